@@ -1,0 +1,120 @@
+//! Flags every subcommand shares, and how a job is shown: live TUI, progress lines, or nothing.
+
+use std::io::IsTerminal;
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
+
+use anyhow::Context;
+use clap::Args;
+use mbrl::run::{ChannelMonitor, ConsoleMonitor, Event, Monitor, NullMonitor};
+use mbrl::tui::{run_live, LiveOutcome};
+
+#[derive(Args, Clone, Debug)]
+pub struct GlobalArgs {
+    /// Seed for every random choice; the same seed and thread count give the same output bytes.
+    #[arg(long, global = true, default_value_t = 0)]
+    pub seed: u64,
+    /// Worker threads (0 = one per core).
+    #[arg(long, global = true, default_value_t = 0)]
+    pub threads: usize,
+    /// Show the live terminal view (default when stdout is a terminal).
+    #[arg(long, global = true, overrides_with = "no_tui")]
+    pub tui: bool,
+    /// Print plain progress lines on stderr instead of the live view.
+    #[arg(long, global = true, overrides_with = "tui")]
+    pub no_tui: bool,
+    /// Print only results and errors.
+    #[arg(short, long, global = true)]
+    pub quiet: bool,
+}
+
+impl GlobalArgs {
+    pub fn use_tui(&self) -> bool {
+        if self.quiet || self.no_tui {
+            return false;
+        }
+        self.tui || std::io::stdout().is_terminal()
+    }
+
+    pub fn thread_count(&self) -> usize {
+        rayon::current_num_threads()
+    }
+}
+
+pub fn init_threads(global: &GlobalArgs) -> anyhow::Result<()> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(global.threads)
+        .build_global()
+        .context("could not start the worker threads")
+}
+
+/// The command line as typed, recorded in datasets and run configs.
+pub fn command_line() -> String {
+    // Record the program as `mbrl`, not the path it was started from, so outputs do not depend on
+    // where the binary lives.
+    std::env::args()
+        .enumerate()
+        .map(|(i, a)| if i == 0 { "mbrl".to_string() } else { a })
+        .map(|a| {
+            if a.is_empty() || a.contains(|c: char| c.is_whitespace() || "\"'$`\\".contains(c)) {
+                format!("'{}'", a.replace('\'', r"'\''"))
+            } else {
+                a
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// Runs `job` with the monitor the flags ask for. With the TUI, the job runs on a worker thread while the
+/// view owns the terminal; quitting the view cancels the job.
+pub fn run_job<T: Send>(
+    global: &GlobalArgs,
+    title: &str,
+    job: impl FnOnce(&dyn Monitor) -> mbrl::Result<T> + Send,
+) -> anyhow::Result<T> {
+    if !global.use_tui() {
+        let result = if global.quiet { job(&NullMonitor) } else { job(&ConsoleMonitor::new()) };
+        return Ok(result?);
+    }
+    let (sender, receiver) = std::sync::mpsc::channel();
+    let cancel = Arc::new(AtomicBool::new(false));
+    let monitor = ChannelMonitor::new(sender, cancel.clone());
+    std::thread::scope(|scope| {
+        let worker = scope.spawn(move || {
+            let result = job(&monitor);
+            if let Err(e) = &result {
+                monitor.emit(&Event::message(format!("error: {e}")));
+            }
+            monitor.emit(&Event::Finished { ok: result.is_ok() });
+            result
+        });
+        let outcome = run_live(receiver, cancel.clone(), title).context("terminal view failed");
+        let result = worker.join().map_err(|_| anyhow::anyhow!("the job panicked"))?;
+        match outcome? {
+            LiveOutcome::QuitByUser | LiveOutcome::Finished => Ok(result?),
+        }
+    })
+}
+
+/// Accepts only finite numbers, so NaN or inf never reach a simulator or planner.
+pub fn finite_f64(text: &str) -> Result<f64, String> {
+    let value: f64 = text.parse().map_err(|_| format!("'{text}' is not a number"))?;
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(format!("'{text}' is not finite; expected a finite number"))
+    }
+}
+
+/// A filesystem-friendly form of an env name (`pendulum:heavy` → `pendulum-heavy`).
+pub fn file_stem(env: &str) -> String {
+    env.chars().map(|c| if c.is_ascii_alphanumeric() || c == '.' || c == '-' { c } else { '-' }).collect()
+}
+
+/// Which dynamics model a planner uses. Learned models join this list as their methods land.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ModelChoice {
+    /// The simulator's own equations (ground truth).
+    True,
+}

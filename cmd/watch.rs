@@ -1,0 +1,87 @@
+//! `mbrl watch`: follow a run's metrics in the live view, or summarise them when not on a terminal.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::Duration;
+
+use anyhow::Context;
+use clap::Args;
+use mbrl::run::dir::METRICS_FILE;
+use mbrl::run::follow::MetricsFollower;
+use mbrl::run::Event;
+use mbrl::tui::run_live;
+
+use crate::common::GlobalArgs;
+
+/// Follow a running or finished run (training or eval) in the live view.
+#[derive(Args, Debug)]
+#[command(after_help = "\
+Examples:
+  mbrl watch reports/quick/pendulum-swingup
+  mbrl watch models/my-run --no-tui      # print a summary of the metrics instead")]
+pub struct WatchArgs {
+    /// Run directory (holds metrics.jsonl) or the metrics file itself.
+    run_dir: PathBuf,
+}
+
+pub fn run(global: &GlobalArgs, args: WatchArgs) -> anyhow::Result<()> {
+    let path = if args.run_dir.is_dir() { args.run_dir.join(METRICS_FILE) } else { args.run_dir.clone() };
+    let mut follower = MetricsFollower::open(&path)?;
+    if !global.use_tui() {
+        return print_summary(&follower.poll()?);
+    }
+    let (sender, receiver) = std::sync::mpsc::channel();
+    let cancel = Arc::new(AtomicBool::new(false));
+    let stop = cancel.clone();
+    let title = format!("watch {}", args.run_dir.display());
+    std::thread::scope(|scope| {
+        let reader = scope.spawn(move || -> mbrl::Result<()> {
+            while !stop.load(Ordering::Relaxed) {
+                for event in follower.poll()? {
+                    let finished = matches!(event, Event::Finished { .. });
+                    if sender.send(event).is_err() || finished {
+                        return Ok(());
+                    }
+                }
+                std::thread::sleep(Duration::from_millis(200));
+            }
+            Ok(())
+        });
+        run_live(receiver, cancel.clone(), &title).context("terminal view failed")?;
+        cancel.store(true, Ordering::Relaxed);
+        reader.join().map_err(|_| anyhow::anyhow!("the metrics reader panicked"))??;
+        Ok(())
+    })
+}
+
+/// Last value of each scalar, the latest progress, messages and whether the run finished.
+fn print_summary(events: &[Event]) -> anyhow::Result<()> {
+    let mut last: BTreeMap<&str, (u64, f64, usize)> = BTreeMap::new();
+    let mut progress: Vec<(&str, u64, u64)> = Vec::new();
+    let mut status = "running (or stopped without finishing)";
+    for event in events {
+        match event {
+            Event::Layout { title, .. } => println!("{title}"),
+            Event::Scalar { name, step, value } => {
+                let entry = last.entry(name).or_insert((0, 0.0, 0));
+                *entry = (*step, *value, entry.2 + 1);
+            }
+            Event::Progress { phase, done, total } => match progress.iter_mut().find(|p| p.0 == phase) {
+                Some(p) => (p.1, p.2) = (*done, *total),
+                None => progress.push((phase, *done, *total)),
+            },
+            Event::Message { text } => println!("{text}"),
+            Event::Finished { ok } => status = if *ok { "finished" } else { "failed" },
+        }
+    }
+    for (phase, done, total) in progress {
+        println!("{phase}: {done}/{total}");
+    }
+    for (name, (step, value, count)) in last {
+        println!("{name}: {value:.6} at step {step} ({count} points)");
+    }
+    println!("status: {status}");
+    Ok(())
+}

@@ -1,0 +1,9 @@
+//! Rollouts and datasets on disk.
+
+pub mod collect;
+pub mod dataset;
+pub mod rollout;
+pub mod schema;
+
+pub use dataset::{read_dataset, write_dataset, Dataset, DatasetMeta, FORMAT_VERSION};
+pub use rollout::{Rollout, Timestep};

@@ -1,0 +1,60 @@
+//! The pendulum's transition and reward as pure functions, shared by the environment and by planners.
+
+use super::params::{angle_normalize, quadrant_of, PendulumParams};
+use crate::envs::Dynamics;
+
+/// One simulator step of gym Pendulum-v0. The order matters: the reward is computed on the pre-step
+/// state, θ advances with the *unclipped* new velocity, and only then is θ̇ clipped (gymnasium v1 clips
+/// first, which gives different trajectories).
+pub fn substep(p: &PendulumParams, state: &mut [f64; 2], action: f64) -> f64 {
+    let [theta, theta_dot] = *state;
+    let torque = applied_torque(p, theta, action);
+    let cost = angle_normalize(theta).powi(2) + 0.1 * theta_dot.powi(2) + 0.001 * torque.powi(2);
+    let accel = -3.0 * p.gravity / (2.0 * p.length) * (theta + std::f64::consts::PI).sin()
+        + 3.0 / (p.mass * p.length.powi(2)) * torque;
+    let new_theta_dot = theta_dot + accel * p.dt;
+    state[0] = theta + new_theta_dot * p.dt;
+    state[1] = new_theta_dot.clamp(-p.max_speed, p.max_speed);
+    -cost
+}
+
+/// The torque that reaches the joint. The quadrant family clips first and then scales, so its effective
+/// range is ±(gain·max_torque); the other variants scale first and then clip.
+fn applied_torque(p: &PendulumParams, theta: f64, action: f64) -> f64 {
+    match &p.quadrants {
+        Some(q) => {
+            let actuator = q[quadrant_of(theta)];
+            action.clamp(-p.max_torque, p.max_torque) * actuator.gain * actuator.sign
+        }
+        None => (action * p.action_factor).clamp(-p.max_torque, p.max_torque),
+    }
+}
+
+/// One environment step: `action_repeat` simulator steps with summed rewards.
+pub fn env_step(p: &PendulumParams, state: &mut [f64; 2], action: f64) -> f64 {
+    (0..p.action_repeat).map(|_| substep(p, state, action)).sum()
+}
+
+/// Ground-truth pendulum dynamics for planners.
+#[derive(Clone, Debug)]
+pub struct PendulumDynamics {
+    pub params: PendulumParams,
+}
+
+impl Dynamics for PendulumDynamics {
+    fn state_dim(&self) -> usize {
+        2
+    }
+
+    fn action_dim(&self) -> usize {
+        1
+    }
+
+    fn step(&self, state: &mut [f64], action: &[f64]) -> f64 {
+        let mut s = [state[0], state[1]];
+        let r = env_step(&self.params, &mut s, action[0]);
+        state[0] = s[0];
+        state[1] = s[1];
+        r
+    }
+}

@@ -1,0 +1,120 @@
+//! `mbrl eval dataset`: what a dataset holds (rollouts, lengths, returns, state ranges), as a report.
+
+use std::path::Path;
+
+use serde::Serialize;
+
+use super::plot::{histogram, line_plot, Series};
+use super::stats::{mean, quantile};
+use super::table::write_csv;
+use crate::data::{read_dataset, Rollout};
+use crate::error::{Error, Result};
+use crate::run::atomic::write_atomic;
+use crate::run::dir::{Provenance, RunDir};
+
+/// Rollouts drawn in the state plot; more would be unreadable.
+const PLOTTED_ROLLOUTS: usize = 20;
+
+#[derive(Clone, Debug, Serialize)]
+pub struct DimensionStats {
+    pub name: String,
+    pub min: f64,
+    pub max: f64,
+    pub mean: f64,
+}
+
+pub struct DatasetSummary {
+    pub env: String,
+    pub rollouts: usize,
+    pub transitions: usize,
+    pub mean_return: f64,
+    pub dimensions: Vec<DimensionStats>,
+}
+
+pub fn report(input: &Path, provenance: &Provenance, out_dir: &Path) -> Result<DatasetSummary> {
+    let data = read_dataset(input)?;
+    let grouped = Rollout::group(&data.steps).map_err(|i| {
+        Error::bad_file(
+            input,
+            format!("timestep {i} does not continue its rollout (expected t and state to follow on)"),
+        )
+    })?;
+    let run = RunDir::create(out_dir)?;
+    run.write_config(&serde_json::json!({
+        "job": "eval dataset",
+        "input": input.display().to_string(),
+        "mbrl_version": provenance.mbrl_version,
+        "command_line": provenance.command_line,
+    }))?;
+    let returns: Vec<f64> = grouped.iter().map(|(_, r)| r.total_reward()).collect();
+    let dimensions: Vec<DimensionStats> = data
+        .meta
+        .state_names
+        .iter()
+        .enumerate()
+        .map(|(d, name)| {
+            let values: Vec<f64> = data.steps.iter().map(|s| s.state[d]).collect();
+            DimensionStats {
+                name: name.clone(),
+                min: values.iter().copied().fold(f64::INFINITY, f64::min),
+                max: values.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+                mean: mean(&values).unwrap_or(f64::NAN),
+            }
+        })
+        .collect();
+    let rows: Vec<Vec<String>> = grouped
+        .iter()
+        .map(|(id, r)| vec![id.to_string(), r.len().to_string(), format!("{:.6}", r.total_reward())])
+        .collect();
+    write_csv(&run.file("rollouts.csv"), &["rollout", "steps", "return"], &rows)?;
+    histogram(&run.file("returns.png"), "Rollout returns", "return", &returns, 20)?;
+    if let Some(first) = data.meta.state_names.first() {
+        let series: Vec<Series> = grouped
+            .iter()
+            .take(PLOTTED_ROLLOUTS)
+            .map(|(id, r)| Series {
+                name: format!("rollout {id}"),
+                points: r.states.iter().enumerate().map(|(t, s)| (t as f64 * data.meta.dt, s[0])).collect(),
+            })
+            .collect();
+        line_plot(&run.file("states.png"), &format!("{first} over time"), "time [s]", first, &series)?;
+    }
+    let summary = DatasetSummary {
+        env: data.meta.env.clone(),
+        rollouts: grouped.len(),
+        transitions: data.steps.len(),
+        mean_return: mean(&returns).unwrap_or(f64::NAN),
+        dimensions,
+    };
+    let md = markdown(input, &data.meta, &summary, &returns);
+    let path = run.file("report.md");
+    write_atomic(&path, |w| w.write_all(md.as_bytes()).map_err(|e| Error::io(&path, e)))?;
+    Ok(summary)
+}
+
+fn markdown(input: &Path, meta: &crate::data::DatasetMeta, s: &DatasetSummary, returns: &[f64]) -> String {
+    let q = |p| quantile(returns, p).map(|x| format!("{x:.2}")).unwrap_or_else(|| "–".into());
+    let mut md = format!(
+        "# Dataset `{}`\n\nEnvironment `{}`, seed {}, written by mbrl {} with `{}`.\n\n\
+         {} rollouts, {} transitions, dt {} s.\n\n\
+         Returns: mean {:.2}, 10 % {}, median {}, 90 % {}.\n\n\
+         | state | min | max | mean |\n|---|---|---|---|\n",
+        input.display(),
+        meta.env,
+        meta.seed,
+        meta.mbrl_version,
+        meta.command_line,
+        s.rollouts,
+        s.transitions,
+        meta.dt,
+        s.mean_return,
+        q(0.1),
+        q(0.5),
+        q(0.9)
+    );
+    for d in &s.dimensions {
+        md.push_str(&format!("| {} | {:.4} | {:.4} | {:.4} |\n", d.name, d.min, d.max, d.mean));
+    }
+    md.push_str("\n![returns](returns.png)\n\n![states](states.png)\n\nPer-rollout values: `rollouts.csv`.\n");
+    md
+}

@@ -1,0 +1,8 @@
+//! Protocols that reproduce the thesis' experiments and write reports (markdown + CSV + PNG).
+
+pub mod dataset_report;
+pub mod plot;
+pub mod quick;
+pub mod stats;
+pub mod swingup;
+pub mod table;

@@ -1,0 +1,144 @@
+//! PNG plots for reports. The font is embedded so the same data renders to the same bytes on every machine.
+
+use std::path::Path;
+use std::sync::Once;
+
+use plotters::prelude::*;
+
+use crate::error::{Error, Result};
+
+const FONT: &[u8] = include_bytes!("fonts/DejaVuSans.ttf");
+const SIZE: (u32, u32) = (900, 560);
+
+fn register_font() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        // The font is compiled in and known to parse; a failure would only drop text from plots.
+        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
+    });
+}
+
+/// A named series of (x, y) points.
+pub struct Series {
+    pub name: String,
+    pub points: Vec<(f64, f64)>,
+}
+
+fn plot_err(path: &Path, e: impl std::fmt::Display) -> Error {
+    Error::bad_file(path, format!("could not draw plot: {e}"))
+}
+
+/// Draws into a temporary PNG beside `path`, then renames it into place.
+fn render_atomic(path: &Path, draw: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+    register_font();
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let tmp =
+        crate::run::atomic::partial_file_builder().suffix(".png").tempfile_in(dir).map_err(|e| Error::io(dir, e))?;
+    draw(tmp.path())?;
+    tmp.persist(path).map_err(|e| Error::io(path, e.error))?;
+    Ok(())
+}
+
+fn bounds(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (lo, hi) =
+        values.filter(|v| v.is_finite()).fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
+    if !lo.is_finite() {
+        return (0.0, 1.0);
+    }
+    let pad = ((hi - lo) * 0.05).max(1e-6);
+    (lo - pad, hi + pad)
+}
+
+pub fn line_plot(path: &Path, title: &str, x_label: &str, y_label: &str, series: &[Series]) -> Result<()> {
+    let (x0, x1) = bounds(series.iter().flat_map(|s| s.points.iter().map(|p| p.0)));
+    let (y0, y1) = bounds(series.iter().flat_map(|s| s.points.iter().map(|p| p.1)));
+    render_atomic(path, |tmp| {
+        let root = BitMapBackend::new(tmp, SIZE).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| plot_err(path, e))?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 24))
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(60)
+            .build_cartesian_2d(x0..x1, y0..y1)
+            .map_err(|e| plot_err(path, e))?;
+        chart.configure_mesh().x_desc(x_label).y_desc(y_label).draw().map_err(|e| plot_err(path, e))?;
+        for (i, s) in series.iter().enumerate() {
+            let color = Palette99::pick(i).to_rgba();
+            // A non-finite y breaks the line, so wrapped angles do not draw vertical jumps.
+            for (j, segment) in s.points.split(|p| !p.1.is_finite()).filter(|seg| !seg.is_empty()).enumerate() {
+                let drawn = chart
+                    .draw_series(LineSeries::new(segment.iter().copied(), color))
+                    .map_err(|e| plot_err(path, e))?;
+                if j == 0 {
+                    drawn
+                        .label(s.name.clone())
+                        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], color));
+                }
+            }
+        }
+        if series.len() <= 12 {
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.8))
+                .border_style(BLACK)
+                .draw()
+                .map_err(|e| plot_err(path, e))?;
+        }
+        root.present().map_err(|e| plot_err(path, e))?;
+        Ok(())
+    })
+}
+
+pub fn histogram(path: &Path, title: &str, x_label: &str, values: &[f64], bins: usize) -> Result<()> {
+    let finite: Vec<f64> = values.iter().copied().filter(|v| v.is_finite()).collect();
+    let (lo, hi) = bounds(finite.iter().copied());
+    let bins = bins.max(1);
+    let width = (hi - lo) / bins as f64;
+    let mut counts = vec![0u32; bins];
+    for v in &finite {
+        let b = (((v - lo) / width) as usize).min(bins - 1);
+        counts[b] += 1;
+    }
+    let top = counts.iter().copied().max().unwrap_or(0).max(1);
+    render_atomic(path, |tmp| {
+        let root = BitMapBackend::new(tmp, SIZE).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| plot_err(path, e))?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 24))
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(50)
+            .build_cartesian_2d(lo..hi, 0u32..top + 1)
+            .map_err(|e| plot_err(path, e))?;
+        chart.configure_mesh().x_desc(x_label).y_desc("count").draw().map_err(|e| plot_err(path, e))?;
+        chart
+            .draw_series(counts.iter().enumerate().map(|(i, &c)| {
+                let x0 = lo + i as f64 * width;
+                Rectangle::new([(x0, 0), (x0 + width, c)], BLUE.mix(0.6).filled())
+            }))
+            .map_err(|e| plot_err(path, e))?;
+        root.present().map_err(|e| plot_err(path, e))?;
+        Ok(())
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn plots_are_png_and_deterministic() {
+        let dir = tempfile::tempdir().unwrap();
+        let s =
+            vec![Series { name: "a".into(), points: (0..50).map(|i| (i as f64, (i as f64 * 0.1).sin())).collect() }];
+        let (a, b) = (dir.path().join("a.png"), dir.path().join("b.png"));
+        line_plot(&a, "t", "x", "y", &s).unwrap();
+        line_plot(&b, "t", "x", "y", &s).unwrap();
+        let bytes = std::fs::read(&a).unwrap();
+        assert_eq!(&bytes[1..4], b"PNG");
+        assert_eq!(bytes, std::fs::read(&b).unwrap());
+        histogram(&dir.path().join("h.png"), "h", "v", &[1.0, 2.0, 2.5, f64::NAN], 5).unwrap();
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 3, "no temporary files left");
+    }
+}

@@ -1,0 +1,315 @@
+//! Pendulum swing-up from the hanging position with MPC (thesis 3.5.2): success means each of the last
+//! 25 of 150 rewards is above −1.
+
+use std::path::Path;
+
+use serde::Serialize;
+
+use super::plot::{histogram, line_plot, Series};
+use super::stats::{mean, quantile};
+use super::table::write_csv;
+use crate::data::{write_dataset, Dataset, DatasetMeta, Rollout, FORMAT_VERSION};
+use crate::envs::pendulum::{angle_normalize, Pendulum, PendulumVariant, StartDistribution};
+use crate::envs::Env;
+use crate::error::Result;
+use crate::planning::mpc::run_mpc_episode;
+use crate::planning::seeding::{derive_seed, rng_for};
+use crate::planning::{Cem, CemConfig};
+use crate::run::atomic::write_atomic;
+use crate::run::dir::{Provenance, RunDir};
+use crate::run::{Event, Monitor, PanelSpec, Tee};
+
+pub const SUCCESS_WINDOW: usize = 25;
+pub const SUCCESS_MIN_REWARD: f64 = -1.0;
+
+/// The thesis' success criterion: every one of the last 25 rewards above −1.
+pub fn is_success(rewards: &[f64]) -> bool {
+    rewards.len() >= SUCCESS_WINDOW && rewards[rewards.len() - SUCCESS_WINDOW..].iter().all(|&r| r > SUCCESS_MIN_REWARD)
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct SwingupSettings {
+    #[serde(serialize_with = "serialize_variant")]
+    pub variant: PendulumVariant,
+    pub cem: CemConfig,
+    pub steps: usize,
+}
+
+fn serialize_variant<S: serde::Serializer>(v: &PendulumVariant, s: S) -> std::result::Result<S::Ok, S::Error> {
+    s.serialize_str(&v.env_name())
+}
+
+impl SwingupSettings {
+    /// Thesis settings: horizon 20, 1000 candidates, 100 elites, 10 iterations, 150 steps.
+    pub fn thesis(variant: PendulumVariant) -> Self {
+        let params = variant.fixed_params();
+        let cem = CemConfig::for_box(&[-params.max_torque], &[params.max_torque]);
+        SwingupSettings { variant, cem, steps: 150 }
+    }
+}
+
+pub struct SwingupEpisode {
+    pub episode: u64,
+    pub instance: serde_json::Value,
+    pub rollout: Rollout,
+    pub total_return: f64,
+    pub success: bool,
+}
+
+/// The live-view panels of a swing-up job.
+pub fn layout(title: &str) -> Event {
+    Event::Layout {
+        title: title.to_string(),
+        panels: vec![
+            PanelSpec {
+                title: "pendulum (current episode)".into(),
+                x_label: "step".into(),
+                series: vec!["pendulum/angle".into(), "pendulum/action".into()],
+                restart_on_rewind: true,
+            },
+            PanelSpec {
+                title: "CEM (current MPC step)".into(),
+                x_label: "iteration".into(),
+                series: vec!["cem/best_cost".into(), "cem/elite_mean_cost".into()],
+                restart_on_rewind: true,
+            },
+        ],
+    }
+}
+
+/// Runs one MPC swing-up with the ground-truth model. Episode `k` under `seed` always starts from the same
+/// state and samples the same candidates.
+pub fn run_episode(
+    settings: &SwingupSettings,
+    seed: u64,
+    episode: u64,
+    monitor: &dyn Monitor,
+) -> Result<SwingupEpisode> {
+    let mut env = Pendulum::new(settings.variant.clone()).with_start(StartDistribution::Hanging);
+    let mut rng = rng_for(seed, &[episode, 0]);
+    env.sample_instance(&mut rng);
+    env.reset(&mut rng);
+    let model = env.dynamics();
+    let mut cem = Cem::new(settings.cem.clone(), derive_seed(seed, &[episode, 1]))?;
+    let phase = format!("episode {} MPC", episode + 1);
+    let rollout = run_mpc_episode(
+        &mut env,
+        model.as_ref(),
+        &mut cem,
+        settings.steps,
+        monitor,
+        |_, it| {
+            monitor.scalar("cem/best_cost", it.iteration as u64, it.best_cost);
+            monitor.scalar("cem/elite_mean_cost", it.iteration as u64, it.elite_mean_cost);
+        },
+        |t, state, action, _| {
+            monitor.scalar("pendulum/angle", t as u64, angle_normalize(state[0]));
+            monitor.scalar("pendulum/action", t as u64, action[0]);
+            monitor.progress(&phase, t as u64 + 1, settings.steps as u64);
+        },
+    )?;
+    let total_return = rollout.total_reward();
+    let success = is_success(&rollout.rewards);
+    monitor.scalar("episode/return", episode, total_return);
+    Ok(SwingupEpisode { episode, instance: env.params(), rollout, total_return, success })
+}
+
+/// Packs executed episodes as a dataset, so planner runs can be inspected like collected data.
+pub fn episodes_dataset(
+    settings: &SwingupSettings,
+    seed: u64,
+    command_line: &str,
+    episodes: &[SwingupEpisode],
+) -> Dataset {
+    let env = Pendulum::new(settings.variant.clone());
+    let spec = env.spec();
+    Dataset {
+        meta: DatasetMeta {
+            format_version: FORMAT_VERSION,
+            env: spec.name.clone(),
+            seed,
+            mbrl_version: crate::VERSION.to_string(),
+            command_line: command_line.to_string(),
+            instances: episodes.iter().map(|e| e.instance.clone()).collect(),
+            state_names: spec.state_names.iter().map(|s| s.to_string()).collect(),
+            action_dim: spec.action_dim(),
+            dt: spec.dt,
+        },
+        steps: episodes.iter().flat_map(|e| e.rollout.timesteps(e.episode as u32)).collect(),
+    }
+}
+
+#[derive(Clone, Debug, Serialize)]
+struct SwingupConfigRecord<'a> {
+    job: &'static str,
+    #[serde(flatten)]
+    provenance: &'a Provenance,
+    episodes: usize,
+    model: &'static str,
+    settings: &'a SwingupSettings,
+}
+
+pub struct SwingupSummary {
+    pub returns: Vec<f64>,
+    pub successes: usize,
+    pub episodes: usize,
+}
+
+/// `mbrl eval pendulum-swingup`: `episodes` MPC swing-ups, written to `report_dir` as report.md,
+/// episodes.csv, angle.png, returns.png, rollouts.mcap, config.json and metrics.jsonl.
+pub fn evaluate(
+    settings: &SwingupSettings,
+    episodes: usize,
+    provenance: &Provenance,
+    report_dir: &Path,
+    monitor: &dyn Monitor,
+) -> Result<SwingupSummary> {
+    let run = RunDir::create(report_dir)?;
+    run.write_config(&SwingupConfigRecord {
+        job: "eval pendulum-swingup",
+        provenance,
+        episodes,
+        model: "true",
+        settings,
+    })?;
+    let metrics = run.metrics()?;
+    let monitor = Tee { first: monitor, second: &metrics };
+    monitor.emit(&layout("pendulum swing-up, ground-truth model + CEM"));
+    let mut results = Vec::with_capacity(episodes);
+    for k in 0..episodes as u64 {
+        monitor.progress("episodes", k, episodes as u64);
+        let ep = run_episode(settings, provenance.seed, k, &monitor)?;
+        monitor.message(&format!(
+            "episode {}: return {:.1}, {}",
+            k + 1,
+            ep.total_return,
+            if ep.success { "success" } else { "failure" }
+        ));
+        results.push(ep);
+    }
+    monitor.progress("episodes", episodes as u64, episodes as u64);
+    write_outputs(settings, provenance, &run, &results)?;
+    monitor.emit(&Event::Finished { ok: true });
+    Ok(SwingupSummary {
+        returns: results.iter().map(|e| e.total_return).collect(),
+        successes: results.iter().filter(|e| e.success).count(),
+        episodes,
+    })
+}
+
+fn write_outputs(
+    settings: &SwingupSettings,
+    provenance: &Provenance,
+    run: &RunDir,
+    results: &[SwingupEpisode],
+) -> Result<()> {
+    let rows: Vec<Vec<String>> = results
+        .iter()
+        .map(|e| {
+            let final_angle = e.rollout.states.last().map(|s| angle_normalize(s[0])).unwrap_or(f64::NAN);
+            vec![
+                e.episode.to_string(),
+                format!("{:.6}", e.total_return),
+                e.success.to_string(),
+                format!("{final_angle:.6}"),
+            ]
+        })
+        .collect();
+    write_csv(&run.file("episodes.csv"), &["episode", "return", "success", "final_angle"], &rows)?;
+    let dt = Pendulum::new(settings.variant.clone()).spec().dt;
+    let series: Vec<Series> = results
+        .iter()
+        .map(|e| Series {
+            name: format!("episode {}", e.episode + 1),
+            points: wrapped_angle_points(&e.rollout.states, dt),
+        })
+        .collect();
+    line_plot(
+        &run.file("angle.png"),
+        "Pendulum angle during swing-up (0 = upright)",
+        "time [s]",
+        "angle [rad]",
+        &series,
+    )?;
+    let returns: Vec<f64> = results.iter().map(|e| e.total_return).collect();
+    histogram(&run.file("returns.png"), "Episode returns", "return", &returns, 10)?;
+    write_dataset(
+        &run.file("rollouts.mcap"),
+        &episodes_dataset(settings, provenance.seed, &provenance.command_line, results),
+    )?;
+    let report = report_markdown(settings, provenance, results);
+    write_atomic(&run.file("report.md"), |w| {
+        w.write_all(report.as_bytes()).map_err(|e| crate::Error::io(&run.file("report.md"), e))
+    })
+}
+
+/// (time, wrapped angle) with a NaN break wherever the angle wraps around ±π.
+fn wrapped_angle_points(states: &[Vec<f64>], dt: f64) -> Vec<(f64, f64)> {
+    let mut points: Vec<(f64, f64)> = Vec::with_capacity(states.len() + 8);
+    for (t, s) in states.iter().enumerate() {
+        let point = (t as f64 * dt, angle_normalize(s[0]));
+        if points.last().is_some_and(|last| (last.1 - point.1).abs() > std::f64::consts::PI) {
+            points.push((point.0, f64::NAN));
+        }
+        points.push(point);
+    }
+    points
+}
+
+fn report_markdown(settings: &SwingupSettings, provenance: &Provenance, results: &[SwingupEpisode]) -> String {
+    let returns: Vec<f64> = results.iter().map(|e| e.total_return).collect();
+    let successes = results.iter().filter(|e| e.success).count();
+    let fmt = |v: Option<f64>| v.map(|x| format!("{x:.1}")).unwrap_or_else(|| "–".into());
+    let c = &settings.cem;
+    let mut md = format!(
+        "# Pendulum swing-up: ground-truth model + CEM\n\n\
+         Environment `{}`, start θ ∼ U[π−0.05, π+0.05], θ̇ ∼ U[−0.05, 0.05], {} steps.\n\
+         CEM: horizon {}, {} candidates, {} elites, {} iterations, noise {:?}, warm start {}.\n\
+         Seed {}, command `{}`.\n\n\
+         Success = each of the last {SUCCESS_WINDOW} rewards > {SUCCESS_MIN_REWARD} (thesis 3.5.2).\n\n\
+         | episodes | successes | mean return | median return | 10 % | 90 % |\n|---|---|---|---|---|---|\n\
+         | {} | {} | {} | {} | {} | {} |\n\n",
+        settings.variant.env_name(),
+        settings.steps,
+        c.horizon,
+        c.candidates,
+        c.elites,
+        c.iterations,
+        c.noise,
+        c.warm_start,
+        provenance.seed,
+        provenance.command_line,
+        results.len(),
+        successes,
+        fmt(mean(&returns)),
+        fmt(quantile(&returns, 0.5)),
+        fmt(quantile(&returns, 0.1)),
+        fmt(quantile(&returns, 0.9)),
+    );
+    md.push_str("| episode | return | success |\n|---|---|---|\n");
+    for e in results {
+        md.push_str(&format!(
+            "| {} | {:.1} | {} |\n",
+            e.episode + 1,
+            e.total_return,
+            if e.success { "yes" } else { "no" }
+        ));
+    }
+    md.push_str("\n![angle over time](angle.png)\n\n![returns](returns.png)\n\nPer-episode values: `episodes.csv`; executed rollouts: `rollouts.mcap`.\n");
+    md
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn success_needs_all_last_25_rewards_above_minus_one() {
+        let mut r = vec![-5.0; 125];
+        r.extend(vec![-0.5; 25]);
+        assert!(is_success(&r));
+        r[130] = -1.0;
+        assert!(!is_success(&r));
+        assert!(!is_success(&[-0.1; 10]));
+    }
+}

@@ -1,0 +1,15 @@
+//! mbrl: model-based reinforcement learning as a library. The `mbrl` binary (in `cmd/`) is a thin shell
+//! over these modules; see ARCHITECTURE.md for how the rooms fit together.
+
+pub mod data;
+pub mod envs;
+pub mod error;
+pub mod eval;
+pub mod planning;
+pub mod run;
+pub mod tui;
+
+pub use error::{Error, Result};
+
+/// The version written into datasets and run directories.
+pub const VERSION: &str = env!("CARGO_PKG_VERSION");

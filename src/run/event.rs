@@ -1,0 +1,47 @@
+//! The events a long-running job reports. One stream feeds the console, the TUI and `metrics.jsonl`,
+//! so everything a user can see live can also be replayed later by `mbrl watch`.
+
+use serde::{Deserialize, Serialize};
+
+/// One line of `metrics.jsonl`, tagged by `kind`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Event {
+    /// Sent once at the start: names the job and the method-specific panels the TUI should draw.
+    Layout { title: String, panels: Vec<PanelSpec> },
+    /// A scalar metric at a step. Names are slash-separated paths such as `cem/best_cost`.
+    Scalar { name: String, step: u64, value: f64 },
+    /// Progress of the current phase: `done` of `total` units.
+    Progress { phase: String, done: u64, total: u64 },
+    /// A human-readable note (a result line, a warning).
+    Message { text: String },
+    /// The job ended; `ok` is false when it failed.
+    Finished { ok: bool },
+}
+
+/// A method-specific plot: several scalar series drawn against their step.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PanelSpec {
+    pub title: String,
+    pub x_label: String,
+    /// Metric names drawn in this panel.
+    pub series: Vec<String>,
+    /// When true, a step not larger than the last one starts the series afresh (a new episode or a new
+    /// planner call), so the panel shows the latest episode instead of overdrawing all of them.
+    #[serde(default)]
+    pub restart_on_rewind: bool,
+}
+
+impl Event {
+    pub fn scalar(name: impl Into<String>, step: u64, value: f64) -> Self {
+        Event::Scalar { name: name.into(), step, value }
+    }
+
+    pub fn progress(phase: impl Into<String>, done: u64, total: u64) -> Self {
+        Event::Progress { phase: phase.into(), done, total }
+    }
+
+    pub fn message(text: impl Into<String>) -> Self {
+        Event::Message { text: text.into() }
+    }
+}

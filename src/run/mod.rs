@@ -1,0 +1,10 @@
+//! A run: its directory on disk, its configuration and its stream of events.
+
+pub mod atomic;
+pub mod dir;
+pub mod event;
+pub mod follow;
+pub mod monitor;
+
+pub use event::{Event, PanelSpec};
+pub use monitor::{ChannelMonitor, ConsoleMonitor, Fanout, JsonlMonitor, Monitor, NullMonitor, Tee};
