@@ -1,0 +1,42 @@
+# Reproduction pipelines and maintenance targets. Every target runs the released binary, so the numbers
+# in a report come from running the method, never from a stored constant.
+
+MBRL := target/release/mbrl
+SEED ?= 0
+
+.PHONY: build test bench completions repro-quick repro-swingup repro-pendulum-data clean-reports
+
+build:
+	cargo build --release
+
+test:
+	cargo test --release
+
+bench:
+	cargo bench
+
+$(MBRL): build
+
+# The README's main job: a small reproduction of every implemented method (reports/quick/).
+repro-quick: build
+	$(MBRL) eval quick --seed $(SEED) --no-tui
+
+# Thesis 3.5.2: ground-truth CEM swing-up, 10 episodes with the thesis' CEM settings.
+repro-swingup: build
+	$(MBRL) eval pendulum-swingup --model true --episodes 10 --horizon 20 --candidates 1000 \
+		--elites 100 --iters 10 --steps 150 --seed $(SEED) --no-tui --out reports/pendulum-swingup
+
+# Thesis 3.5: 500 random rollouts of 30 transitions of the pendulum and each modified pendulum.
+repro-pendulum-data: build
+	for env in pendulum pendulum:light pendulum:heavy pendulum:inverted; do \
+		$(MBRL) collect --env $$env --rollouts 500 --steps 30 --seed $(SEED) --no-tui \
+			--out datasets/$$(echo $$env | tr ':' '-')-random.mcap || exit 1; \
+	done
+
+completions: build
+	$(MBRL) completions bash > completions/mbrl.bash
+	$(MBRL) completions zsh > completions/_mbrl
+	$(MBRL) completions fish > completions/mbrl.fish
+
+clean-reports:
+	rm -rf reports

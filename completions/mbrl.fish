@@ -1,0 +1,145 @@
+# Print an optspec for argparse to handle cmd's options that are independent of any subcommand.
+function __fish_mbrl_global_optspecs
+    string join \n seed= threads= tui no-tui q/quiet h/help V/version
+end
+
+function __fish_mbrl_needs_command
+    # Figure out if the current invocation already has a command.
+    set -l cmd (commandline -opc)
+    set -e cmd[1]
+    argparse -s (__fish_mbrl_global_optspecs) -- $cmd 2>/dev/null
+    or return
+    if set -q argv[1]
+        # Also print the command, so this can be used to figure out what it is.
+        echo $argv[1]
+        return 1
+    end
+    return 0
+end
+
+function __fish_mbrl_using_subcommand
+    set -l cmd (__fish_mbrl_needs_command)
+    test -z "$cmd"
+    and return 1
+    contains -- $cmd[1] $argv
+end
+
+complete -c mbrl -n "__fish_mbrl_needs_command" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
+complete -c mbrl -n "__fish_mbrl_needs_command" -l threads -d 'Worker threads (0 = one per core)' -r
+complete -c mbrl -n "__fish_mbrl_needs_command" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_needs_command" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_needs_command" -s q -l quiet -d 'Print only results and errors'
+complete -c mbrl -n "__fish_mbrl_needs_command" -s h -l help -d 'Print help'
+complete -c mbrl -n "__fish_mbrl_needs_command" -s V -l version -d 'Print version'
+complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "collect" -d 'Collect rollouts from a simulator into an MCAP dataset'
+complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "plan" -d 'Plan with CEM on a model and execute the plan in the simulator (MPC)'
+complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "eval" -d 'Run an evaluation protocol and write a report directory (report.md, CSV, PNG)'
+complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "watch" -d 'Follow a running or finished run (training or eval) in the live view'
+complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "completions" -d 'Print a shell completion script'
+complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l env -d 'Environment: pendulum[:light|heavy|mass=<m>|inverted|quadrant]' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l rollouts -d 'Number of rollouts' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l steps -d 'Steps per rollout' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l policy -d 'Behaviour policy' -r -f -a "random\t'Uniformly random actions within the action bounds'"
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l out -d 'Output file (default: datasets/<env>-random.mcap)' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l threads -d 'Worker threads (0 = one per core)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -s q -l quiet -d 'Print only results and errors'
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -s h -l help -d 'Print help (see more with \'--help\')'
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -s V -l version -d 'Print version'
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l env -d 'Environment: pendulum[:light|heavy|mass=<m>|inverted|quadrant]' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l model -d 'Dynamics model the planner uses' -r -f -a "true\t'The simulator\'s own equations (ground truth)'"
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l steps -d 'Steps to execute' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l horizon -d 'Planning horizon in steps' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l candidates -d 'Candidate action sequences per iteration' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l elites -d 'Elite candidates used to refit the sampling distribution' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l iters -d 'CEM iterations per planning call' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l noise -d 'Sampling noise' -r -f -a "white\t'Independent Gaussian samples (thesis Algorithm 1)'
+colored\t'Power spectral density ∝ 1/f^β along time (iCEM)'"
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l beta -d 'Exponent β of colored noise (used with --noise colored)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l out -d 'Where to save the executed rollout (default: datasets/plan-<env>.mcap)' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l threads -d 'Worker threads (0 = one per core)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l no-warm-start -d 'Start every planning call from zero instead of the previous plan shifted by one step'
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -s q -l quiet -d 'Print only results and errors'
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -s h -l help -d 'Print help (see more with \'--help\')'
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -s V -l version -d 'Print version'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset pendulum-swingup help" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset pendulum-swingup help" -l threads -d 'Worker threads (0 = one per core)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset pendulum-swingup help" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset pendulum-swingup help" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset pendulum-swingup help" -s q -l quiet -d 'Print only results and errors'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset pendulum-swingup help" -s h -l help -d 'Print help'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset pendulum-swingup help" -s V -l version -d 'Print version'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset pendulum-swingup help" -f -a "quick" -d 'Small reproduction of every implemented method (about a minute)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset pendulum-swingup help" -f -a "dataset" -d 'Summarise a dataset: rollouts, returns, state ranges, plots'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset pendulum-swingup help" -f -a "pendulum-swingup" -d 'Pendulum swing-up with MPC: success rate, returns, angle plots'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset pendulum-swingup help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from quick" -l out -d 'Report directory' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from quick" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from quick" -l threads -d 'Worker threads (0 = one per core)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from quick" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from quick" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from quick" -s q -l quiet -d 'Print only results and errors'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from quick" -s h -l help -d 'Print help'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from quick" -s V -l version -d 'Print version'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dataset" -l input -d 'Dataset file written by `mbrl collect` or `mbrl plan`' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dataset" -l out -d 'Report directory' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dataset" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dataset" -l threads -d 'Worker threads (0 = one per core)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dataset" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dataset" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dataset" -s q -l quiet -d 'Print only results and errors'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dataset" -s h -l help -d 'Print help'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dataset" -s V -l version -d 'Print version'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l model -d 'Dynamics model the planner uses' -r -f -a "true\t'The simulator\'s own equations (ground truth)'"
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l episodes -d 'Number of episodes (each with its own start state)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l env -d 'Environment variant: pendulum[:light|heavy|mass=<m>|inverted|quadrant]' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l steps -d 'Steps per episode' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l horizon -d 'Planning horizon in steps' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l candidates -d 'Candidate action sequences per iteration' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l elites -d 'Elite candidates used to refit the sampling distribution' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l iters -d 'CEM iterations per planning call' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l noise -d 'Sampling noise' -r -f -a "white\t'Independent Gaussian samples (thesis Algorithm 1)'
+colored\t'Power spectral density ∝ 1/f^β along time (iCEM)'"
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l beta -d 'Exponent β of colored noise (used with --noise colored)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l out -d 'Report directory' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l threads -d 'Worker threads (0 = one per core)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l no-warm-start -d 'Start every planning call from zero instead of the previous plan shifted by one step'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -s q -l quiet -d 'Print only results and errors'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -s h -l help -d 'Print help (see more with \'--help\')'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -s V -l version -d 'Print version'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from help" -f -a "quick" -d 'Small reproduction of every implemented method (about a minute)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from help" -f -a "dataset" -d 'Summarise a dataset: rollouts, returns, state ranges, plots'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from help" -f -a "pendulum-swingup" -d 'Pendulum swing-up with MPC: success rate, returns, angle plots'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -l threads -d 'Worker threads (0 = one per core)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -s q -l quiet -d 'Print only results and errors'
+complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -s h -l help -d 'Print help'
+complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -s V -l version -d 'Print version'
+complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -l threads -d 'Worker threads (0 = one per core)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -s q -l quiet -d 'Print only results and errors'
+complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -s h -l help -d 'Print help'
+complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -s V -l version -d 'Print version'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan eval watch completions help" -f -a "collect" -d 'Collect rollouts from a simulator into an MCAP dataset'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan eval watch completions help" -f -a "plan" -d 'Plan with CEM on a model and execute the plan in the simulator (MPC)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan eval watch completions help" -f -a "eval" -d 'Run an evaluation protocol and write a report directory (report.md, CSV, PNG)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan eval watch completions help" -f -a "watch" -d 'Follow a running or finished run (training or eval) in the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan eval watch completions help" -f -a "completions" -d 'Print a shell completion script'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan eval watch completions help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from eval" -f -a "quick" -d 'Small reproduction of every implemented method (about a minute)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from eval" -f -a "dataset" -d 'Summarise a dataset: rollouts, returns, state ranges, plots'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from eval" -f -a "pendulum-swingup" -d 'Pendulum swing-up with MPC: success rate, returns, angle plots'

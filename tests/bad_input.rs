@@ -1,0 +1,103 @@
+//! Bad input gets one clear error line, a non-zero exit, and no output file.
+
+mod common;
+
+use common::*;
+
+#[test]
+fn unknown_env_names_what_is_supported() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = mbrl(dir.path()).args(["collect", "--env", "cartpole", "--out", "x.mcap"]).output().unwrap();
+    assert_one_line_error(&out, &["cartpole", "pendulum"]);
+    assert!(files_in(dir.path()).is_empty());
+}
+
+#[test]
+fn unknown_variant_names_the_variants() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = mbrl(dir.path()).args(["plan", "--env", "pendulum:wobbly", "--model", "true"]).output().unwrap();
+    assert_one_line_error(&out, &["wobbly", "inverted", "quadrant"]);
+    assert!(files_in(dir.path()).is_empty());
+}
+
+#[test]
+fn non_finite_values_are_rejected() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = mbrl(dir.path()).args(["collect", "--env", "pendulum:mass=nan", "--out", "x.mcap"]).output().unwrap();
+    assert_one_line_error(&out, &["mass=nan", "finite"]);
+    let out = mbrl(dir.path())
+        .args(["plan", "--env", "pendulum", "--model", "true", "--noise", "colored", "--beta", "inf"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = stderr_of(&out);
+    assert!(err.lines().next().unwrap().contains("'inf' is not finite"), "{err}");
+    assert!(files_in(dir.path()).is_empty());
+}
+
+#[test]
+fn unsupported_model_lists_the_supported_ones() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = mbrl(dir.path()).args(["plan", "--env", "pendulum", "--model", "gp"]).output().unwrap();
+    assert!(!out.status.success());
+    let err = stderr_of(&out);
+    assert!(err.lines().next().unwrap().contains("invalid value 'gp'") && err.contains("true"), "{err}");
+}
+
+#[test]
+fn impossible_cem_settings_are_explained() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = mbrl(dir.path())
+        .args(["plan", "--env", "pendulum", "--model", "true", "--candidates", "10", "--elites", "50"])
+        .output()
+        .unwrap();
+    assert_one_line_error(&out, &["elites", "10"]);
+    assert!(files_in(dir.path()).is_empty());
+}
+
+fn collected(dir: &std::path::Path) -> Vec<u8> {
+    mbrl(dir)
+        .args(["collect", "--env", "pendulum", "--rollouts", "2", "--steps", "10", "-q", "--out", "ok.mcap"])
+        .assert()
+        .success();
+    std::fs::read(dir.join("ok.mcap")).unwrap()
+}
+
+#[test]
+fn truncated_mcap_is_reported_without_partial_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let bytes = collected(dir.path());
+    std::fs::write(dir.path().join("cut.mcap"), &bytes[..bytes.len() - 40]).unwrap();
+    let out = mbrl(dir.path()).args(["eval", "dataset", "--input", "cut.mcap", "--out", "rep"]).output().unwrap();
+    assert_one_line_error(&out, &["cut.mcap", "truncated or corrupt"]);
+    assert!(!dir.path().join("rep").exists(), "no report for bad input");
+}
+
+#[test]
+fn missing_and_non_mcap_files_are_reported() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = mbrl(dir.path()).args(["eval", "dataset", "--input", "nope.mcap"]).output().unwrap();
+    assert_one_line_error(&out, &["nope.mcap", "No such file"]);
+    std::fs::write(dir.path().join("text.mcap"), "episode,return\n1,2\n").unwrap();
+    let out = mbrl(dir.path()).args(["eval", "dataset", "--input", "text.mcap"]).output().unwrap();
+    assert_one_line_error(&out, &["text.mcap", "MCAP"]);
+}
+
+#[test]
+fn wrong_format_version_is_rejected() {
+    let dir = tempfile::tempdir().unwrap();
+    collected(dir.path());
+    let mut data = mbrl::data::read_dataset(&dir.path().join("ok.mcap")).unwrap();
+    data.meta.format_version = 99;
+    mbrl::data::write_dataset(&dir.path().join("v99.mcap"), &data).unwrap();
+    let out = mbrl(dir.path()).args(["eval", "dataset", "--input", "v99.mcap", "--out", "rep"]).output().unwrap();
+    assert_one_line_error(&out, &["v99.mcap", "format version 99", "version 1"]);
+    assert!(!dir.path().join("rep").exists());
+}
+
+#[test]
+fn watch_of_a_missing_run_is_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = mbrl(dir.path()).args(["watch", "models/none", "--no-tui"]).output().unwrap();
+    assert_one_line_error(&out, &["models/none", "metrics.jsonl"]);
+}
