@@ -2,12 +2,18 @@
 
 use std::path::PathBuf;
 
+use anyhow::bail;
 use clap::{Args, ValueEnum};
+use mbrl::data::boardset::{write_board_set, BoardSet};
 use mbrl::data::collect::{collect_random, CollectSettings};
 use mbrl::data::write_dataset;
-use mbrl::envs::parse_env;
+use mbrl::envs::boards::depth::{DenseIndex, DepthTable};
+use mbrl::envs::boards::sets::board_set;
+use mbrl::envs::boards::{GameSpec, LightsOut, Split, TileSwap};
+use mbrl::envs::{parse_env, EnvName};
 
 use crate::common::{command_line, file_stem, run_job, GlobalArgs};
+use crate::solve_board::SplitChoice;
 
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
 pub enum Policy {
@@ -21,9 +27,11 @@ pub enum Policy {
 Examples:
   mbrl collect --env pendulum --rollouts 500 --steps 30 --out datasets/pendulum.mcap
   mbrl collect --env pendulum:quadrant --rollouts 100 --steps 50 --seed 3
+  mbrl collect --env lightsout --boards --max-depth 5 --split test --out datasets/lightsout-test.mcap
 
 Start states: θ ~ U[-π, π], θ̇ ~ U[-8, 8]; actions ~ U[-2, 2]. Parametrized variants
-(pendulum:quadrant) draw a new instance per rollout; its parameters go into the metadata.")]
+(pendulum:quadrant) draw a new instance per rollout; its parameters go into the metadata.
+Board sets (lightsout 5x5, tileswap) hold every board of depth 1..D with its train/test split.")]
 pub struct CollectArgs {
     /// Environment: pendulum[:light|heavy|mass=<m>|inverted|quadrant].
     #[arg(long)]
@@ -37,13 +45,31 @@ pub struct CollectArgs {
     /// Behaviour policy.
     #[arg(long, value_enum, default_value_t = Policy::Random)]
     policy: Policy,
-    /// Output file (default: datasets/<env>-random.mcap).
+    /// Output file (default: datasets/<env>-random.mcap, or datasets/<game>-boards-d<D>.mcap).
     #[arg(long)]
     out: Option<PathBuf>,
+    /// For board games: write the set of all boards of solution depth 1..=--max-depth with their split.
+    #[arg(long, requires = "max_depth")]
+    boards: bool,
+    /// Deepest solution depth in a board set.
+    #[arg(long, requires = "boards")]
+    max_depth: Option<u8>,
+    /// Only boards of this split.
+    #[arg(long, value_enum, requires = "boards")]
+    split: Option<crate::solve_board::SplitChoice>,
 }
 
 pub fn run(global: &GlobalArgs, args: CollectArgs) -> anyhow::Result<()> {
     let env = parse_env(&args.env)?;
+    if let EnvName::Board(game) = env {
+        if !args.boards {
+            bail!("'{}' is a board game: collect its board sets with --boards --max-depth D", game.name());
+        }
+        return collect_boards(global, game, &args);
+    }
+    if args.boards {
+        bail!("--boards is for board games (lightsout, tileswap), not '{}'", env.canonical());
+    }
     let out =
         args.out.unwrap_or_else(|| PathBuf::from(format!("datasets/{}-random.mcap", file_stem(&env.canonical()))));
     let settings = CollectSettings {
@@ -68,4 +94,62 @@ pub fn run(global: &GlobalArgs, args: CollectArgs) -> anyhow::Result<()> {
         out.display()
     );
     Ok(())
+}
+
+fn collect_boards(global: &GlobalArgs, game: GameSpec, args: &CollectArgs) -> anyhow::Result<()> {
+    let max_depth = args.max_depth.unwrap_or(0);
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(format!("datasets/{}-boards-d{max_depth}.mcap", file_stem(&game.name()))));
+    let split = args.split.map(|s| match s {
+        SplitChoice::Train => Split::Train,
+        SplitChoice::Test => Split::Test,
+    });
+    let set = run_job(global, "collect boards", |monitor| {
+        let boards = match game {
+            GameSpec::LightsOut(n) => records(&LightsOut::new(n)?, max_depth, split, monitor)?,
+            GameSpec::TileSwap => records(&TileSwap::new(), max_depth, split, monitor)?,
+        };
+        let set = BoardSet {
+            game: game.name(),
+            seed: global.seed,
+            command_line: command_line(),
+            mbrl_version: mbrl::VERSION.to_string(),
+            boards,
+        };
+        write_board_set(&out, &set)?;
+        Ok(set)
+    })?;
+    let mut per_depth = vec![0usize; max_depth as usize + 1];
+    for b in &set.boards {
+        per_depth[b.depth as usize] += 1;
+    }
+    let counts: Vec<String> = (1..=max_depth as usize).map(|d| format!("{d}: {}", per_depth[d])).collect();
+    println!(
+        "wrote {} boards of {} to {} (per depth {})",
+        set.boards.len(),
+        set.game,
+        out.display(),
+        counts.join(", ")
+    );
+    Ok(())
+}
+
+fn records<G: DenseIndex>(
+    game: &G,
+    max_depth: u8,
+    split: Option<Split>,
+    monitor: &dyn mbrl::run::Monitor,
+) -> mbrl::Result<Vec<mbrl::envs::boards::sets::BoardRecord>> {
+    monitor.message(&format!("building the depth table of {}", game.name()));
+    let table = DepthTable::build(game)?;
+    if max_depth == 0 || max_depth > table.max_depth() {
+        return Err(mbrl::Error::InvalidInput(format!(
+            "--max-depth must be between 1 and {} for {}",
+            table.max_depth(),
+            game.name()
+        )));
+    }
+    Ok(board_set(game, &table, max_depth, split))
 }

@@ -118,3 +118,15 @@ pub enum ModelChoice {
     /// The simulator's own equations (ground truth).
     True,
 }
+
+/// The pendulum variant an env name denotes; other envs have no continuous MPC task yet.
+pub fn pendulum_variant(name: &str) -> anyhow::Result<mbrl::envs::pendulum::PendulumVariant> {
+    match mbrl::envs::parse_env(name)? {
+        mbrl::envs::EnvName::Pendulum(v) => Ok(v),
+        mbrl::envs::EnvName::Board(g) => anyhow::bail!(
+            "'{}' is a board game: solve it with `mbrl solve-board --game {}`; CEM planning supports pendulum envs",
+            g.name(),
+            g.name()
+        ),
+    }
+}

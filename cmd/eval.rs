@@ -4,14 +4,18 @@ use std::path::PathBuf;
 
 use anyhow::bail;
 use clap::{Args, Subcommand};
+use mbrl::envs::boards::{GameSpec, LightsOut, Split, TileSwap};
+use mbrl::envs::embodiments::Embodiment;
 use mbrl::envs::pendulum::PendulumVariant;
+use mbrl::eval::boards::{self, EmbodiedSettings};
 use mbrl::eval::dataset_report;
 use mbrl::eval::quick::run_quick;
 use mbrl::eval::swingup::{self, SwingupSettings};
 use mbrl::run::dir::Provenance;
 
 use crate::cem_args::CemArgs;
-use crate::common::{command_line, run_job, GlobalArgs, ModelChoice};
+use crate::common::{command_line, pendulum_variant, run_job, GlobalArgs, ModelChoice};
+use crate::solve_board::{EmbodimentChoice, SplitChoice};
 
 /// Run an evaluation protocol and write a report directory (report.md, CSV, PNG).
 #[derive(Args, Debug)]
@@ -19,6 +23,8 @@ use crate::common::{command_line, run_job, GlobalArgs, ModelChoice};
 Examples:
   mbrl eval quick
   mbrl eval dataset --input datasets/pendulum-random.mcap
+  mbrl eval boards
+  mbrl eval embodied --game lightsout --embodiment cursor --max-depth 5 --boards 200
   mbrl eval pendulum-swingup --model true --episodes 10 --out reports/swingup")]
 pub struct EvalArgs {
     #[command(subcommand)]
@@ -35,9 +41,9 @@ enum Protocol {
         out: PathBuf,
     },
     /// Summarise a dataset: rollouts, returns, state ranges, plots.
-    #[command(
-        after_help = "Example:\n  mbrl eval dataset --input datasets/pendulum-random.mcap --out reports/dataset"
-    )]
+    #[command(after_help = "Example:\n  mbrl eval dataset --input datasets/pendulum-random.mcap
+  mbrl eval boards
+  mbrl eval embodied --game lightsout --embodiment cursor --max-depth 5 --boards 200 --out reports/dataset")]
     Dataset {
         /// Dataset file written by `mbrl collect` or `mbrl plan`.
         #[arg(long)]
@@ -46,9 +52,44 @@ enum Protocol {
         #[arg(long, default_value = "reports/dataset")]
         out: PathBuf,
     },
+    /// Depth and train/test split tables of LightsOut 5x5 and TileSwap (thesis Tables 7.1, 7.2).
+    #[command(after_help = "Example:\n  mbrl eval boards --out reports/boards")]
+    Boards {
+        /// Report directory.
+        #[arg(long, default_value = "reports/boards")]
+        out: PathBuf,
+    },
+    /// A manipulator's scripted controller plays optimal plans of boards of depth 1..D.
+    #[command(
+        after_help = "Examples:\n  mbrl eval embodied --game lightsout --embodiment cursor --max-depth 5 --boards 200\n  \
+                            mbrl eval embodied --game tileswap --embodiment reacher --max-depth 5 --boards 100"
+    )]
+    Embodied(EmbodiedArgs),
     /// Pendulum swing-up with MPC: success rate, returns, angle plots.
     #[command(after_help = "Example:\n  mbrl eval pendulum-swingup --model true --episodes 10 --out reports/swingup")]
     PendulumSwingup(SwingupArgs),
+}
+
+#[derive(Args, Debug)]
+struct EmbodiedArgs {
+    /// Game: lightsout (5x5) or tileswap.
+    #[arg(long)]
+    game: String,
+    /// Manipulator.
+    #[arg(long, value_enum)]
+    embodiment: EmbodimentChoice,
+    /// Boards of depth 1..=max-depth are evaluated.
+    #[arg(long, default_value_t = 5)]
+    max_depth: u8,
+    /// Boards drawn per depth (fewer when the split has fewer).
+    #[arg(long, default_value_t = 100)]
+    boards: usize,
+    /// Split the boards come from.
+    #[arg(long, value_enum, default_value_t = SplitChoice::Test)]
+    split: SplitChoice,
+    /// Report directory.
+    #[arg(long, default_value = "reports/embodied")]
+    out: PathBuf,
 }
 
 #[derive(Args, Debug)]
@@ -82,6 +123,51 @@ pub fn run(global: &GlobalArgs, args: EvalArgs) -> anyhow::Result<()> {
             }
             println!("report: {}", out.join("report.md").display());
         }
+        Protocol::Boards { out } => {
+            let rows = run_job(global, "eval boards", |monitor| boards::depth_report(&provenance, &out, monitor))?;
+            println!("game        depth   boards    train     test   thesis");
+            for r in &rows {
+                let thesis = r.thesis.map(|t| t.to_string()).unwrap_or_else(|| "-".into());
+                println!("{:<11} {:>5} {:>8} {:>8} {:>8} {:>8}", r.game, r.depth, r.boards, r.train, r.test, thesis);
+            }
+            println!("report: {}", out.join("report.md").display());
+        }
+        Protocol::Embodied(a) => {
+            let settings = EmbodiedSettings {
+                embodiment: match a.embodiment {
+                    EmbodimentChoice::Cursor => Embodiment::Cursor,
+                    EmbodimentChoice::Reacher => Embodiment::Reacher,
+                },
+                max_depth: a.max_depth,
+                boards_per_depth: a.boards,
+                split: match a.split {
+                    SplitChoice::Train => Split::Train,
+                    SplitChoice::Test => Split::Test,
+                },
+            };
+            if a.max_depth == 0 || a.boards == 0 {
+                bail!("--max-depth and --boards must be at least 1");
+            }
+            let rows = run_job(global, "eval embodied", |monitor| match GameSpec::parse(&a.game)? {
+                GameSpec::LightsOut(n) => {
+                    boards::embodied_report(&LightsOut::new(n)?, &settings, &provenance, &a.out, monitor)
+                }
+                GameSpec::TileSwap => {
+                    boards::embodied_report(&TileSwap::new(), &settings, &provenance, &a.out, monitor)
+                }
+            })?;
+            for r in &rows {
+                println!(
+                    "depth {}: {}/{} solved ({:.1} %), {:.1} control steps per board",
+                    r.depth,
+                    r.solved,
+                    r.boards,
+                    100.0 * r.solved as f64 / r.boards.max(1) as f64,
+                    r.mean_control_steps
+                );
+            }
+            println!("report: {}", a.out.join("report.md").display());
+        }
         Protocol::Dataset { input, out } => {
             let s = run_job(global, "eval dataset", |_| dataset_report::report(&input, &provenance, &out))?;
             println!(
@@ -96,9 +182,7 @@ pub fn run(global: &GlobalArgs, args: EvalArgs) -> anyhow::Result<()> {
         }
         Protocol::PendulumSwingup(a) => {
             let ModelChoice::True = a.model;
-            let variant = match mbrl::envs::parse_env(&a.env)? {
-                mbrl::envs::EnvName::Pendulum(v) => v,
-            };
+            let variant = pendulum_variant(&a.env)?;
             if a.episodes == 0 || a.steps < swingup::SUCCESS_WINDOW {
                 bail!("--episodes must be at least 1 and --steps at least {}", swingup::SUCCESS_WINDOW);
             }

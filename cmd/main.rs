@@ -6,6 +6,7 @@ mod common;
 mod completions;
 mod eval;
 mod plan;
+mod solve_board;
 mod watch;
 
 use clap::{Parser, Subcommand};
@@ -19,6 +20,7 @@ Examples:
   mbrl eval quick                      # small reproduction of every method, report in reports/quick/
   mbrl plan --env pendulum --model true --steps 150
   mbrl collect --env pendulum:heavy --rollouts 10 --steps 30 --out datasets/heavy.mcap
+  mbrl solve-board --game lightsout --random-depth 9 --model true
   mbrl watch reports/quick/pendulum-swingup";
 
 #[derive(Parser)]
@@ -34,6 +36,7 @@ pub struct Cli {
 enum Command {
     Collect(collect::CollectArgs),
     Plan(plan::PlanArgs),
+    SolveBoard(solve_board::SolveBoardArgs),
     Eval(eval::EvalArgs),
     Watch(watch::WatchArgs),
     Completions(completions::CompletionsArgs),
@@ -44,6 +47,7 @@ fn main() {
     let outcome = common::init_threads(&cli.global).and_then(|()| match cli.command {
         Command::Collect(args) => collect::run(&cli.global, args),
         Command::Plan(args) => plan::run(&cli.global, args),
+        Command::SolveBoard(args) => solve_board::run(&cli.global, args),
         Command::Eval(args) => eval::run(&cli.global, args),
         Command::Watch(args) => watch::run(&cli.global, args),
         Command::Completions(args) => completions::run(args),

@@ -5,11 +5,10 @@ use std::path::PathBuf;
 use anyhow::bail;
 use clap::Args;
 use mbrl::data::write_dataset;
-use mbrl::envs::{parse_env, EnvName};
 use mbrl::eval::swingup::{self, SwingupSettings};
 
 use crate::cem_args::CemArgs;
-use crate::common::{command_line, file_stem, run_job, GlobalArgs, ModelChoice};
+use crate::common::{command_line, file_stem, pendulum_variant, run_job, GlobalArgs, ModelChoice};
 
 /// Plan with CEM on a model and execute the plan in the simulator (MPC).
 #[derive(Args, Debug)]
@@ -38,7 +37,7 @@ pub struct PlanArgs {
 }
 
 pub fn run(global: &GlobalArgs, args: PlanArgs) -> anyhow::Result<()> {
-    let EnvName::Pendulum(variant) = parse_env(&args.env)?;
+    let variant = pendulum_variant(&args.env)?;
     if args.steps == 0 {
         bail!("--steps must be at least 1");
     }

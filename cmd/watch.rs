@@ -56,10 +56,13 @@ pub fn run(global: &GlobalArgs, args: WatchArgs) -> anyhow::Result<()> {
     })
 }
 
-/// Last value of each scalar, the latest progress, messages and whether the run finished.
+/// Last value of each scalar, the latest progress, messages, the latest text of each text panel and
+/// whether the run finished.
 fn print_summary(events: &[Event]) -> anyhow::Result<()> {
     let mut last: BTreeMap<&str, (u64, f64, usize)> = BTreeMap::new();
     let mut progress: Vec<(&str, u64, u64)> = Vec::new();
+    // Printed once at the end, not as they come: a board redrawn every step would flood the summary.
+    let mut texts: Vec<(&str, &str)> = Vec::new();
     let mut status = "running (or stopped without finishing)";
     for event in events {
         match event {
@@ -73,6 +76,10 @@ fn print_summary(events: &[Event]) -> anyhow::Result<()> {
                 None => progress.push((phase, *done, *total)),
             },
             Event::Message { text } => println!("{text}"),
+            Event::Text { panel, text } => match texts.iter_mut().find(|t| t.0 == panel) {
+                Some(t) => t.1 = text,
+                None => texts.push((panel, text)),
+            },
             Event::Finished { ok } => status = if *ok { "finished" } else { "failed" },
         }
     }
@@ -81,6 +88,10 @@ fn print_summary(events: &[Event]) -> anyhow::Result<()> {
     }
     for (name, (step, value, count)) in last {
         println!("{name}: {value:.6} at step {step} ({count} points)");
+    }
+    for (panel, text) in texts {
+        println!("== {panel} ==");
+        println!("{}", text.trim_end_matches('\n'));
     }
     println!("status: {status}");
     Ok(())

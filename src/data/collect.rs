@@ -22,7 +22,7 @@ pub fn collect_random(settings: &CollectSettings, monitor: &dyn Monitor) -> Resu
     if settings.rollouts == 0 || settings.steps == 0 {
         return Err(Error::InvalidInput("--rollouts and --steps must be at least 1".into()));
     }
-    let mut env = settings.env.build();
+    let mut env = settings.env.build()?;
     let spec = env.spec();
     let mut instances = Vec::with_capacity(settings.rollouts);
     let mut steps = Vec::with_capacity(settings.rollouts * settings.steps);
@@ -55,7 +55,7 @@ pub fn collect_random(settings: &CollectSettings, monitor: &dyn Monitor) -> Resu
             mbrl_version: crate::VERSION.to_string(),
             command_line: settings.command_line.clone(),
             instances,
-            state_names: spec.state_names.iter().map(|s| s.to_string()).collect(),
+            state_names: spec.state_names.clone(),
             action_dim: spec.action_dim(),
             dt: spec.dt,
         },

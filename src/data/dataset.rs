@@ -6,15 +6,14 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
+use super::mcap_io::{check_version, read_messages, write_messages, Layout};
 use super::rollout::Timestep;
 use super::schema::{TIMESTEP_SCHEMA, TIMESTEP_SCHEMA_NAME, TIMESTEP_TOPIC};
 use crate::error::{Error, Result};
-use crate::run::atomic::write_atomic_seekable;
 
 /// Version of the on-disk layout; readers reject any other.
 pub const FORMAT_VERSION: u32 = 1;
 pub const METADATA_NAME: &str = "mbrl.dataset";
-const PROFILE: &str = "mbrl";
 
 /// What the metadata record says about a dataset.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -61,16 +60,7 @@ impl DatasetMeta {
         };
         let parse_err =
             |key: &str, expected: &str| Error::bad_file(path, format!("metadata field '{key}': expected {expected}"));
-        let version: u32 = field("format_version")?.parse().map_err(|_| parse_err("format_version", "an integer"))?;
-        if version != FORMAT_VERSION {
-            return Err(Error::bad_file(
-                path,
-                format!(
-                    "dataset format version {version} is not supported (this mbrl {} reads version {FORMAT_VERSION})",
-                    crate::VERSION
-                ),
-            ));
-        }
+        let version = check_version(path, record, FORMAT_VERSION)?;
         Ok(DatasetMeta {
             format_version: version,
             env: field("env")?.clone(),
@@ -90,71 +80,28 @@ fn to_json<T: Serialize>(value: &T) -> String {
     serde_json::to_string(value).unwrap_or_else(|_| "null".into())
 }
 
-fn mcap_err(path: &Path, e: mcap::McapError) -> Error {
-    Error::bad_file(path, format!("MCAP write failed: {e}"))
+fn layout(meta: &DatasetMeta) -> Layout<'static> {
+    Layout {
+        metadata_name: METADATA_NAME,
+        topic: TIMESTEP_TOPIC,
+        schema_name: TIMESTEP_SCHEMA_NAME,
+        schema: TIMESTEP_SCHEMA,
+        // Rollouts are laid end to end on the log clock so viewers play them one after another.
+        tick_ns: (meta.dt * 1e9).round().max(1.0) as u64,
+    }
 }
 
 /// Writes the dataset atomically: the file appears complete or not at all.
 pub fn write_dataset(path: &Path, dataset: &Dataset) -> Result<()> {
-    write_atomic_seekable(path, |file| {
-        let options = mcap::WriteOptions::new()
-            .compression(Some(mcap::Compression::Zstd))
-            .profile(PROFILE)
-            .library(format!("mbrl {}", crate::VERSION));
-        let mut writer = options.create(std::io::BufWriter::new(file)).map_err(|e| mcap_err(path, e))?;
-        writer
-            .write_metadata(&mcap::records::Metadata {
-                name: METADATA_NAME.to_string(),
-                metadata: dataset.meta.to_record(),
-            })
-            .map_err(|e| mcap_err(path, e))?;
-        let schema = writer
-            .add_schema(TIMESTEP_SCHEMA_NAME, "jsonschema", TIMESTEP_SCHEMA.as_bytes())
-            .map_err(|e| mcap_err(path, e))?;
-        let channel =
-            writer.add_channel(schema, TIMESTEP_TOPIC, "json", &BTreeMap::new()).map_err(|e| mcap_err(path, e))?;
-        let dt_ns = (dataset.meta.dt * 1e9).round().max(1.0) as u64;
-        let mut clock = 0u64;
-        for (sequence, step) in dataset.steps.iter().enumerate() {
-            // Rollouts are laid end to end on the log clock so viewers play them one after another.
-            clock += dt_ns;
-            let data = serde_json::to_vec(step).map_err(|e| Error::bad_file(path, e.to_string()))?;
-            let header = mcap::records::MessageHeader {
-                channel_id: channel,
-                sequence: sequence as u32,
-                log_time: clock,
-                publish_time: clock,
-            };
-            writer.write_to_known_channel(&header, &data).map_err(|e| mcap_err(path, e))?;
-        }
-        writer.finish().map_err(|e| mcap_err(path, e))?;
-        Ok(())
-    })
+    write_messages(path, &layout(&dataset.meta), dataset.meta.to_record(), &dataset.steps)
 }
 
 pub fn read_dataset(path: &Path) -> Result<Dataset> {
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-    let corrupt =
-        |e: mcap::McapError| Error::bad_file(path, format!("not a readable MCAP dataset (truncated or corrupt?): {e}"));
-    let mut meta = None;
-    for record in mcap::read::LinearReader::new(&bytes).map_err(corrupt)? {
-        if let mcap::records::Record::Metadata(m) = record.map_err(corrupt)? {
-            if m.name == METADATA_NAME {
-                meta = Some(DatasetMeta::from_record(path, &m.metadata)?);
-            }
-        }
-    }
-    let meta = meta
-        .ok_or_else(|| Error::bad_file(path, format!("no '{METADATA_NAME}' metadata record; not an mbrl dataset")))?;
-    let mut steps = Vec::new();
-    for message in mcap::MessageStream::new(&bytes).map_err(corrupt)? {
-        let message = message.map_err(corrupt)?;
-        if message.channel.topic != TIMESTEP_TOPIC {
-            continue;
-        }
-        let step: Timestep = serde_json::from_slice(&message.data)
-            .map_err(|e| Error::bad_file(path, format!("message {} on {TIMESTEP_TOPIC}: {e}", message.sequence)))?;
-        validate_step(path, &meta, &step, message.sequence)?;
+    let (record, messages) = read_messages::<Timestep>(path, METADATA_NAME, TIMESTEP_TOPIC)?;
+    let meta = DatasetMeta::from_record(path, &record)?;
+    let mut steps = Vec::with_capacity(messages.len());
+    for (sequence, step) in messages {
+        validate_step(path, &meta, &step, sequence)?;
         steps.push(step);
     }
     Ok(Dataset { meta, steps })

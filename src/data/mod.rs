@@ -1,7 +1,9 @@
 //! Rollouts and datasets on disk.
 
+pub mod boardset;
 pub mod collect;
 pub mod dataset;
+pub mod mcap_io;
 pub mod rollout;
 pub mod schema;
 

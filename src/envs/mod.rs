@@ -1,6 +1,8 @@
 //! Simulators. Every environment is an [`Env`] for stepping one instance, and exposes its ground-truth
 //! dynamics as a pure [`Dynamics`] so planners can use the simulator itself as a reference model.
 
+pub mod boards;
+pub mod embodiments;
 pub mod pendulum;
 pub mod registry;
 
@@ -13,8 +15,8 @@ pub use registry::{parse_env, EnvName};
 #[derive(Clone, Debug, PartialEq)]
 pub struct EnvSpec {
     pub name: String,
-    pub state_names: Vec<&'static str>,
-    pub obs_names: Vec<&'static str>,
+    pub state_names: Vec<String>,
+    pub obs_names: Vec<String>,
     pub action_low: Vec<f64>,
     pub action_high: Vec<f64>,
     /// Simulated seconds per `step`.
@@ -51,8 +53,8 @@ pub trait Env {
     fn params(&self) -> serde_json::Value;
     /// For parametrized families: draw new hidden parameters. Fixed environments keep theirs.
     fn sample_instance(&mut self, _rng: &mut ChaCha8Rng) {}
-    /// The pure dynamics of this instance, for planners.
-    fn dynamics(&self) -> Box<dyn Dynamics>;
+    /// The pure dynamics of this instance, for continuous planners; `None` where planning is symbolic.
+    fn dynamics(&self) -> Option<Box<dyn Dynamics>>;
 }
 
 /// What a planner rolls out. Pure: the same state and action always give the same result.

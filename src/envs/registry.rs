@@ -1,34 +1,48 @@
 //! Turns an environment name from the command line (`family[:variant]`) into a simulator.
 
+use super::boards::spec::GAME_HELP;
+use super::boards::GameSpec;
 use super::pendulum::{Pendulum, PendulumVariant};
 use super::Env;
 use crate::error::{Error, Result};
 
-pub const KNOWN_ENVS: &str = "pendulum[:light|heavy|mass=<m>|inverted|quadrant]";
+pub const KNOWN_ENVS: &str = "pendulum[:light|heavy|mass=<m>|inverted|quadrant], lightsout[:<n>x<n>], tileswap";
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum EnvName {
     Pendulum(PendulumVariant),
+    /// A board game on its own: board sets and symbolic planning, no simulator to step.
+    Board(GameSpec),
 }
 
 pub fn parse_env(name: &str) -> Result<EnvName> {
     let (family, variant) = name.split_once(':').unwrap_or((name, ""));
     match family {
         "pendulum" => Ok(EnvName::Pendulum(PendulumVariant::parse(variant)?)),
+        "lightsout" | "tileswap" => Ok(EnvName::Board(GameSpec::parse(name)?)),
         _ => Err(Error::InvalidInput(format!("unknown env '{name}'; supported: {KNOWN_ENVS}"))),
     }
 }
 
 impl EnvName {
-    pub fn build(&self) -> Box<dyn Env> {
+    /// The simulator for this name. Board games alone have none: they are played symbolically
+    /// (`solve-board`) or collected as board sets (`collect --boards`).
+    pub fn build(&self) -> Result<Box<dyn Env>> {
         match self {
-            EnvName::Pendulum(v) => Box::new(Pendulum::new(v.clone())),
+            EnvName::Pendulum(v) => Ok(Box::new(Pendulum::new(v.clone()))),
+            EnvName::Board(g) => Err(Error::InvalidInput(format!(
+                "'{}' is a board game, not a simulator to roll out; use `mbrl collect --env {} --boards --max-depth D` \
+                 for board sets (games: {GAME_HELP})",
+                g.name(),
+                g.name()
+            ))),
         }
     }
 
     pub fn canonical(&self) -> String {
         match self {
             EnvName::Pendulum(v) => v.env_name(),
+            EnvName::Board(g) => g.name(),
         }
     }
 }
@@ -45,7 +59,16 @@ mod tests {
 
     #[test]
     fn variant_round_trips_through_canonical_name() {
-        for name in ["pendulum", "pendulum:light", "pendulum:heavy", "pendulum:inverted", "pendulum:quadrant"] {
+        for name in [
+            "pendulum",
+            "pendulum:light",
+            "pendulum:heavy",
+            "pendulum:inverted",
+            "pendulum:quadrant",
+            "lightsout",
+            "lightsout:7x7",
+            "tileswap",
+        ] {
             assert_eq!(parse_env(name).unwrap().canonical(), name);
         }
     }

@@ -89,12 +89,12 @@ pub fn run_episode(
     let mut rng = rng_for(seed, &[episode, 0]);
     env.sample_instance(&mut rng);
     env.reset(&mut rng);
-    let model = env.dynamics();
+    let model = env.pendulum_dynamics();
     let mut cem = Cem::new(settings.cem.clone(), derive_seed(seed, &[episode, 1]))?;
     let phase = format!("episode {} MPC", episode + 1);
     let rollout = run_mpc_episode(
         &mut env,
-        model.as_ref(),
+        &model,
         &mut cem,
         settings.steps,
         monitor,
@@ -131,7 +131,7 @@ pub fn episodes_dataset(
             mbrl_version: crate::VERSION.to_string(),
             command_line: command_line.to_string(),
             instances: episodes.iter().map(|e| e.instance.clone()).collect(),
-            state_names: spec.state_names.iter().map(|s| s.to_string()).collect(),
+            state_names: spec.state_names.clone(),
             action_dim: spec.action_dim(),
             dt: spec.dt,
         },

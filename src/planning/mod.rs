@@ -1,10 +1,12 @@
 //! Planners. A planner optimizes an [`Objective`] over action sequences and knows nothing of the model
 //! behind it.
 
+pub mod bfs;
 pub mod cem;
 pub mod colored_noise;
 pub mod mpc;
 pub mod seeding;
+pub mod solve_board;
 
 pub use cem::{Cem, CemConfig, CemIteration, NoiseKind};
 

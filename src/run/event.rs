@@ -15,6 +15,8 @@ pub enum Event {
     Progress { phase: String, done: u64, total: u64 },
     /// A human-readable note (a result line, a warning).
     Message { text: String },
+    /// A block of preformatted text for a method panel (a board, a plan), replacing that panel's previous text.
+    Text { panel: String, text: String },
     /// The job ended; `ok` is false when it failed.
     Finished { ok: bool },
 }
@@ -43,5 +45,46 @@ impl Event {
 
     pub fn message(text: impl Into<String>) -> Self {
         Event::Message { text: text.into() }
+    }
+
+    pub fn text(panel: impl Into<String>, text: impl Into<String>) -> Self {
+        Event::Text { panel: panel.into(), text: text.into() }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn text_round_trips_through_json() {
+        let event = Event::text("board", "■ · ■\n· ■ ·\nplan: push (0, 1)\n");
+        let line = serde_json::to_string(&event).expect("serialize");
+        assert!(line.starts_with(r#"{"kind":"text","panel":"board","#), "{line}");
+        assert_eq!(serde_json::from_str::<Event>(&line).expect("deserialize"), event);
+    }
+
+    #[test]
+    fn every_kind_round_trips_through_json() {
+        let events = [
+            Event::Layout {
+                title: "t".into(),
+                panels: vec![PanelSpec {
+                    title: "p".into(),
+                    x_label: "x".into(),
+                    series: vec!["a".into()],
+                    restart_on_rewind: true,
+                }],
+            },
+            Event::scalar("loss", 3, 0.5),
+            Event::progress("train", 1, 2),
+            Event::message("hello"),
+            Event::text("plan", ""),
+            Event::Finished { ok: true },
+        ];
+        for event in events {
+            let line = serde_json::to_string(&event).expect("serialize");
+            assert_eq!(serde_json::from_str::<Event>(&line).expect("deserialize"), event, "{line}");
+        }
     }
 }

@@ -9,7 +9,8 @@ use crossterm::event::KeyEvent;
 use super::keys::{action_for, Action};
 use super::panel::Panel;
 use super::series::Series;
-use crate::run::monitor::format_progress;
+use super::text_panel::{TextPanel, TextPanels};
+use crate::run::monitor::{PhaseProgress, PhaseTracker};
 use crate::run::{Event, PanelSpec};
 
 /// Messages kept for the Messages panel; only the newest few fit on screen anyway.
@@ -24,47 +25,19 @@ pub(crate) enum Status {
     Ended,
 }
 
-/// The current phase. Both instants come from ingestion so that rate and ETA are a function of the
-/// events alone, which keeps rendering deterministic under `ingest_at`.
-#[derive(Clone, Debug)]
-pub(crate) struct Progress {
-    phase: String,
-    done: u64,
-    total: u64,
-    started: Instant,
-    updated: Instant,
-}
-
-impl Progress {
-    pub(crate) fn ratio(&self) -> f64 {
-        if self.total == 0 {
-            return 0.0;
-        }
-        (self.done as f64 / self.total as f64).clamp(0.0, 1.0)
-    }
-
-    /// `phase: done/total (pct) rate/s, ETA`, the same line the console prints.
-    pub(crate) fn summary(&self) -> String {
-        let elapsed = self.updated.duration_since(self.started).as_secs_f64();
-        format_progress(&self.phase, self.done, self.total, elapsed)
-    }
-
-    /// A counter going backwards means the phase was restarted, so its rate must be measured afresh.
-    fn continues(&self, phase: &str, done: u64) -> bool {
-        self.phase == phase && done >= self.done
-    }
-}
-
 /// Everything the live view shows, built from events and keys alone.
 pub struct App {
     title: String,
     status: Status,
-    progress: Option<Progress>,
+    /// Every phase on its own clock, so interleaved phases do not reset each other's rate.
+    progress: PhaseTracker,
     /// Every metric's full (capped) history; a BTreeMap so metric order is by name, stable across runs.
     history: BTreeMap<String, Series>,
     /// Tracked by name, not index, so metrics appearing later do not move the user's selection.
     selected: Option<String>,
     panels: Vec<Panel>,
+    /// Kept apart from `panels`: text arrives under any name, with no `Layout` announcing it.
+    texts: TextPanels,
     messages: VecDeque<String>,
 }
 
@@ -73,10 +46,11 @@ impl App {
         App {
             title: title.to_string(),
             status: Status::Running,
-            progress: None,
+            progress: PhaseTracker::default(),
             history: BTreeMap::new(),
             selected: None,
             panels: Vec::new(),
+            texts: TextPanels::default(),
             messages: VecDeque::new(),
         }
     }
@@ -91,6 +65,7 @@ impl App {
             Event::Scalar { name, step, value } => self.record_scalar(name, *step, *value),
             Event::Progress { phase, done, total } => self.update_progress(phase, *done, *total, now),
             Event::Message { text } => self.push_message(text),
+            Event::Text { panel, text } => self.texts.set(panel, text),
             Event::Finished { ok } => self.status = if *ok { Status::Done } else { Status::Failed },
         }
     }
@@ -134,8 +109,9 @@ impl App {
         self.status
     }
 
-    pub(crate) fn progress(&self) -> Option<&Progress> {
-        self.progress.as_ref()
+    /// The `count` most recently updated phases, in order of first appearance.
+    pub(crate) fn progress(&self, count: usize) -> Vec<&PhaseProgress> {
+        self.progress.recent(count)
     }
 
     /// The selected metric's name, its history, and its 1-based position among all metrics.
@@ -153,6 +129,11 @@ impl App {
         &self.panels
     }
 
+    /// Text panels in order of first appearance, each with its latest text.
+    pub(crate) fn text_panels(&self) -> &[TextPanel] {
+        self.texts.as_slice()
+    }
+
     /// Messages, oldest first.
     pub(crate) fn messages(&self) -> impl DoubleEndedIterator<Item = &str> + ExactSizeIterator {
         self.messages.iter().map(String::as_str)
@@ -166,7 +147,7 @@ impl App {
     }
 
     fn record_scalar(&mut self, name: &str, step: u64, value: f64) {
-        self.history.entry(name.to_string()).or_default().push(step, value);
+        self.history.entry(name.to_string()).or_insert_with(Series::indexed_on_rewind).push(step, value);
         for panel in &mut self.panels {
             panel.record(name, step, value);
         }
@@ -176,11 +157,7 @@ impl App {
     }
 
     fn update_progress(&mut self, phase: &str, done: u64, total: u64, now: Instant) {
-        let started = match &self.progress {
-            Some(p) if p.continues(phase, done) => p.started,
-            _ => now,
-        };
-        self.progress = Some(Progress { phase: phase.to_string(), done, total, started, updated: now });
+        self.progress.update(phase, done, total, now);
     }
 
     fn push_message(&mut self, text: &str) {
@@ -299,32 +276,77 @@ mod tests {
         assert_eq!(app.panels()[0].spec().title, "pendulum");
     }
 
+    fn summaries(app: &App) -> Vec<String> {
+        app.progress(3).iter().map(|p| p.summary()).collect()
+    }
+
     #[test]
     fn progress_rate_is_measured_from_the_phase_start() {
         let mut app = App::new("t");
         let t0 = Instant::now();
         app.ingest_at(&Event::progress("train", 0, 150), t0);
         app.ingest_at(&Event::progress("train", 50, 150), t0 + Duration::from_secs(10));
-        let progress = app.progress().expect("progress");
-        assert_eq!(progress.summary(), "train: 50/150 (33%) 5.0/s, ETA 20s");
-        assert!((progress.ratio() - 1.0 / 3.0).abs() < 1e-12);
+        let progress = app.progress(3);
+        assert_eq!(progress.len(), 1);
+        assert_eq!(progress[0].summary(), "train: 50/150 (33%) 5.0/s, ETA 20s");
+        assert!((progress[0].ratio() - 1.0 / 3.0).abs() < 1e-12);
 
-        // A new phase, or the same one counting again from zero, restarts the clock.
+        // A new phase has no rate yet; the same one counting again from zero restarts its clock.
         app.ingest_at(&Event::progress("eval", 10, 20), t0 + Duration::from_secs(20));
-        assert_eq!(app.progress().expect("progress").summary(), "eval: 10/20 (50%) 0.0/s");
+        assert_eq!(summaries(&app)[1], "eval: 10/20 (50%)");
         app.ingest_at(&Event::progress("eval", 20, 20), t0 + Duration::from_secs(30));
         app.ingest_at(&Event::progress("eval", 4, 20), t0 + Duration::from_secs(40));
         app.ingest_at(&Event::progress("eval", 8, 20), t0 + Duration::from_secs(42));
-        assert_eq!(app.progress().expect("progress").summary(), "eval: 8/20 (40%) 4.0/s, ETA 3s");
+        assert_eq!(summaries(&app), vec!["train: 50/150 (33%) 5.0/s, ETA 20s", "eval: 8/20 (40%) 4.0/s, ETA 3s"]);
+    }
+
+    #[test]
+    fn interleaved_phases_keep_separate_rates() {
+        // The shape of `mbrl eval pendulum-swingup --episodes 3`: an outer count of episodes around an
+        // inner count of MPC steps, one inner phase per episode.
+        let mut app = App::new("t");
+        let t0 = Instant::now();
+        let at = |ms: u64| t0 + Duration::from_millis(ms);
+        for episode in 0..3u64 {
+            app.ingest_at(&Event::progress("episodes", episode, 3), at(3000 * episode));
+            for t in 0..150 {
+                let phase = format!("episode {} MPC", episode + 1);
+                app.ingest_at(&Event::progress(phase, t + 1, 150), at(3000 * episode + 20 * t));
+            }
+        }
+        app.ingest_at(&Event::progress("episodes", 3, 3), at(9000));
+        assert_eq!(
+            summaries(&app),
+            vec![
+                "episodes: 3/3 (100%) 0.3/s",
+                "episode 2 MPC: 150/150 (100%) 50.3/s",
+                "episode 3 MPC: 150/150 (100%) 50.3/s"
+            ]
+        );
     }
 
     #[test]
     fn progress_ratio_handles_zero_and_overshoot() {
         let mut app = App::new("t");
         app.ingest(&Event::progress("p", 3, 0));
-        assert_eq!(app.progress().expect("progress").ratio(), 0.0);
+        assert_eq!(app.progress(3)[0].ratio(), 0.0);
         app.ingest(&Event::progress("p", 30, 10));
-        assert_eq!(app.progress().expect("progress").ratio(), 1.0);
+        assert_eq!(app.progress(3)[0].ratio(), 1.0);
+    }
+
+    #[test]
+    fn rewinding_history_is_plotted_against_a_monotone_sample_index() {
+        let mut app = App::new("t");
+        for _ in 0..4 {
+            for iteration in 0..10 {
+                app.ingest(&Event::scalar("cem/best_cost", iteration, 100.0 - iteration as f64));
+            }
+        }
+        let (_, history, _) = app.selected_series().expect("cost is selected");
+        let xs: Vec<f64> = history.points().iter().map(|p| p.0).collect();
+        assert_eq!(xs.len(), 40);
+        assert!(xs.windows(2).all(|w| w[0] < w[1]), "x must increase strictly: {xs:?}");
+        assert_eq!(history.x_label(), "sample");
     }
 
     #[test]
@@ -336,6 +358,19 @@ mod tests {
         assert_eq!(app.messages().len(), MESSAGE_CAP);
         assert_eq!(app.messages().next(), Some("m5"));
         assert_eq!(app.messages().last(), Some(format!("m{}", MESSAGE_CAP + 4).as_str()));
+    }
+
+    #[test]
+    fn text_events_fill_panels_in_order_of_first_appearance() {
+        let mut app = App::new("t");
+        app.ingest(&Event::text("board", "■ ·"));
+        app.ingest(&Event::text("plan", "push (0, 1)"));
+        app.ingest(&Event::text("board", "· ■"));
+        app.ingest(&pendulum_layout());
+        let texts: Vec<(&str, &str)> = app.text_panels().iter().map(|p| (p.name.as_str(), p.text.as_str())).collect();
+        assert_eq!(texts, vec![("board", "· ■"), ("plan", "push (0, 1)")], "a layout keeps the text panels");
+        assert_eq!(app.panels().len(), 1);
+        assert!(app.metric_names().is_empty());
     }
 
     #[test]

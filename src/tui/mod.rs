@@ -4,11 +4,13 @@
 
 pub mod app;
 mod keys;
+mod method;
 mod panel;
 mod plot;
 pub mod render;
 mod series;
 pub mod terminal;
+mod text_panel;
 
 pub use app::App;
 pub use terminal::{run_live, LiveOutcome};

@@ -1,5 +1,5 @@
-//! Drawing an [`App`] into a frame. Layout, top to bottom: a status line, the progress gauge, the
-//! curves (the selected metric beside the method panels) and the latest messages.
+//! Drawing an [`App`] into a frame. Layout, top to bottom: a status line, the progress gauges, the
+//! curves (the selected metric beside the method panels: charts, then text) and the latest messages.
 
 use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::style::{Color, Modifier, Style};
@@ -8,16 +8,22 @@ use ratatui::widgets::{Block, Gauge, Paragraph};
 use ratatui::Frame;
 
 use super::app::{App, Status};
+use super::method::{method_rows, stack};
 use super::panel::Panel;
 use super::plot::{color, format_value, line_chart, short_names, Trace};
+use super::text_panel::TextPanel;
+use crate::run::monitor::PhaseProgress;
 
 /// Messages shown at most; the panel collapses when there are none.
 const MAX_MESSAGE_ROWS: usize = 5;
 
+/// Progress phases shown at most: enough for a job's episodes, the steps inside one, and the phase before.
+const MAX_PHASE_ROWS: usize = 3;
+
 pub fn render(app: &App, frame: &mut Frame) {
     let [header, progress, body, messages] = Layout::vertical([
         Constraint::Length(1),
-        Constraint::Length(3),
+        Constraint::Length(progress_height(app, frame.area().height)),
         Constraint::Min(0),
         // Max, not Length: on a short terminal the messages give way before the progress gauge does.
         Constraint::Max(messages_height(app)),
@@ -51,31 +57,60 @@ fn status_label(status: Status) -> (&'static str, Color) {
     }
 }
 
+/// The phases shown: the most recently updated ones, up to [`MAX_PHASE_ROWS`]. A short terminal shows
+/// fewer (one row more for every two rows past 18) so that the curves keep room.
+fn shown_phases(app: &App, screen_height: u16) -> Vec<&PhaseProgress> {
+    let fit = 1 + usize::from(screen_height.saturating_sub(18) / 2);
+    app.progress(fit.min(MAX_PHASE_ROWS))
+}
+
+/// One row per shown phase (one for the placeholder) inside a border.
+fn progress_height(app: &App, screen_height: u16) -> u16 {
+    shown_phases(app, screen_height).len().max(1) as u16 + 2
+}
+
 fn render_progress(app: &App, frame: &mut Frame, area: Rect) {
     let block = Block::bordered().title(" Progress ");
-    let Some(progress) = app.progress() else {
+    let phases = shown_phases(app, frame.area().height);
+    if phases.is_empty() {
         let waiting = Paragraph::new("waiting for progress…").style(Style::default().fg(Color::DarkGray));
         frame.render_widget(waiting.block(block), area);
         return;
-    };
-    let gauge = Gauge::default()
-        .block(block)
-        .ratio(progress.ratio())
-        .label(progress.summary())
-        .gauge_style(Style::default().fg(Color::Cyan).bg(Color::Black));
-    frame.render_widget(gauge, area);
+    }
+    let inner = block.inner(area);
+    frame.render_widget(block, area);
+    let rows = Layout::vertical(vec![Constraint::Length(1); phases.len()]).split(inner);
+    for (phase, row) in phases.iter().zip(rows.iter()) {
+        let gauge = Gauge::default()
+            .ratio(phase.ratio())
+            .label(phase.summary())
+            .gauge_style(Style::default().fg(Color::Cyan).bg(Color::Black));
+        frame.render_widget(gauge, *row);
+    }
 }
 
 fn render_body(app: &App, frame: &mut Frame, area: Rect) {
-    if app.panels().is_empty() {
+    if app.panels().is_empty() && app.text_panels().is_empty() {
         render_curves(app, frame, area);
         return;
     }
-    let [curves, panels] = Layout::horizontal([Constraint::Percentage(50); 2]).areas(area);
+    let [curves, method] = Layout::horizontal([Constraint::Percentage(50); 2]).areas(area);
     render_curves(app, frame, curves);
-    let rows = Layout::vertical(vec![Constraint::Fill(1); app.panels().len()]).split(panels);
-    for (panel, row) in app.panels().iter().zip(rows.iter()) {
+    render_method(app, frame, method);
+}
+
+/// The chart panels, then the text panels sized to their text.
+fn render_method(app: &App, frame: &mut Frame, area: Rect) {
+    let text_rows: Vec<u16> =
+        app.text_panels().iter().map(|p| u16::try_from(p.line_count() + 2).unwrap_or(u16::MAX)).collect();
+    let heights = method_rows(app.panels().len(), &text_rows, area.height);
+    let rows = stack(area, &heights);
+    let (chart_rows, text_rows) = rows.split_at(app.panels().len());
+    for (panel, row) in app.panels().iter().zip(chart_rows) {
         render_panel(panel, frame, *row);
+    }
+    for (panel, row) in app.text_panels().iter().zip(text_rows) {
+        render_text_panel(panel, frame, *row);
     }
 }
 
@@ -88,7 +123,7 @@ fn render_curves(app: &App, frame: &mut Frame, area: Rect) {
     let last = series.last_value().map_or_else(|| "-".to_string(), format_value);
     let title = format!(" {name} = {last}  ({position}/{}) ", app.metric_count());
     let trace = Trace { name: name.to_string(), points: series.points(), color: Color::Cyan };
-    frame.render_widget(line_chart(vec![trace], "step", Block::bordered().title(title)), area);
+    frame.render_widget(line_chart(vec![trace], series.x_label(), Block::bordered().title(title)), area);
 }
 
 fn render_panel(panel: &Panel, frame: &mut Frame, area: Rect) {
@@ -102,6 +137,13 @@ fn render_panel(panel: &Panel, frame: &mut Frame, area: Rect) {
     let spec = panel.spec();
     let block = Block::bordered().title(format!(" {} ", spec.title));
     frame.render_widget(line_chart(traces, &spec.x_label, block), area);
+}
+
+/// The text verbatim. No wrapping: a wrapped row would break a board's grid, so long lines are cut at
+/// the border instead, and lines beyond the panel's height are left out.
+fn render_text_panel(panel: &TextPanel, frame: &mut Frame, area: Rect) {
+    let block = Block::bordered().title(format!(" {} ", panel.name));
+    frame.render_widget(Paragraph::new(panel.text.as_str()).block(block), area);
 }
 
 fn messages_height(app: &App) -> u16 {
@@ -242,14 +284,173 @@ mod tests {
         assert!(draw(&app, 60, 20).contains("diverged = NaN"));
     }
 
+    /// `mbrl eval pendulum-swingup --episodes 3`, stopped in the middle of the second episode: progress
+    /// of the episodes around progress of each episode's MPC steps, and CEM's iteration counting 0..9
+    /// again for every MPC step.
+    fn swingup_app() -> App {
+        let mut app = App::new("swing-up");
+        let t0 = Instant::now();
+        let at = |ms: u64| t0 + Duration::from_millis(ms);
+        for episode in 0..2u64 {
+            app.ingest_at(&Event::progress("episodes", episode, 3), at(3000 * episode));
+            let steps = if episode == 0 { 150 } else { 75 };
+            for t in 0..steps {
+                for iteration in 0..10 {
+                    let cost = 100.0 - iteration as f64 - t as f64 * 0.1;
+                    app.ingest_at(&Event::scalar("cem/best_cost", iteration, cost), at(3000 * episode + 20 * t));
+                }
+                let phase = format!("episode {} MPC", episode + 1);
+                app.ingest_at(&Event::progress(phase, t + 1, 150), at(3000 * episode + 20 * t));
+            }
+        }
+        app
+    }
+
+    #[test]
+    fn progress_lists_the_recent_phases_with_their_own_rates() {
+        let screen = draw(&swingup_app(), 100, 30);
+        let rows: Vec<&str> = screen.lines().collect();
+        let row_of = |text: &str| rows.iter().position(|row| row.contains(text));
+        let outer = row_of("episodes: 1/3 (33%) 0.3/s, ETA 6s").unwrap_or_else(|| panic!("{screen}"));
+        let done = row_of("episode 1 MPC: 150/150 (100%) 50.3/s").unwrap_or_else(|| panic!("{screen}"));
+        let current = row_of("episode 2 MPC: 75/150 (50%) 50.7/s, ETA 1s").unwrap_or_else(|| panic!("{screen}"));
+        assert_eq!((done, current), (outer + 1, outer + 2), "one gauge a row, in order of appearance:\n{screen}");
+        assert!(!screen.contains("0.0/s"), "{screen}");
+    }
+
+    #[test]
+    fn short_terminals_show_only_the_latest_phase() {
+        let screen = draw(&swingup_app(), 100, 18);
+        assert!(screen.contains("episode 2 MPC: 75/150"), "{screen}");
+        assert!(!screen.contains("episodes:"), "{screen}");
+        let screen = draw(&swingup_app(), 100, 20);
+        assert!(screen.contains("episodes: 1/3") && screen.contains("episode 2 MPC"), "{screen}");
+        assert!(!screen.contains("episode 1 MPC"), "{screen}");
+    }
+
+    #[test]
+    fn a_rewinding_metric_is_drawn_against_the_sample_index() {
+        let app = swingup_app();
+        let (_, history, _) = app.selected_series().expect("cost is selected");
+        assert_eq!(history.points().len(), 2250);
+        assert!(history.points().windows(2).all(|w| w[0].0 < w[1].0));
+        let screen = draw(&app, 100, 30);
+        assert!(screen.contains("sample"), "{screen}");
+        assert!(screen.contains("2249"), "x runs over every sample:\n{screen}");
+        assert!(!screen.contains("step"), "{screen}");
+
+        let screen = draw(&pendulum_app(), 100, 30);
+        assert!(screen.contains("step") && !screen.contains("sample"), "{screen}");
+    }
+
+    const BOARD: &str = "■ · · · ■\n· ■ · · ·\n· · ■ · ·\n· · · ■ ·\n■ · · · ■";
+
+    /// Row and column (in cells) where `text` first appears.
+    fn find(screen: &str, text: &str) -> Option<(usize, usize)> {
+        screen
+            .lines()
+            .enumerate()
+            .find_map(|(row, line)| line.find(text).map(|byte| (row, line[..byte].chars().count())))
+    }
+
+    fn cell(screen: &str, row: usize, col: usize) -> Option<char> {
+        screen.lines().nth(row)?.chars().nth(col)
+    }
+
+    /// `mbrl solve-board` with its board and plan, optionally beside a chart panel.
+    fn board_app(with_chart: bool) -> App {
+        let mut app = if with_chart { pendulum_app() } else { App::new("solve-board") };
+        app.ingest(&Event::text("board", BOARD));
+        app.ingest(&Event::text("plan", "plan: push (0, 1)"));
+        app
+    }
+
+    /// Asserts the panel titled `title` holds `lines` verbatim, one a row, and fits them exactly: its
+    /// bottom border follows the last line. Returns the rows of its top and bottom borders.
+    fn assert_fitted_panel(screen: &str, title: &str, lines: &[&str]) -> (usize, usize) {
+        let (top, left) = find(screen, &format!("┌ {title} ")).unwrap_or_else(|| panic!("no {title}:\n{screen}"));
+        for (i, line) in lines.iter().enumerate() {
+            let row = screen.lines().nth(top + 1 + i).unwrap_or_else(|| panic!("no row for {line:?}:\n{screen}"));
+            let shown: String = row.chars().skip(left + 1).take(line.chars().count()).collect();
+            assert_eq!(shown, *line, "line {i} of {title} misplaced:\n{screen}");
+        }
+        let bottom = top + 1 + lines.len();
+        assert_eq!(cell(screen, bottom, left), Some('└'), "{title} must end below its text:\n{screen}");
+        (top, bottom)
+    }
+
+    #[test]
+    fn text_panels_show_board_and_plan_verbatim_below_the_charts() {
+        let screen = draw(&board_app(true), 100, 40);
+        let board: Vec<&str> = BOARD.lines().collect();
+        let (board_top, board_bottom) = assert_fitted_panel(&screen, "board", &board);
+        let (plan_top, _) = assert_fitted_panel(&screen, "plan", &["plan: push (0, 1)"]);
+        assert_eq!(plan_top, board_bottom + 1, "text panels in order of first appearance:\n{screen}");
+        let (chart_top, _) = find(&screen, "┌ pendulum ").unwrap_or_else(|| panic!("{screen}"));
+        assert!(chart_top < board_top, "charts come first:\n{screen}");
+        assert!(board_top - chart_top > 10, "the chart takes the rows the text does not need:\n{screen}");
+        assert!(screen.contains("cem/best_cost = "), "{screen}");
+    }
+
+    #[test]
+    fn later_text_replaces_the_panel_text() {
+        let mut app = board_app(true);
+        app.ingest(&Event::text("plan", "plan: pull (4, 4)\nthen: done"));
+        let screen = draw(&app, 100, 40);
+        assert!(!screen.contains("push (0, 1)"), "{screen}");
+        assert_fitted_panel(&screen, "plan", &["plan: pull (4, 4)", "then: done"]);
+        assert_eq!(screen.matches("┌ plan ").count(), 1, "{screen}");
+    }
+
+    #[test]
+    fn without_chart_panels_text_panels_use_the_whole_method_area() {
+        let screen = draw(&board_app(false), 80, 24);
+        assert!(screen.contains("no metrics yet"), "the curves keep their half:\n{screen}");
+        let (_, board_bottom) = assert_fitted_panel(&screen, "board", &BOARD.lines().collect::<Vec<_>>());
+        let (plan_top, left) = find(&screen, "┌ plan ").unwrap_or_else(|| panic!("{screen}"));
+        assert_eq!(plan_top, board_bottom + 1, "{screen}");
+        assert_eq!(cell(&screen, 23, left), Some('└'), "the last panel reaches the bottom:\n{screen}");
+        assert!(left >= 30, "text panels sit in the method half:\n{screen}");
+    }
+
+    #[test]
+    fn long_lines_are_cut_not_wrapped() {
+        let mut app = App::new("t");
+        app.ingest(&Event::text("wide", format!("{}END\nnext row", "■".repeat(60))));
+        let screen = draw(&app, 60, 20);
+        assert!(!screen.contains("END"), "{screen}");
+        let (row, col) = find(&screen, "■■■■").unwrap_or_else(|| panic!("{screen}"));
+        assert_eq!(find(&screen, "next row"), Some((row + 1, col)), "{screen}");
+        assert_eq!(cell(&screen, row, 58), Some('■'), "the line runs to the border:\n{screen}");
+    }
+
+    #[test]
+    fn a_tall_text_leaves_the_charts_room() {
+        let mut app = pendulum_app();
+        app.ingest(&Event::text("plan", (0..100).map(|i| format!("step {i}")).collect::<Vec<_>>().join("\n")));
+        let screen = draw(&app, 100, 30);
+        let (chart_top, _) = find(&screen, "┌ pendulum ").unwrap_or_else(|| panic!("{screen}"));
+        let (plan_top, _) = find(&screen, "┌ plan ").unwrap_or_else(|| panic!("{screen}"));
+        assert!(plan_top >= chart_top + 6, "{screen}");
+        assert!(screen.contains("step 0") && !screen.contains("step 99"), "{screen}");
+    }
+
     #[test]
     fn tiny_terminals_do_not_panic() {
         let mut app = pendulum_app();
         app.ingest(&Event::message("a message that is far wider than the terminal"));
+        let swingup = swingup_app();
+        let mut texts = board_app(true);
+        for k in 0..20 {
+            texts.ingest(&Event::text(format!("panel {k}"), "■ ·\n".repeat(k)));
+        }
         for width in 0..=24 {
-            for height in 0..=8 {
+            for height in 0..=24 {
                 draw(&app, width, height);
+                draw(&swingup, width, height);
                 draw(&App::new("empty"), width, height);
+                draw(&board_app(false), width, height);
+                draw(&texts, width, height);
             }
         }
         assert!(draw(&app, 20, 5).contains("cem on"));

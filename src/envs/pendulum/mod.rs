@@ -44,6 +44,10 @@ impl Pendulum {
         &self.params
     }
 
+    pub fn pendulum_dynamics(&self) -> PendulumDynamics {
+        PendulumDynamics { params: self.params.clone() }
+    }
+
     pub fn set_params(&mut self, params: PendulumParams) {
         self.params = params;
     }
@@ -53,8 +57,8 @@ impl Env for Pendulum {
     fn spec(&self) -> EnvSpec {
         EnvSpec {
             name: self.variant.env_name(),
-            state_names: vec!["theta", "theta_dot"],
-            obs_names: vec!["cos_theta", "sin_theta", "theta_dot"],
+            state_names: vec!["theta".into(), "theta_dot".into()],
+            obs_names: vec!["cos_theta".into(), "sin_theta".into(), "theta_dot".into()],
             action_low: vec![-self.params.max_torque],
             action_high: vec![self.params.max_torque],
             dt: self.params.dt * self.params.action_repeat as f64,
@@ -98,7 +102,7 @@ impl Env for Pendulum {
         self.params = self.variant.sample_params(rng);
     }
 
-    fn dynamics(&self) -> Box<dyn Dynamics> {
-        Box::new(PendulumDynamics { params: self.params.clone() })
+    fn dynamics(&self) -> Option<Box<dyn Dynamics>> {
+        Some(Box::new(self.pendulum_dynamics()))
     }
 }

@@ -1,0 +1,119 @@
+//! The MCAP container shared by every mbrl file: one metadata record, one JSON channel with a JSON Schema,
+//! zstd chunks, written atomically.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use serde::de::DeserializeOwned;
+use serde::Serialize;
+
+use crate::error::{Error, Result};
+use crate::run::atomic::write_atomic_seekable;
+
+const PROFILE: &str = "mbrl";
+
+/// What a file holds besides its messages.
+pub struct Layout<'a> {
+    pub metadata_name: &'a str,
+    pub topic: &'a str,
+    pub schema_name: &'a str,
+    pub schema: &'a str,
+    /// Log-clock nanoseconds between messages (viewers play messages back on this clock).
+    pub tick_ns: u64,
+}
+
+fn mcap_err(path: &Path, e: mcap::McapError) -> Error {
+    Error::bad_file(path, format!("MCAP write failed: {e}"))
+}
+
+pub fn write_messages<T: Serialize>(
+    path: &Path,
+    layout: &Layout,
+    metadata: BTreeMap<String, String>,
+    messages: &[T],
+) -> Result<()> {
+    write_atomic_seekable(path, |file| {
+        let options = mcap::WriteOptions::new()
+            .compression(Some(mcap::Compression::Zstd))
+            .profile(PROFILE)
+            .library(format!("mbrl {}", crate::VERSION));
+        let mut writer = options.create(std::io::BufWriter::new(file)).map_err(|e| mcap_err(path, e))?;
+        writer
+            .write_metadata(&mcap::records::Metadata { name: layout.metadata_name.to_string(), metadata })
+            .map_err(|e| mcap_err(path, e))?;
+        let schema = writer
+            .add_schema(layout.schema_name, "jsonschema", layout.schema.as_bytes())
+            .map_err(|e| mcap_err(path, e))?;
+        let channel =
+            writer.add_channel(schema, layout.topic, "json", &BTreeMap::new()).map_err(|e| mcap_err(path, e))?;
+        for (sequence, message) in messages.iter().enumerate() {
+            let clock = (sequence as u64 + 1) * layout.tick_ns.max(1);
+            let data = serde_json::to_vec(message).map_err(|e| Error::bad_file(path, e.to_string()))?;
+            let header = mcap::records::MessageHeader {
+                channel_id: channel,
+                sequence: sequence as u32,
+                log_time: clock,
+                publish_time: clock,
+            };
+            writer.write_to_known_channel(&header, &data).map_err(|e| mcap_err(path, e))?;
+        }
+        writer.finish().map_err(|e| mcap_err(path, e))?;
+        Ok(())
+    })
+}
+
+/// The named metadata record and the decoded messages of `topic`, each with its sequence number.
+pub fn read_messages<T: DeserializeOwned>(
+    path: &Path,
+    metadata_name: &str,
+    topic: &str,
+) -> Result<(BTreeMap<String, String>, Vec<(u32, T)>)> {
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let corrupt =
+        |e: mcap::McapError| Error::bad_file(path, format!("not a readable MCAP file (truncated or corrupt?): {e}"));
+    let mut metadata = None;
+    let mut other_names = Vec::new();
+    for record in mcap::read::LinearReader::new(&bytes).map_err(corrupt)? {
+        if let mcap::records::Record::Metadata(m) = record.map_err(corrupt)? {
+            if m.name == metadata_name {
+                metadata = Some(m.metadata);
+            } else {
+                other_names.push(m.name);
+            }
+        }
+    }
+    let metadata = metadata.ok_or_else(|| {
+        let found = if other_names.is_empty() { "none".to_string() } else { other_names.join(", ") };
+        Error::bad_file(path, format!("expected a '{metadata_name}' metadata record, found {found}"))
+    })?;
+    let mut messages = Vec::new();
+    for message in mcap::MessageStream::new(&bytes).map_err(corrupt)? {
+        let message = message.map_err(corrupt)?;
+        if message.channel.topic != topic {
+            continue;
+        }
+        let value: T = serde_json::from_slice(&message.data)
+            .map_err(|e| Error::bad_file(path, format!("message {} on {topic}: {e}", message.sequence)))?;
+        messages.push((message.sequence, value));
+    }
+    Ok((metadata, messages))
+}
+
+/// Reads the `format_version` field and rejects versions this build does not know.
+pub fn check_version(path: &Path, metadata: &BTreeMap<String, String>, supported: u32) -> Result<u32> {
+    let version: u32 = metadata
+        .get("format_version")
+        .ok_or_else(|| Error::bad_file(path, "metadata lacks the field 'format_version'"))?
+        .parse()
+        .map_err(|_| Error::bad_file(path, "metadata field 'format_version': expected an integer"))?;
+    if version != supported {
+        return Err(Error::bad_file(
+            path,
+            format!(
+                "format version {version} is not supported (this mbrl {} reads version {supported})",
+                crate::VERSION
+            ),
+        ));
+    }
+    Ok(version)
+}

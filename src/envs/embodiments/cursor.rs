@@ -1,0 +1,121 @@
+//! Cursor (thesis D.1.1): a point on the board moved by bounded steps, pushing where it stands.
+
+use rand::Rng;
+use rand_chacha::ChaCha8Rng;
+
+use super::manipulator::{BoardPoint, Manipulator, ScriptedController};
+
+/// Largest move per step along each axis.
+pub const MAX_STEP: f64 = 0.2;
+/// A push happens when the third action component exceeds this.
+pub const PUSH_THRESHOLD: f64 = 0.6;
+pub const SKILL_STEP_LIMIT: usize = 10;
+
+#[derive(Clone, Debug, Default)]
+pub struct Cursor {
+    position: BoardPoint,
+}
+
+impl Cursor {
+    pub fn new() -> Self {
+        Cursor { position: [0.5, 0.5] }
+    }
+}
+
+impl Manipulator for Cursor {
+    fn name(&self) -> &'static str {
+        "cursor"
+    }
+
+    fn action_low(&self) -> Vec<f64> {
+        vec![-MAX_STEP, -MAX_STEP, -1.0]
+    }
+
+    fn action_high(&self) -> Vec<f64> {
+        vec![MAX_STEP, MAX_STEP, 1.0]
+    }
+
+    fn obs_names(&self) -> Vec<&'static str> {
+        vec!["cursor_x", "cursor_y"]
+    }
+
+    fn observe(&self) -> Vec<f64> {
+        self.position.to_vec()
+    }
+
+    fn state(&self) -> Vec<f64> {
+        self.position.to_vec()
+    }
+
+    fn set_state(&mut self, state: &[f64]) {
+        self.position = [state[0].clamp(0.0, 1.0), state[1].clamp(0.0, 1.0)];
+    }
+
+    fn reset(&mut self, rng: &mut ChaCha8Rng) {
+        self.position = [rng.random_range(0.0..1.0), rng.random_range(0.0..1.0)];
+    }
+
+    /// The move is applied (and clipped to the board) before the push is checked, as in the original.
+    fn step(&mut self, action: &[f64]) -> Option<BoardPoint> {
+        for axis in 0..2 {
+            let delta = action[axis].clamp(-MAX_STEP, MAX_STEP);
+            self.position[axis] = (self.position[axis] + delta).clamp(0.0, 1.0);
+        }
+        (action[2] > PUSH_THRESHOLD).then_some(self.position)
+    }
+
+    fn effector(&self) -> BoardPoint {
+        self.position
+    }
+
+    fn skill_step_limit(&self) -> usize {
+        SKILL_STEP_LIMIT
+    }
+
+    fn dt(&self) -> f64 {
+        1.0
+    }
+}
+
+/// Moves straight towards the target at full speed and pushes on arrival.
+#[derive(Clone, Debug, Default)]
+pub struct CursorController;
+
+impl ScriptedController for CursorController {
+    fn act(&mut self, manipulator: &dyn Manipulator, target: BoardPoint) -> Vec<f64> {
+        let here = manipulator.effector();
+        let delta = [target[0] - here[0], target[1] - here[1]];
+        let arrives = delta.iter().all(|d| d.abs() <= MAX_STEP);
+        vec![delta[0].clamp(-MAX_STEP, MAX_STEP), delta[1].clamp(-MAX_STEP, MAX_STEP), if arrives { 1.0 } else { -1.0 }]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn moves_are_clipped_and_push_after_moving() {
+        let mut c = Cursor::new();
+        c.set_state(&[0.9, 0.1]);
+        assert_eq!(c.step(&[0.5, -0.5, 0.0]), None);
+        assert_eq!(c.effector(), [1.0, 0.0], "clipped to ±0.2 and to the board");
+        assert_eq!(c.step(&[-0.1, 0.1, 0.61]), Some([0.9, 0.1]));
+        assert_eq!(c.step(&[0.0, 0.0, 0.6]), None, "threshold is strict");
+    }
+
+    #[test]
+    fn controller_reaches_any_target_within_the_skill_limit() {
+        let mut c = Cursor::new();
+        let mut ctrl = CursorController;
+        for (start, target) in [([0.0, 0.0], [0.9, 0.9]), ([0.5, 0.5], [0.5, 0.5]), ([1.0, 0.0], [0.1, 0.7])] {
+            c.set_state(&start);
+            let pushed = (0..SKILL_STEP_LIMIT).find_map(|_| {
+                let a = ctrl.act(&c, target);
+                c.step(&a)
+            });
+            let p = pushed.expect("pushes within the limit");
+            assert!((p[0] - target[0]).abs() < 1e-12 && (p[1] - target[1]).abs() < 1e-12);
+        }
+    }
+}

@@ -1,0 +1,39 @@
+//! Manipulators that play the board games physically (thesis 7.4, appendix D.1): the state is the
+//! manipulator's state followed by the symbolic board.
+
+pub mod cursor;
+pub mod embodied;
+pub mod manipulator;
+pub mod reacher;
+
+pub use manipulator::{BoardPoint, Manipulator, ScriptedController};
+
+use crate::error::{Error, Result};
+
+pub const EMBODIMENT_HELP: &str = "cursor, reacher";
+
+/// The manipulators a user can name.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Embodiment {
+    Cursor,
+    Reacher,
+}
+
+impl Embodiment {
+    pub fn parse(name: &str) -> Result<Self> {
+        match name {
+            "cursor" => Ok(Embodiment::Cursor),
+            "reacher" => Ok(Embodiment::Reacher),
+            other => Err(Error::InvalidInput(format!("unknown embodiment '{other}'; supported: {EMBODIMENT_HELP}"))),
+        }
+    }
+
+    /// The manipulator and its scripted controller.
+    pub fn build(self) -> (Box<dyn Manipulator>, Box<dyn ScriptedController>) {
+        match self {
+            Embodiment::Cursor => (Box::new(cursor::Cursor::new()), Box::new(cursor::CursorController)),
+            Embodiment::Reacher => (Box::new(reacher::Reacher::new()), Box::new(reacher::ReacherController::new())),
+        }
+    }
+}
