@@ -31,11 +31,20 @@ _mbrl() {
             mbrl,plan)
                 cmd="mbrl__subcmd__plan"
                 ;;
+            mbrl,solve-board)
+                cmd="mbrl__subcmd__solve__subcmd__board"
+                ;;
             mbrl,watch)
                 cmd="mbrl__subcmd__watch"
                 ;;
+            mbrl__subcmd__eval,boards)
+                cmd="mbrl__subcmd__eval__subcmd__boards"
+                ;;
             mbrl__subcmd__eval,dataset)
                 cmd="mbrl__subcmd__eval__subcmd__dataset"
+                ;;
+            mbrl__subcmd__eval,embodied)
+                cmd="mbrl__subcmd__eval__subcmd__embodied"
                 ;;
             mbrl__subcmd__eval,help)
                 cmd="mbrl__subcmd__eval__subcmd__help"
@@ -46,8 +55,14 @@ _mbrl() {
             mbrl__subcmd__eval,quick)
                 cmd="mbrl__subcmd__eval__subcmd__quick"
                 ;;
+            mbrl__subcmd__eval__subcmd__help,boards)
+                cmd="mbrl__subcmd__eval__subcmd__help__subcmd__boards"
+                ;;
             mbrl__subcmd__eval__subcmd__help,dataset)
                 cmd="mbrl__subcmd__eval__subcmd__help__subcmd__dataset"
+                ;;
+            mbrl__subcmd__eval__subcmd__help,embodied)
+                cmd="mbrl__subcmd__eval__subcmd__help__subcmd__embodied"
                 ;;
             mbrl__subcmd__eval__subcmd__help,help)
                 cmd="mbrl__subcmd__eval__subcmd__help__subcmd__help"
@@ -73,11 +88,20 @@ _mbrl() {
             mbrl__subcmd__help,plan)
                 cmd="mbrl__subcmd__help__subcmd__plan"
                 ;;
+            mbrl__subcmd__help,solve-board)
+                cmd="mbrl__subcmd__help__subcmd__solve__subcmd__board"
+                ;;
             mbrl__subcmd__help,watch)
                 cmd="mbrl__subcmd__help__subcmd__watch"
                 ;;
+            mbrl__subcmd__help__subcmd__eval,boards)
+                cmd="mbrl__subcmd__help__subcmd__eval__subcmd__boards"
+                ;;
             mbrl__subcmd__help__subcmd__eval,dataset)
                 cmd="mbrl__subcmd__help__subcmd__eval__subcmd__dataset"
+                ;;
+            mbrl__subcmd__help__subcmd__eval,embodied)
+                cmd="mbrl__subcmd__help__subcmd__eval__subcmd__embodied"
                 ;;
             mbrl__subcmd__help__subcmd__eval,pendulum-swingup)
                 cmd="mbrl__subcmd__help__subcmd__eval__subcmd__pendulum__subcmd__swingup"
@@ -92,7 +116,7 @@ _mbrl() {
 
     case "${cmd}" in
         mbrl)
-            opts="-q -h -V --seed --threads --tui --no-tui --quiet --help --version collect plan eval watch completions help"
+            opts="-q -h -V --seed --threads --tui --no-tui --quiet --help --version collect plan solve-board eval watch completions help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 1 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -114,7 +138,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__collect)
-            opts="-q -h -V --env --rollouts --steps --policy --out --seed --threads --tui --no-tui --quiet --help --version"
+            opts="-q -h -V --env --rollouts --steps --policy --out --boards --max-depth --split --seed --threads --tui --no-tui --quiet --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -138,6 +162,14 @@ _mbrl() {
                     ;;
                 --out)
                     COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --max-depth)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --split)
+                    COMPREPLY=($(compgen -W "train test" -- "${cur}"))
                     return 0
                     ;;
                 --seed)
@@ -178,12 +210,38 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval)
-            opts="-q -h -V --seed --threads --tui --no-tui --quiet --help --version quick dataset pendulum-swingup help"
+            opts="-q -h -V --seed --threads --tui --no-tui --quiet --help --version quick dataset boards embodied pendulum-swingup help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
             fi
             case "${prev}" in
+                --seed)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mbrl__subcmd__eval__subcmd__boards)
+            opts="-q -h -V --out --seed --threads --tui --no-tui --quiet --help --version"
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                --out)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 --seed)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
@@ -229,8 +287,54 @@ _mbrl() {
             COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
             return 0
             ;;
+        mbrl__subcmd__eval__subcmd__embodied)
+            opts="-q -h -V --game --embodiment --max-depth --boards --split --out --seed --threads --tui --no-tui --quiet --help --version"
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                --game)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --embodiment)
+                    COMPREPLY=($(compgen -W "cursor reacher" -- "${cur}"))
+                    return 0
+                    ;;
+                --max-depth)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --boards)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --split)
+                    COMPREPLY=($(compgen -W "train test" -- "${cur}"))
+                    return 0
+                    ;;
+                --out)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --seed)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
         mbrl__subcmd__eval__subcmd__help)
-            opts="quick dataset pendulum-swingup help"
+            opts="quick dataset boards embodied pendulum-swingup help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -243,7 +347,35 @@ _mbrl() {
             COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
             return 0
             ;;
+        mbrl__subcmd__eval__subcmd__help__subcmd__boards)
+            opts=""
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 4 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
         mbrl__subcmd__eval__subcmd__help__subcmd__dataset)
+            opts=""
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 4 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mbrl__subcmd__eval__subcmd__help__subcmd__embodied)
             opts=""
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 4 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
@@ -392,7 +524,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__help)
-            opts="collect plan eval watch completions help"
+            opts="collect plan solve-board eval watch completions help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -434,7 +566,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__help__subcmd__eval)
-            opts="quick dataset pendulum-swingup"
+            opts="quick dataset boards embodied pendulum-swingup"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -447,7 +579,35 @@ _mbrl() {
             COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
             return 0
             ;;
+        mbrl__subcmd__help__subcmd__eval__subcmd__boards)
+            opts=""
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 4 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
         mbrl__subcmd__help__subcmd__eval__subcmd__dataset)
+            opts=""
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 4 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mbrl__subcmd__help__subcmd__eval__subcmd__embodied)
             opts=""
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 4 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
@@ -504,6 +664,20 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__help__subcmd__plan)
+            opts=""
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mbrl__subcmd__help__subcmd__solve__subcmd__board)
             opts=""
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
@@ -575,6 +749,68 @@ _mbrl() {
                     return 0
                     ;;
                 --out)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --seed)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mbrl__subcmd__solve__subcmd__board)
+            opts="-q -h -V --game --board --random-depth --split --model --embodiment --search --max-depth --max-nodes --max-memory-mib --seed --threads --tui --no-tui --quiet --help --version"
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                --game)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --board)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --random-depth)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --split)
+                    COMPREPLY=($(compgen -W "train test" -- "${cur}"))
+                    return 0
+                    ;;
+                --model)
+                    COMPREPLY=($(compgen -W "true" -- "${cur}"))
+                    return 0
+                    ;;
+                --embodiment)
+                    COMPREPLY=($(compgen -W "cursor reacher" -- "${cur}"))
+                    return 0
+                    ;;
+                --search)
+                    COMPREPLY=($(compgen -W "bidirectional bfs" -- "${cur}"))
+                    return 0
+                    ;;
+                --max-depth)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --max-nodes)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --max-memory-mib)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;

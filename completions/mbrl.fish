@@ -33,6 +33,7 @@ complete -c mbrl -n "__fish_mbrl_needs_command" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_needs_command" -s V -l version -d 'Print version'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "collect" -d 'Collect rollouts from a simulator into an MCAP dataset'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "plan" -d 'Plan with CEM on a model and execute the plan in the simulator (MPC)'
+complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "solve-board" -d 'Find a shortest solution of a LightsOut or TileSwap board and optionally play it with a manipulator'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "eval" -d 'Run an evaluation protocol and write a report directory (report.md, CSV, PNG)'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "watch" -d 'Follow a running or finished run (training or eval) in the live view'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "completions" -d 'Print a shell completion script'
@@ -41,9 +42,13 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l env -d 'Environmen
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l rollouts -d 'Number of rollouts' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l steps -d 'Steps per rollout' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l policy -d 'Behaviour policy' -r -f -a "random\t'Uniformly random actions within the action bounds'"
-complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l out -d 'Output file (default: datasets/<env>-random.mcap)' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l out -d 'Output file (default: datasets/<env>-random.mcap, or datasets/<game>-boards-d<D>.mcap)' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l max-depth -d 'Deepest solution depth in a board set' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l split -d 'Only boards of this split' -r -f -a "train\t''
+test\t''"
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l threads -d 'Worker threads (0 = one per core)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l boards -d 'For board games: write the set of all boards of solution depth 1..=--max-depth with their split'
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -s q -l quiet -d 'Print only results and errors'
@@ -68,17 +73,39 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l no-tui -d 'Print plai
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -s V -l version -d 'Print version'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset pendulum-swingup help" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset pendulum-swingup help" -l threads -d 'Worker threads (0 = one per core)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset pendulum-swingup help" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset pendulum-swingup help" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset pendulum-swingup help" -s q -l quiet -d 'Print only results and errors'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset pendulum-swingup help" -s h -l help -d 'Print help'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset pendulum-swingup help" -s V -l version -d 'Print version'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset pendulum-swingup help" -f -a "quick" -d 'Small reproduction of every implemented method (about a minute)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset pendulum-swingup help" -f -a "dataset" -d 'Summarise a dataset: rollouts, returns, state ranges, plots'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset pendulum-swingup help" -f -a "pendulum-swingup" -d 'Pendulum swing-up with MPC: success rate, returns, angle plots'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset pendulum-swingup help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l game -d 'Game: lightsout (5x5), lightsout:<n>x<n> (n = 2..13), tileswap' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l board -d 'The board to solve' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l random-depth -d 'Draw a random board whose shortest solution has this many moves (5x5 LightsOut, TileSwap)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l split -d 'Draw the random board from this split only (thesis appendix D.1.4)' -r -f -a "train\t''
+test\t''"
+complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l model -d 'Successor model used by the search' -r -f -a "true\t'The simulator\'s own equations (ground truth)'"
+complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l embodiment -d 'Play the plan with this manipulator\'s scripted controller' -r -f -a "cursor\t'A point moved by steps of at most 0.2, pushing where it stands (10 steps per move)'
+reacher\t'A torque-driven two-link arm over a 0.3 m board (50 steps per move)'"
+complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l search -d 'Search algorithm' -r -f -a "bidirectional\t'From both ends (moves undo themselves); far fewer states'
+bfs\t'From the start only, as the thesis\' planner'"
+complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l max-depth -d 'Longest plan searched for' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l max-nodes -d 'Give up after storing this many states' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l max-memory-mib -d 'Give up when the search needs more memory than this (MiB)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l threads -d 'Worker threads (0 = one per core)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -s q -l quiet -d 'Print only results and errors'
+complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -s h -l help -d 'Print help (see more with \'--help\')'
+complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -s V -l version -d 'Print version'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied pendulum-swingup help" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied pendulum-swingup help" -l threads -d 'Worker threads (0 = one per core)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied pendulum-swingup help" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied pendulum-swingup help" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied pendulum-swingup help" -s q -l quiet -d 'Print only results and errors'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied pendulum-swingup help" -s h -l help -d 'Print help'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied pendulum-swingup help" -s V -l version -d 'Print version'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied pendulum-swingup help" -f -a "quick" -d 'Small reproduction of every implemented method (about a minute)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied pendulum-swingup help" -f -a "dataset" -d 'Summarise a dataset: rollouts, returns, state ranges, plots'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied pendulum-swingup help" -f -a "boards" -d 'Depth and train/test split tables of LightsOut 5x5 and TileSwap (thesis Tables 7.1, 7.2)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied pendulum-swingup help" -f -a "embodied" -d 'A manipulator\'s scripted controller plays optimal plans of boards of depth 1..D'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied pendulum-swingup help" -f -a "pendulum-swingup" -d 'Pendulum swing-up with MPC: success rate, returns, angle plots'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied pendulum-swingup help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from quick" -l out -d 'Report directory' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from quick" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from quick" -l threads -d 'Worker threads (0 = one per core)' -r
@@ -96,6 +123,29 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dataset" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dataset" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dataset" -s V -l version -d 'Print version'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from boards" -l out -d 'Report directory' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from boards" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from boards" -l threads -d 'Worker threads (0 = one per core)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from boards" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from boards" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from boards" -s q -l quiet -d 'Print only results and errors'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from boards" -s h -l help -d 'Print help'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from boards" -s V -l version -d 'Print version'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l game -d 'Game: lightsout (5x5) or tileswap' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l embodiment -d 'Manipulator' -r -f -a "cursor\t'A point moved by steps of at most 0.2, pushing where it stands (10 steps per move)'
+reacher\t'A torque-driven two-link arm over a 0.3 m board (50 steps per move)'"
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l max-depth -d 'Boards of depth 1..=max-depth are evaluated' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l boards -d 'Boards drawn per depth (fewer when the split has fewer)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l split -d 'Split the boards come from' -r -f -a "train\t''
+test\t''"
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l out -d 'Report directory' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l threads -d 'Worker threads (0 = one per core)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -s q -l quiet -d 'Print only results and errors'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -s h -l help -d 'Print help (see more with \'--help\')'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -s V -l version -d 'Print version'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l model -d 'Dynamics model the planner uses' -r -f -a "true\t'The simulator\'s own equations (ground truth)'"
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l episodes -d 'Number of episodes (each with its own start state)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l env -d 'Environment variant: pendulum[:light|heavy|mass=<m>|inverted|quadrant]' -r
@@ -118,6 +168,8 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -s V -l version -d 'Print version'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from help" -f -a "quick" -d 'Small reproduction of every implemented method (about a minute)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from help" -f -a "dataset" -d 'Summarise a dataset: rollouts, returns, state ranges, plots'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from help" -f -a "boards" -d 'Depth and train/test split tables of LightsOut 5x5 and TileSwap (thesis Tables 7.1, 7.2)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from help" -f -a "embodied" -d 'A manipulator\'s scripted controller plays optimal plans of boards of depth 1..D'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from help" -f -a "pendulum-swingup" -d 'Pendulum swing-up with MPC: success rate, returns, angle plots'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
@@ -134,12 +186,15 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -l no-tui -d 'Pri
 complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -s V -l version -d 'Print version'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan eval watch completions help" -f -a "collect" -d 'Collect rollouts from a simulator into an MCAP dataset'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan eval watch completions help" -f -a "plan" -d 'Plan with CEM on a model and execute the plan in the simulator (MPC)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan eval watch completions help" -f -a "eval" -d 'Run an evaluation protocol and write a report directory (report.md, CSV, PNG)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan eval watch completions help" -f -a "watch" -d 'Follow a running or finished run (training or eval) in the live view'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan eval watch completions help" -f -a "completions" -d 'Print a shell completion script'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan eval watch completions help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan solve-board eval watch completions help" -f -a "collect" -d 'Collect rollouts from a simulator into an MCAP dataset'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan solve-board eval watch completions help" -f -a "plan" -d 'Plan with CEM on a model and execute the plan in the simulator (MPC)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan solve-board eval watch completions help" -f -a "solve-board" -d 'Find a shortest solution of a LightsOut or TileSwap board and optionally play it with a manipulator'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan solve-board eval watch completions help" -f -a "eval" -d 'Run an evaluation protocol and write a report directory (report.md, CSV, PNG)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan solve-board eval watch completions help" -f -a "watch" -d 'Follow a running or finished run (training or eval) in the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan solve-board eval watch completions help" -f -a "completions" -d 'Print a shell completion script'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan solve-board eval watch completions help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from eval" -f -a "quick" -d 'Small reproduction of every implemented method (about a minute)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from eval" -f -a "dataset" -d 'Summarise a dataset: rollouts, returns, state ranges, plots'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from eval" -f -a "boards" -d 'Depth and train/test split tables of LightsOut 5x5 and TileSwap (thesis Tables 7.1, 7.2)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from eval" -f -a "embodied" -d 'A manipulator\'s scripted controller plays optimal plans of boards of depth 1..D'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from eval" -f -a "pendulum-swingup" -d 'Pendulum swing-up with MPC: success rate, returns, angle plots'

@@ -12,6 +12,9 @@ const SUBCOMMANDS: &[&[&str]] = &[
     &["eval", "quick"],
     &["eval", "dataset"],
     &["eval", "pendulum-swingup"],
+    &["eval", "boards"],
+    &["eval", "embodied"],
+    &["solve-board"],
     &["watch"],
     &["completions"],
 ];

@@ -95,13 +95,19 @@ impl<G: BoardGame> EmbodiedBoard<G> {
 
 impl<G: BoardGame> Env for EmbodiedBoard<G> {
     fn spec(&self) -> EnvSpec {
-        let mut names: Vec<String> = self.manipulator.obs_names().iter().map(|s| s.to_string()).collect();
-        names.extend((0..self.game.symbolic(self.board).len()).map(|i| format!("board_{i}")));
-        names.push("remaining_time".into());
+        let name = self.manipulator.name();
+        let board: Vec<String> = (0..self.game.symbolic(self.board).len()).map(|i| format!("board_{i}")).collect();
+        let with_board_and_time = |mut names: Vec<String>| {
+            names.extend(board.iter().cloned());
+            names.push("remaining_time".into());
+            names
+        };
         EnvSpec {
-            name: format!("{}:{}", self.game.name(), self.manipulator.name()),
-            state_names: names.clone(),
-            obs_names: names,
+            name: format!("{}:{name}", self.game.name()),
+            state_names: with_board_and_time(
+                (0..self.manipulator.state().len()).map(|i| format!("{name}_q{i}")).collect(),
+            ),
+            obs_names: with_board_and_time(self.manipulator.obs_names().iter().map(|s| s.to_string()).collect()),
             action_low: self.manipulator.action_low(),
             action_high: self.manipulator.action_high(),
             dt: self.manipulator.dt(),

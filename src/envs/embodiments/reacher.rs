@@ -842,4 +842,30 @@ mod tests {
         }
         assert!(failures.is_empty(), "{} failures: {:?}", failures.len(), &failures[..failures.len().min(5)]);
     }
+
+    /// The real games through [`EmbodiedBoard`](crate::envs::embodiments::embodied::EmbodiedBoard): every
+    /// move, one after another without resetting the arm, performs exactly that move.
+    #[test]
+    fn executes_every_move_of_the_real_games() {
+        use crate::envs::boards::{BoardGame, LightsOut, TileSwap};
+        use crate::envs::embodiments::embodied::EmbodiedBoard;
+        use crate::envs::Env;
+
+        fn check<G: BoardGame>(game: G) {
+            let mut env = EmbodiedBoard::new(game.clone(), Box::new(Reacher::new()), game.goal());
+            let mut ctrl = ReacherController::new();
+            let mut rng = ChaCha8Rng::seed_from_u64(21);
+            for round in 0..4 {
+                env.reset(&mut rng);
+                for mv in 0..game.num_moves() {
+                    let before = env.board();
+                    let out = env.execute(&mut ctrl, mv);
+                    assert_eq!(out.performed, Some(mv), "{} move {mv}, round {round}", game.name());
+                    assert_eq!(env.board(), game.apply(before, mv));
+                }
+            }
+        }
+        check(LightsOut::new(5).unwrap());
+        check(TileSwap::new());
+    }
 }
