@@ -4,7 +4,7 @@
 MBRL := target/release/mbrl
 SEED ?= 0
 
-.PHONY: build test bench completions repro-quick repro-swingup repro-pendulum-data clean-reports
+.PHONY: build test bench completions repro-quick repro-swingup repro-pendulum-data repro-boards clean-reports
 
 build:
 	cargo build --release
@@ -32,6 +32,16 @@ repro-pendulum-data: build
 		$(MBRL) collect --env $$env --rollouts 500 --steps 30 --seed $(SEED) --no-tui \
 			--out datasets/$$(echo $$env | tr ':' '-')-random.mcap || exit 1; \
 	done
+
+# Thesis chapter 7 environments: depth/split tables, board sets, embodied play with scripted controllers.
+repro-boards: build
+	$(MBRL) eval boards --no-tui --out reports/boards
+	$(MBRL) collect --env lightsout --boards --max-depth 5 --no-tui --out datasets/lightsout-boards-d5.mcap
+	$(MBRL) collect --env tileswap --boards --max-depth 5 --no-tui --out datasets/tileswap-boards-d5.mcap
+	for game in lightsout tileswap; do for arm in cursor reacher; do \
+		$(MBRL) eval embodied --game $$game --embodiment $$arm --max-depth 5 --boards 500 --seed $(SEED) \
+			--no-tui --out reports/embodied-$$game-$$arm || exit 1; \
+	done; done
 
 completions: build
 	$(MBRL) completions bash > completions/mbrl.bash

@@ -3,7 +3,10 @@
 
 use std::path::Path;
 
+use super::boards::{self, EmbodiedSettings};
 use super::swingup::{self, SwingupSettings};
+use crate::envs::boards::{LightsOut, Split};
+use crate::envs::embodiments::Embodiment;
 use crate::envs::pendulum::PendulumVariant;
 use crate::error::{Error, Result};
 use crate::run::atomic::write_atomic;
@@ -11,6 +14,7 @@ use crate::run::dir::Provenance;
 use crate::run::Monitor;
 
 pub const SWINGUP_EPISODES: usize = 5;
+pub const EMBODIED_BOARDS_PER_DEPTH: usize = 20;
 
 pub struct QuickSummary {
     pub lines: Vec<String>,
@@ -20,10 +24,27 @@ pub fn run_quick(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor)
     std::fs::create_dir_all(out_dir).map_err(|e| Error::io(out_dir, e))?;
     let settings = SwingupSettings::thesis(PendulumVariant::Standard);
     let swing = swingup::evaluate(&settings, SWINGUP_EPISODES, provenance, &out_dir.join("pendulum-swingup"), monitor)?;
-    let lines = vec![format!(
+    let mut lines = vec![format!(
         "pendulum swing-up (ground-truth model, CEM {}×{}×{}): {}/{} episodes succeeded; see pendulum-swingup/report.md",
         settings.cem.candidates, settings.cem.horizon, settings.cem.iterations, swing.successes, swing.episodes
     )];
+    let rows = boards::depth_report(provenance, &out_dir.join("boards"), monitor)?;
+    let differing = rows.iter().filter(|r| r.thesis.is_some_and(|t| t != r.boards)).count();
+    lines.push(format!(
+        "board depth tables (LightsOut 5×5, TileSwap 3×3): {} depths, {differing} differ from thesis Table 7.1; see boards/report.md",
+        rows.len()
+    ));
+    let embodied = EmbodiedSettings {
+        embodiment: Embodiment::Reacher,
+        max_depth: 5,
+        boards_per_depth: EMBODIED_BOARDS_PER_DEPTH,
+        split: Split::Test,
+    };
+    let played = boards::embodied_report(&LightsOut::new(5)?, &embodied, provenance, &out_dir.join("lightsout-reacher"), monitor)?;
+    let (total, solved) = played.iter().fold((0, 0), |(t, s), r| (t + r.boards, s + r.solved));
+    lines.push(format!(
+        "LightsOut played by the Reacher's scripted controller, depths 1-5 (test split): {solved}/{total} boards solved; see lightsout-reacher/report.md"
+    ));
     let mut md = String::from("# mbrl quick reproduction\n\nSmall-scale runs of each implemented method.\n\n");
     for line in &lines {
         md.push_str(&format!("- {line}\n"));

@@ -189,7 +189,8 @@ pub fn evaluate(
     }
     monitor.progress("episodes", episodes as u64, episodes as u64);
     write_outputs(settings, provenance, &run, &results)?;
-    monitor.emit(&Event::Finished { ok: true });
+    // Only the run's own file is told it finished: the caller's view may have more jobs to show.
+    metrics.emit(&Event::Finished { ok: true });
     Ok(SwingupSummary {
         returns: results.iter().map(|e| e.total_return).collect(),
         successes: results.iter().filter(|e| e.success).count(),
