@@ -13,7 +13,6 @@ use mbrl::envs::boards::{GameSpec, LightsOut, Split, TileSwap};
 use mbrl::envs::{parse_env, EnvName};
 
 use crate::common::{command_line, file_stem, run_job, GlobalArgs};
-use crate::solve_board::SplitChoice;
 
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
 pub enum Policy {
@@ -102,10 +101,7 @@ fn collect_boards(global: &GlobalArgs, game: GameSpec, args: &CollectArgs) -> an
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from(format!("datasets/{}-boards-d{max_depth}.mcap", file_stem(&game.name()))));
-    let split = args.split.map(|s| match s {
-        SplitChoice::Train => Split::Train,
-        SplitChoice::Test => Split::Test,
-    });
+    let split = args.split.map(Split::from);
     let set = run_job(global, "collect boards", |monitor| {
         let boards = match game {
             GameSpec::LightsOut(n) => records(&LightsOut::new(n)?, max_depth, split, monitor)?,

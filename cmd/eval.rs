@@ -4,8 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::bail;
 use clap::{Args, Subcommand};
-use mbrl::envs::boards::{GameSpec, LightsOut, Split, TileSwap};
-use mbrl::envs::embodiments::Embodiment;
+use mbrl::envs::boards::{GameSpec, LightsOut, TileSwap};
 use mbrl::envs::pendulum::PendulumVariant;
 use mbrl::eval::boards::{self, EmbodiedSettings};
 use mbrl::eval::dataset_report;
@@ -134,16 +133,10 @@ pub fn run(global: &GlobalArgs, args: EvalArgs) -> anyhow::Result<()> {
         }
         Protocol::Embodied(a) => {
             let settings = EmbodiedSettings {
-                embodiment: match a.embodiment {
-                    EmbodimentChoice::Cursor => Embodiment::Cursor,
-                    EmbodimentChoice::Reacher => Embodiment::Reacher,
-                },
+                embodiment: a.embodiment.into(),
                 max_depth: a.max_depth,
                 boards_per_depth: a.boards,
-                split: match a.split {
-                    SplitChoice::Train => Split::Train,
-                    SplitChoice::Test => Split::Test,
-                },
+                split: a.split.into(),
             };
             if a.max_depth == 0 || a.boards == 0 {
                 bail!("--max-depth and --boards must be at least 1");

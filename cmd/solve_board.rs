@@ -35,6 +35,24 @@ pub enum EmbodimentChoice {
     Reacher,
 }
 
+impl From<SplitChoice> for Split {
+    fn from(choice: SplitChoice) -> Split {
+        match choice {
+            SplitChoice::Train => Split::Train,
+            SplitChoice::Test => Split::Test,
+        }
+    }
+}
+
+impl From<EmbodimentChoice> for Embodiment {
+    fn from(choice: EmbodimentChoice) -> Embodiment {
+        match choice {
+            EmbodimentChoice::Cursor => Embodiment::Cursor,
+            EmbodimentChoice::Reacher => Embodiment::Reacher,
+        }
+    }
+}
+
 /// Find a shortest solution of a LightsOut or TileSwap board and optionally play it with a manipulator.
 #[derive(Args, Debug)]
 #[command(after_help = "\
@@ -93,11 +111,7 @@ fn solve<G: DenseIndex>(global: &GlobalArgs, args: &SolveBoardArgs, game: G) -> 
         (Some(text), _) => game.parse(text).with_context(|| format!("--board '{text}'"))?,
         (None, Some(depth)) => {
             let table = DepthTable::build(&game)?;
-            let split = args.split.map(|s| match s {
-                SplitChoice::Train => Split::Train,
-                SplitChoice::Test => Split::Test,
-            });
-            sample_board(&game, &table, depth, split, &mut rng_for(seed, &[0]))?
+            sample_board(&game, &table, depth, args.split.map(Split::from), &mut rng_for(seed, &[0]))?
         }
         (None, None) => bail!("give --board or --random-depth"),
     };
@@ -110,10 +124,7 @@ fn solve<G: DenseIndex>(global: &GlobalArgs, args: &SolveBoardArgs, game: G) -> 
         SearchChoice::Bidirectional => SearchKind::Bidirectional,
         SearchChoice::Bfs => SearchKind::Bfs,
     };
-    let embodiment = args.embodiment.map(|e| match e {
-        EmbodimentChoice::Cursor => Embodiment::Cursor,
-        EmbodimentChoice::Reacher => Embodiment::Reacher,
-    });
+    let embodiment = args.embodiment.map(Embodiment::from);
     let title = format!("solve-board: {}", game.name());
     let (result, execution) = run_job(global, &title, |monitor| {
         monitor.emit(&layout(&title));

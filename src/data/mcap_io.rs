@@ -62,12 +62,15 @@ pub fn write_messages<T: Serialize>(
     })
 }
 
+/// A file's metadata record and its messages with their sequence numbers.
+pub type MetadataAndMessages<T> = (BTreeMap<String, String>, Vec<(u32, T)>);
+
 /// The named metadata record and the decoded messages of `topic`, each with its sequence number.
 pub fn read_messages<T: DeserializeOwned>(
     path: &Path,
     metadata_name: &str,
     topic: &str,
-) -> Result<(BTreeMap<String, String>, Vec<(u32, T)>)> {
+) -> Result<MetadataAndMessages<T>> {
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
     let corrupt =
         |e: mcap::McapError| Error::bad_file(path, format!("not a readable MCAP file (truncated or corrupt?): {e}"));

@@ -40,7 +40,13 @@ pub fn run_quick(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor)
         boards_per_depth: EMBODIED_BOARDS_PER_DEPTH,
         split: Split::Test,
     };
-    let played = boards::embodied_report(&LightsOut::new(5)?, &embodied, provenance, &out_dir.join("lightsout-reacher"), monitor)?;
+    let played = boards::embodied_report(
+        &LightsOut::new(5)?,
+        &embodied,
+        provenance,
+        &out_dir.join("lightsout-reacher"),
+        monitor,
+    )?;
     let (total, solved) = played.iter().fold((0, 0), |(t, s), r| (t + r.boards, s + r.solved));
     lines.push(format!(
         "LightsOut played by the Reacher's scripted controller, depths 1-5 (test split): {solved}/{total} boards solved; see lightsout-reacher/report.md"

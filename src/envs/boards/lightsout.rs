@@ -113,7 +113,7 @@ impl BoardGame for LightsOut {
         (0..self.fields()).map(|f| if state.get(f) { 1.0 } else { 0.0 }).collect()
     }
 
-    fn from_symbolic(&self, bits: &[f64]) -> Option<LightsOutState> {
+    fn decode_symbolic(&self, bits: &[f64]) -> Option<LightsOutState> {
         if bits.len() != self.fields() {
             return None;
         }
@@ -213,7 +213,7 @@ mod tests {
         let game = LightsOut::new(13).unwrap();
         let s = game.apply(game.goal(), 168);
         assert!(s.get(168) && s.get(167) && s.get(155));
-        assert_eq!(game.from_symbolic(&game.symbolic(s)), Some(s));
+        assert_eq!(game.decode_symbolic(&game.symbolic(s)), Some(s));
     }
 
     #[test]

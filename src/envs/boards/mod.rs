@@ -33,7 +33,7 @@ pub trait BoardGame: Clone + Send + Sync + 'static {
     /// "chip j on field i" matrix for TileSwap.
     fn symbolic(&self, state: Self::State) -> Vec<f64>;
     /// Inverse of [`symbolic`](Self::symbolic); `None` when the bits are not a board of this game.
-    fn from_symbolic(&self, bits: &[f64]) -> Option<Self::State>;
+    fn decode_symbolic(&self, bits: &[f64]) -> Option<Self::State>;
     /// The comma-separated canonical string used for the train/test hash (appendix D.1.4).
     fn canonical_string(&self, state: Self::State) -> String;
     /// Parses the canonical comma-separated form, with a one-line error on bad input.

@@ -96,7 +96,7 @@ impl BoardGame for TileSwap {
         bits
     }
 
-    fn from_symbolic(&self, bits: &[f64]) -> Option<TileSwapState> {
+    fn decode_symbolic(&self, bits: &[f64]) -> Option<TileSwapState> {
         if bits.len() != FIELDS * FIELDS {
             return None;
         }
@@ -204,7 +204,7 @@ mod tests {
         assert_eq!(bits[1], 1.0, "field 0 holds chip 1");
         assert_eq!(bits[9], 1.0, "field 1 holds chip 0");
         assert_eq!(bits.iter().sum::<f64>(), 9.0);
-        assert_eq!(game.from_symbolic(&bits), Some(s));
+        assert_eq!(game.decode_symbolic(&bits), Some(s));
     }
 
     #[test]

@@ -140,7 +140,7 @@ impl<G: BoardGame> Env for EmbodiedBoard<G> {
         let m = self.manipulator.state().len();
         let bits = self.game.symbolic(self.board).len();
         self.manipulator.set_state(&state[..m]);
-        if let Some(board) = state.get(m..m + bits).and_then(|b| self.game.from_symbolic(b)) {
+        if let Some(board) = state.get(m..m + bits).and_then(|b| self.game.decode_symbolic(b)) {
             self.board = board;
         }
         if let Some(&remaining) = state.get(m + bits) {
