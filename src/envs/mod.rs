@@ -1,6 +1,7 @@
 //! Simulators. Every environment is an [`Env`] for stepping one instance, and exposes its ground-truth
 //! dynamics as a pure [`Dynamics`] so planners can use the simulator itself as a reference model.
 
+pub mod ball;
 pub mod boards;
 pub mod embodiments;
 pub mod pendulum;

@@ -1,0 +1,3 @@
+mod filtering;
+mod jacobian;
+mod model;
