@@ -5,6 +5,8 @@ pub mod data;
 pub mod envs;
 pub mod error;
 pub mod eval;
+pub mod filtering;
+pub mod models;
 pub mod planning;
 pub mod run;
 pub mod tui;

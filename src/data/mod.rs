@@ -1,5 +1,6 @@
 //! Rollouts and datasets on disk.
 
+pub mod ball_io;
 pub mod boardset;
 pub mod collect;
 pub mod dataset;

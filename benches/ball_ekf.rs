@@ -1,0 +1,38 @@
+//! Speed of the ball EKF: one predict+update step (target < 2 µs) and a 1 s open-loop forecast, 180 steps
+//! (target < 50 µs), far below the camera's 5.6 ms frame period.
+
+use std::hint::black_box;
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use mbrl::filtering::{forecast, forecast_means, predict, update, Vector};
+use mbrl::models::ball::{initial_belief, BallModel, BallModelParams, Phase, SpinPrior};
+
+fn bench(c: &mut Criterion) {
+    let model = BallModel::new(BallModelParams::thesis_learned()).unwrap();
+    // High above the table: a free-flight step, the common case.
+    let start =
+        initial_belief(model.params(), [0.1, 2.8, 0.3], [0.102, 2.775, 0.305], 1, false, &SpinPrior::Uninformed)
+            .unwrap();
+    let m = Vector::<3>::new(0.104, 2.75, 0.31);
+
+    c.bench_function("ball_ekf_predict_update", |b| {
+        b.iter(|| {
+            let prior = predict(&model, black_box(&start));
+            update(&model, &prior, black_box(&m)).unwrap()
+        })
+    });
+
+    // Just above the table and falling: the step contains the impact.
+    let mut falling = start;
+    falling.mean[2] = -0.461 + 0.02 + 0.005;
+    falling.mean[5] = -3.0;
+    c.bench_function("ball_ekf_predict_with_impact", |b| b.iter(|| predict(&model, black_box(&falling))));
+
+    c.bench_function("ball_forecast_1s_with_covariance", |b| b.iter(|| forecast(&model, black_box(&start), 180)));
+    c.bench_function("ball_forecast_1s_mean_only", |b| {
+        b.iter(|| forecast_means(&model, black_box(&start.mean), Phase::BeforeImpact, 180))
+    });
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
