@@ -4,9 +4,12 @@ use std::path::PathBuf;
 
 use anyhow::bail;
 use clap::{Args, ValueEnum};
+use mbrl::data::ball_io::write_ball_dataset;
 use mbrl::data::boardset::{write_board_set, BoardSet};
 use mbrl::data::collect::{collect_random, CollectSettings};
+use mbrl::data::collect_ball::{collect_ball, BallCollectSettings};
 use mbrl::data::write_dataset;
+use mbrl::envs::ball::Orientation;
 use mbrl::envs::boards::depth::{DenseIndex, DepthTable};
 use mbrl::envs::boards::sets::board_set;
 use mbrl::envs::boards::{GameSpec, LightsOut, Split, TileSwap};
@@ -27,10 +30,13 @@ Examples:
   mbrl collect --env pendulum --rollouts 500 --steps 30 --out datasets/pendulum.mcap
   mbrl collect --env pendulum:quadrant --rollouts 100 --steps 50 --seed 3
   mbrl collect --env lightsout --boards --max-depth 5 --split test --out datasets/lightsout-test.mcap
+  mbrl collect --env ball --trajectories 100 --augment-rotations 19 --out datasets/ball-train.mcap
+  mbrl collect --env ball --trajectories 30 --orientation unseen-3 --out datasets/ball-unseen-3.mcap
 
 Start states: θ ~ U[-π, π], θ̇ ~ U[-8, 8]; actions ~ U[-2, 2]. Parametrized variants
 (pendulum:quadrant) draw a new instance per rollout; its parameters go into the metadata.
-Board sets (lightsout 5x5, tileswap) hold every board of depth 1..D with its train/test split.")]
+Board sets (lightsout 5x5, tileswap) hold every board of depth 1..D with its train/test split.
+Ball shots: launcher settings drawn as in thesis 6.5.1, 180 Hz camera with ~1 mm noise and dropouts.")]
 pub struct CollectArgs {
     /// Environment: pendulum[:light|heavy|mass=<m>|inverted|quadrant].
     #[arg(long)]
@@ -47,6 +53,15 @@ pub struct CollectArgs {
     /// Output file (default: datasets/<env>-random.mcap, or datasets/<game>-boards-d<D>.mcap).
     #[arg(long)]
     out: Option<PathBuf>,
+    /// For the ball: number of simulated shots (each with exactly one table bounce).
+    #[arg(long)]
+    trajectories: Option<usize>,
+    /// For the ball: launcher pose, default or unseen-1..unseen-5 (thesis 6.5.1).
+    #[arg(long, default_value = "default", requires = "trajectories")]
+    orientation: String,
+    /// For the ball: rotated copies added per shot, about z through its lowest point (19 in the thesis).
+    #[arg(long, default_value_t = 0, requires = "trajectories")]
+    augment_rotations: usize,
     /// For board games: write the set of all boards of solution depth 1..=--max-depth with their split.
     #[arg(long, requires = "max_depth")]
     boards: bool,
@@ -60,6 +75,15 @@ pub struct CollectArgs {
 
 pub fn run(global: &GlobalArgs, args: CollectArgs) -> anyhow::Result<()> {
     let env = parse_env(&args.env)?;
+    if env == EnvName::Ball {
+        let Some(trajectories) = args.trajectories else {
+            bail!("'ball' is recorded as camera trajectories: give --trajectories N");
+        };
+        return collect_ball_shots(global, trajectories, &args);
+    }
+    if args.trajectories.is_some() {
+        bail!("--trajectories is for --env ball, not '{}'", env.canonical());
+    }
     if let EnvName::Board(game) = env {
         if !args.boards {
             bail!("'{}' is a board game: collect its board sets with --boards --max-depth D", game.name());
@@ -148,4 +172,31 @@ fn records<G: DenseIndex>(
         )));
     }
     Ok(board_set(game, &table, max_depth, split))
+}
+
+fn collect_ball_shots(global: &GlobalArgs, trajectories: usize, args: &CollectArgs) -> anyhow::Result<()> {
+    let orientation = Orientation::parse(&args.orientation)?;
+    let out = args.out.clone().unwrap_or_else(|| PathBuf::from(format!("datasets/ball-{}.mcap", orientation.name())));
+    let settings = BallCollectSettings {
+        trajectories,
+        orientation,
+        augment_rotations: args.augment_rotations,
+        seed: global.seed,
+        command_line: command_line(),
+    };
+    let data = run_job(global, "collect ball shots", |monitor| {
+        let data = collect_ball(&settings, monitor)?;
+        write_ball_dataset(&out, &data)?;
+        Ok(data)
+    })?;
+    let frames: usize = data.recordings.iter().map(|r| r.frames.len()).sum();
+    println!(
+        "wrote {} ball trajectories ({} shots from the {} pose, {} rotated copies), {frames} frames, to {}",
+        data.recordings.len(),
+        trajectories,
+        orientation.name(),
+        data.recordings.len() - trajectories,
+        out.display()
+    );
+    Ok(())
 }

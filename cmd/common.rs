@@ -123,6 +123,11 @@ pub enum ModelChoice {
 pub fn pendulum_variant(name: &str) -> anyhow::Result<mbrl::envs::pendulum::PendulumVariant> {
     match mbrl::envs::parse_env(name)? {
         mbrl::envs::EnvName::Pendulum(v) => Ok(v),
+        mbrl::envs::EnvName::Ball => {
+            anyhow::bail!(
+                "'ball' has no control task; use `mbrl filter` / `mbrl predict`; CEM planning supports pendulum envs"
+            )
+        }
         mbrl::envs::EnvName::Board(g) => anyhow::bail!(
             "'{}' is a board game: solve it with `mbrl solve-board --game {}`; CEM planning supports pendulum envs",
             g.name(),

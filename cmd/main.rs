@@ -5,7 +5,9 @@ mod collect;
 mod common;
 mod completions;
 mod eval;
+mod filter;
 mod plan;
+mod predict;
 mod solve_board;
 mod watch;
 
@@ -21,6 +23,8 @@ Examples:
   mbrl plan --env pendulum --model true --steps 150
   mbrl collect --env pendulum:heavy --rollouts 10 --steps 30 --out datasets/heavy.mcap
   mbrl solve-board --game lightsout --random-depth 9 --model true
+  mbrl collect --env ball --trajectories 20 --out datasets/ball.mcap
+  mbrl predict --model thesis --input datasets/ball.mcap --horizon 1s
   mbrl watch reports/quick/pendulum-swingup";
 
 #[derive(Parser)]
@@ -36,6 +40,8 @@ pub struct Cli {
 enum Command {
     Collect(collect::CollectArgs),
     Plan(plan::PlanArgs),
+    Filter(filter::FilterArgs),
+    Predict(predict::PredictArgs),
     SolveBoard(solve_board::SolveBoardArgs),
     Eval(eval::EvalArgs),
     Watch(watch::WatchArgs),
@@ -47,6 +53,8 @@ fn main() {
     let outcome = common::init_threads(&cli.global).and_then(|()| match cli.command {
         Command::Collect(args) => collect::run(&cli.global, args),
         Command::Plan(args) => plan::run(&cli.global, args),
+        Command::Filter(args) => filter::run(&cli.global, args),
+        Command::Predict(args) => predict::run(&cli.global, args),
         Command::SolveBoard(args) => solve_board::run(&cli.global, args),
         Command::Eval(args) => eval::run(&cli.global, args),
         Command::Watch(args) => watch::run(&cli.global, args),

@@ -25,11 +25,17 @@ _mbrl() {
             mbrl,eval)
                 cmd="mbrl__subcmd__eval"
                 ;;
+            mbrl,filter)
+                cmd="mbrl__subcmd__filter"
+                ;;
             mbrl,help)
                 cmd="mbrl__subcmd__help"
                 ;;
             mbrl,plan)
                 cmd="mbrl__subcmd__plan"
+                ;;
+            mbrl,predict)
+                cmd="mbrl__subcmd__predict"
                 ;;
             mbrl,solve-board)
                 cmd="mbrl__subcmd__solve__subcmd__board"
@@ -82,11 +88,17 @@ _mbrl() {
             mbrl__subcmd__help,eval)
                 cmd="mbrl__subcmd__help__subcmd__eval"
                 ;;
+            mbrl__subcmd__help,filter)
+                cmd="mbrl__subcmd__help__subcmd__filter"
+                ;;
             mbrl__subcmd__help,help)
                 cmd="mbrl__subcmd__help__subcmd__help"
                 ;;
             mbrl__subcmd__help,plan)
                 cmd="mbrl__subcmd__help__subcmd__plan"
+                ;;
+            mbrl__subcmd__help,predict)
+                cmd="mbrl__subcmd__help__subcmd__predict"
                 ;;
             mbrl__subcmd__help,solve-board)
                 cmd="mbrl__subcmd__help__subcmd__solve__subcmd__board"
@@ -116,7 +128,7 @@ _mbrl() {
 
     case "${cmd}" in
         mbrl)
-            opts="-q -h -V --seed --threads --tui --no-tui --quiet --help --version collect plan solve-board eval watch completions help"
+            opts="-q -h -V --seed --threads --tui --no-tui --quiet --help --version collect plan filter predict solve-board eval watch completions help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 1 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -138,7 +150,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__collect)
-            opts="-q -h -V --env --rollouts --steps --policy --out --boards --max-depth --split --seed --threads --tui --no-tui --quiet --help --version"
+            opts="-q -h -V --env --rollouts --steps --policy --out --trajectories --orientation --augment-rotations --boards --max-depth --split --seed --threads --tui --no-tui --quiet --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -161,6 +173,18 @@ _mbrl() {
                     return 0
                     ;;
                 --out)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --trajectories)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --orientation)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --augment-rotations)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
@@ -523,8 +547,46 @@ _mbrl() {
             COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
             return 0
             ;;
+        mbrl__subcmd__filter)
+            opts="-q -h -V --model --input --out --mcap --seed --threads --tui --no-tui --quiet --help --version"
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                --model)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --input)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --out)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --mcap)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --seed)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
         mbrl__subcmd__help)
-            opts="collect plan solve-board eval watch completions help"
+            opts="collect plan filter predict solve-board eval watch completions help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -649,6 +711,20 @@ _mbrl() {
             COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
             return 0
             ;;
+        mbrl__subcmd__help__subcmd__filter)
+            opts=""
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
         mbrl__subcmd__help__subcmd__help)
             opts=""
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
@@ -664,6 +740,20 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__help__subcmd__plan)
+            opts=""
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mbrl__subcmd__help__subcmd__predict)
             opts=""
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
@@ -745,6 +835,52 @@ _mbrl() {
                     return 0
                     ;;
                 --beta)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --out)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --seed)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mbrl__subcmd__predict)
+            opts="-q -h -V --model --input --horizon --from-frame --plane-y --out --seed --threads --tui --no-tui --quiet --help --version"
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                --model)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --input)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --horizon)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --from-frame)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --plane-y)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;

@@ -33,6 +33,8 @@ complete -c mbrl -n "__fish_mbrl_needs_command" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_needs_command" -s V -l version -d 'Print version'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "collect" -d 'Collect rollouts from a simulator into an MCAP dataset'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "plan" -d 'Plan with CEM on a model and execute the plan in the simulator (MPC)'
+complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "filter" -d 'Filter table-tennis ball recordings with the gray-box EKF (thesis chapter 6)'
+complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "predict" -d 'Predict table-tennis ball trajectories: filter until a horizon before the end, then predict ahead'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "solve-board" -d 'Find a shortest solution of a LightsOut or TileSwap board and optionally play it with a manipulator'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "eval" -d 'Run an evaluation protocol and write a report directory (report.md, CSV, PNG)'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "watch" -d 'Follow a running or finished run (training or eval) in the live view'
@@ -43,6 +45,9 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l rollouts -d 'Numbe
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l steps -d 'Steps per rollout' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l policy -d 'Behaviour policy' -r -f -a "random\t'Uniformly random actions within the action bounds'"
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l out -d 'Output file (default: datasets/<env>-random.mcap, or datasets/<game>-boards-d<D>.mcap)' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l trajectories -d 'For the ball: number of simulated shots (each with exactly one table bounce)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l orientation -d 'For the ball: launcher pose, default or unseen-1..unseen-5 (thesis 6.5.1)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l augment-rotations -d 'For the ball: rotated copies added per shot, about z through its lowest point (19 in the thesis)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l max-depth -d 'Deepest solution depth in a board set' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l split -d 'Only boards of this split' -r -f -a "train\t''
 test\t''"
@@ -73,6 +78,30 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l no-tui -d 'Print plai
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -s V -l version -d 'Print version'
+complete -c mbrl -n "__fish_mbrl_using_subcommand filter" -l model -d 'Ball model: thesis, initial, or a checkpoint directory' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand filter" -l input -d 'Recordings: a .mcap ball dataset or a .csv recording' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand filter" -l out -d 'CSV output: per frame the measurement, the state mean and its standard deviations' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand filter" -l mcap -d 'Also write the means with full covariances as MCAP' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand filter" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand filter" -l threads -d 'Worker threads (0 = one per core)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand filter" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand filter" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand filter" -s q -l quiet -d 'Print only results and errors'
+complete -c mbrl -n "__fish_mbrl_using_subcommand filter" -s h -l help -d 'Print help'
+complete -c mbrl -n "__fish_mbrl_using_subcommand filter" -s V -l version -d 'Print version'
+complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -l model -d 'Ball model: thesis, initial, or a checkpoint directory' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -l input -d 'Recordings: a .mcap ball dataset or a .csv recording' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -l horizon -d 'How far to predict: seconds with an `s` suffix (1s, 0.5s) or camera frames with `f` (90f)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -l from-frame -d 'Filter until this camera frame instead of one horizon before the end' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -l plane-y -d 'Report the crossing of the plane y = this value [m]' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -l out -d 'CSV of predicted points' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -l threads -d 'Worker threads (0 = one per core)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -s q -l quiet -d 'Print only results and errors'
+complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -s h -l help -d 'Print help'
+complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -s V -l version -d 'Print version'
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l game -d 'Game: lightsout (5x5), lightsout:<n>x<n> (n = 2..13), tileswap' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l board -d 'The board to solve' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l random-depth -d 'Draw a random board whose shortest solution has this many moves (5x5 LightsOut, TileSwap)' -r
@@ -186,13 +215,15 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -l no-tui -d 'Pri
 complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -s V -l version -d 'Print version'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan solve-board eval watch completions help" -f -a "collect" -d 'Collect rollouts from a simulator into an MCAP dataset'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan solve-board eval watch completions help" -f -a "plan" -d 'Plan with CEM on a model and execute the plan in the simulator (MPC)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan solve-board eval watch completions help" -f -a "solve-board" -d 'Find a shortest solution of a LightsOut or TileSwap board and optionally play it with a manipulator'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan solve-board eval watch completions help" -f -a "eval" -d 'Run an evaluation protocol and write a report directory (report.md, CSV, PNG)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan solve-board eval watch completions help" -f -a "watch" -d 'Follow a running or finished run (training or eval) in the live view'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan solve-board eval watch completions help" -f -a "completions" -d 'Print a shell completion script'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan solve-board eval watch completions help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan filter predict solve-board eval watch completions help" -f -a "collect" -d 'Collect rollouts from a simulator into an MCAP dataset'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan filter predict solve-board eval watch completions help" -f -a "plan" -d 'Plan with CEM on a model and execute the plan in the simulator (MPC)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan filter predict solve-board eval watch completions help" -f -a "filter" -d 'Filter table-tennis ball recordings with the gray-box EKF (thesis chapter 6)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan filter predict solve-board eval watch completions help" -f -a "predict" -d 'Predict table-tennis ball trajectories: filter until a horizon before the end, then predict ahead'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan filter predict solve-board eval watch completions help" -f -a "solve-board" -d 'Find a shortest solution of a LightsOut or TileSwap board and optionally play it with a manipulator'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan filter predict solve-board eval watch completions help" -f -a "eval" -d 'Run an evaluation protocol and write a report directory (report.md, CSV, PNG)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan filter predict solve-board eval watch completions help" -f -a "watch" -d 'Follow a running or finished run (training or eval) in the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan filter predict solve-board eval watch completions help" -f -a "completions" -d 'Print a shell completion script'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan filter predict solve-board eval watch completions help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from eval" -f -a "quick" -d 'Small reproduction of every implemented method (about a minute)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from eval" -f -a "dataset" -d 'Summarise a dataset: rollouts, returns, state ranges, plots'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from eval" -f -a "boards" -d 'Depth and train/test split tables of LightsOut 5x5 and TileSwap (thesis Tables 7.1, 7.2)'

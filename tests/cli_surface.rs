@@ -15,6 +15,8 @@ const SUBCOMMANDS: &[&[&str]] = &[
     &["eval", "boards"],
     &["eval", "embodied"],
     &["solve-board"],
+    &["filter"],
+    &["predict"],
     &["watch"],
     &["completions"],
 ];

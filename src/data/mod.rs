@@ -1,8 +1,10 @@
 //! Rollouts and datasets on disk.
 
+pub mod ball_estimates;
 pub mod ball_io;
 pub mod boardset;
 pub mod collect;
+pub mod collect_ball;
 pub mod dataset;
 pub mod mcap_io;
 pub mod rollout;

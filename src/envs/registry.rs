@@ -6,13 +6,15 @@ use super::pendulum::{Pendulum, PendulumVariant};
 use super::Env;
 use crate::error::{Error, Result};
 
-pub const KNOWN_ENVS: &str = "pendulum[:light|heavy|mass=<m>|inverted|quadrant], lightsout[:<n>x<n>], tileswap";
+pub const KNOWN_ENVS: &str = "pendulum[:light|heavy|mass=<m>|inverted|quadrant], lightsout[:<n>x<n>], tileswap, ball";
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum EnvName {
     Pendulum(PendulumVariant),
     /// A board game on its own: board sets and symbolic planning, no simulator to step.
     Board(GameSpec),
+    /// The table-tennis ball simulator: recorded as camera trajectories, not stepped by actions.
+    Ball,
 }
 
 pub fn parse_env(name: &str) -> Result<EnvName> {
@@ -20,6 +22,7 @@ pub fn parse_env(name: &str) -> Result<EnvName> {
     match family {
         "pendulum" => Ok(EnvName::Pendulum(PendulumVariant::parse(variant)?)),
         "lightsout" | "tileswap" => Ok(EnvName::Board(GameSpec::parse(name)?)),
+        "ball" if variant.is_empty() => Ok(EnvName::Ball),
         _ => Err(Error::InvalidInput(format!("unknown env '{name}'; supported: {KNOWN_ENVS}"))),
     }
 }
@@ -36,6 +39,9 @@ impl EnvName {
                 g.name(),
                 g.name()
             ))),
+            EnvName::Ball => Err(Error::InvalidInput(
+                "'ball' is recorded as camera trajectories: use `mbrl collect --env ball --trajectories N`".into(),
+            )),
         }
     }
 
@@ -43,6 +49,7 @@ impl EnvName {
         match self {
             EnvName::Pendulum(v) => v.env_name(),
             EnvName::Board(g) => g.name(),
+            EnvName::Ball => "ball".into(),
         }
     }
 }

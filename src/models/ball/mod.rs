@@ -19,13 +19,16 @@
 //! assert_eq!(next_second.len(), 180);
 //! ```
 
+pub mod checkpoint;
 mod error;
 mod flight;
 mod impact;
 mod init;
+pub mod learn;
 mod model;
 mod params;
 mod state;
+pub mod track;
 
 pub use error::BallModelError;
 pub use init::{initial_belief, SpinPrior};

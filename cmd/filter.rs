@@ -1,0 +1,76 @@
+//! `mbrl filter`: run the ball EKF over recordings and write the filtered states with covariances.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use mbrl::data::ball_estimates::{write_estimates_csv, write_estimates_mcap, BallEstimate};
+use mbrl::data::ball_io::{read_recordings, FRAME_RATE};
+use mbrl::models::ball::checkpoint::load_ball_model;
+use mbrl::models::ball::track::filter_recording;
+use mbrl::models::ball::Phase;
+
+use crate::common::{command_line, run_job, GlobalArgs};
+
+/// Filter table-tennis ball recordings with the gray-box EKF (thesis chapter 6).
+#[derive(Args, Debug)]
+#[command(after_help = "\
+Examples:
+  mbrl filter --model thesis --input datasets/ball-default.mcap --out filtered.csv --mcap filtered.mcap
+  mbrl filter --model models/ball-ekf --input recording.csv
+
+--model is `thesis` (learned values of eq. 6.26 / Table C.2), `initial` (Table C.1) or a directory
+written by training. CSV input: header frame (or t), x, y, z; empty x,y,z cells are lost frames.")]
+pub struct FilterArgs {
+    /// Ball model: thesis, initial, or a checkpoint directory.
+    #[arg(long)]
+    model: String,
+    /// Recordings: a .mcap ball dataset or a .csv recording.
+    #[arg(long)]
+    input: PathBuf,
+    /// CSV output: per frame the measurement, the state mean and its standard deviations.
+    #[arg(long, default_value = "filtered.csv")]
+    out: PathBuf,
+    /// Also write the means with full covariances as MCAP.
+    #[arg(long)]
+    mcap: Option<PathBuf>,
+}
+
+pub fn run(global: &GlobalArgs, args: FilterArgs) -> anyhow::Result<()> {
+    let model = load_ball_model(&args.model)?;
+    let recordings = read_recordings(&args.input)?;
+    let (estimates, likelihoods) = run_job(global, "filter", |monitor| {
+        let mut estimates = Vec::new();
+        let mut likelihoods = Vec::new();
+        for (k, rec) in recordings.iter().enumerate() {
+            let track = filter_recording(&model, rec, None)?;
+            likelihoods.push((rec.id, track.log_likelihood, track.frames.len()));
+            let measured: std::collections::HashMap<u64, [f64; 3]> =
+                rec.frames.iter().zip(&rec.positions).filter_map(|(f, p)| p.map(|p| (*f, p))).collect();
+            for (frame, belief) in track.frames.iter().zip(&track.beliefs) {
+                estimates.push(BallEstimate {
+                    trajectory: rec.id,
+                    frame: *frame,
+                    t: *frame as f64 / FRAME_RATE,
+                    measurement: measured.get(frame).copied(),
+                    mean: std::array::from_fn(|i| belief.mean[i]),
+                    covariance: belief.cov.transpose().iter().copied().collect(),
+                    after_impact: belief.mode == Phase::AfterImpact,
+                });
+            }
+            monitor.progress("filter recordings", k as u64 + 1, recordings.len() as u64);
+        }
+        write_estimates_csv(&args.out, &estimates)?;
+        if let Some(path) = &args.mcap {
+            write_estimates_mcap(path, &args.model, &command_line(), &estimates)?;
+        }
+        Ok((estimates, likelihoods))
+    })?;
+    for (id, ll, frames) in &likelihoods {
+        println!("trajectory {id}: {frames} frames filtered, log-likelihood {ll:.2}");
+    }
+    println!("wrote {} estimates to {}", estimates.len(), args.out.display());
+    if let Some(path) = &args.mcap {
+        println!("wrote means and covariances to {}", path.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,95 @@
+//! End to end: simulated ball shots, filtering and prediction from the command line, bad recordings.
+
+mod common;
+
+use common::*;
+use mbrl::data::ball_io::read_ball_dataset;
+
+#[test]
+fn collect_filter_predict_pipeline() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = mbrl(dir.path())
+        .args(["collect", "--env", "ball", "--trajectories", "6", "--augment-rotations", "2", "--out", "b.mcap", "-q"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr_of(&out));
+    let data = read_ball_dataset(&dir.path().join("b.mcap")).unwrap();
+    assert_eq!(data.recordings.len(), 18, "6 shots + 2 rotated copies each");
+    assert!(data.recordings.iter().all(|r| r.info.side_info.is_some() && r.truth.is_some()));
+    assert_eq!(data.recordings[6].info.rotated_from.map(|r| r.0), Some(0));
+
+    let out = mbrl(dir.path())
+        .args(["filter", "--model", "thesis", "--input", "b.mcap", "--mcap", "f.mcap", "-q"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr_of(&out));
+    let csv = std::fs::read_to_string(dir.path().join("filtered.csv")).unwrap();
+    let header = csv.lines().next().unwrap();
+    assert!(header.starts_with("trajectory,frame,t,mx,my,mz,px,py,pz") && header.contains("std_a_m"), "{header}");
+    assert!(dir.path().join("f.mcap").is_file());
+
+    let out = mbrl(dir.path())
+        .args(["predict", "--model", "thesis", "--input", "b.mcap", "--horizon", "1s", "--plane-y", "0.5", "-q"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr_of(&out));
+    let text = stdout_of(&out);
+    let errors: Vec<f64> = text
+        .lines()
+        .filter_map(|l| l.split("error ").nth(1))
+        .filter_map(|rest| rest.split(" cm").next()?.parse().ok())
+        .collect();
+    assert_eq!(errors.len(), 18, "{text}");
+    let median = {
+        let mut e = errors.clone();
+        e.sort_by(f64::total_cmp);
+        e[e.len() / 2]
+    };
+    assert!(median < 25.0, "median 1 s prediction error {median} cm with the thesis parameters");
+    assert!(text.contains("lands at") && text.contains("crosses y = 0.500"), "{text}");
+}
+
+#[test]
+fn csv_recordings_are_filtered_and_bad_ones_rejected() {
+    let dir = tempfile::tempdir().unwrap();
+    // A falling ball sampled at 180 Hz with one lost frame; estimates start at the second measurement.
+    let mut text = String::from("frame,x,y,z\n");
+    for f in 0..40u32 {
+        let t = f as f64 / 180.0;
+        if f == 5 {
+            text += &format!("{f},,,\n");
+        } else {
+            text += &format!("{f},{:.5},{:.5},{:.5}\n", 0.1, 2.5 - 4.0 * t, 0.3 + 1.0 * t - 4.9 * t * t);
+        }
+    }
+    std::fs::write(dir.path().join("ok.csv"), &text).unwrap();
+    let out = mbrl(dir.path()).args(["filter", "--model", "thesis", "--input", "ok.csv", "-q"]).output().unwrap();
+    assert!(out.status.success(), "{}", stderr_of(&out));
+    assert!(stdout_of(&out).contains("trajectory 0: 39 frames filtered"), "{}", stdout_of(&out));
+
+    let bad = [
+        ("nan.csv", "frame,x,y,z\n0,0,0,0\n1,nan,0,0\n2,0,0,0\n", "row 3: x is NaN"),
+        ("order.csv", "frame,x,y,z\n0,0,0,0\n2,0,0,0\n1,0,0,0\n", "row 4: frame 1 does not follow"),
+        ("one.csv", "frame,x,y,z\n0,0,0,0\n1,,,\n", "1 measured positions"),
+        ("cols.csv", "frame,x,y,z\n0,0,0,0\n1,0,0\n", "row 3: 3 columns, expected 4"),
+    ];
+    for (name, content, needle) in bad {
+        std::fs::write(dir.path().join(name), content).unwrap();
+        let out =
+            mbrl(dir.path()).args(["filter", "--model", "thesis", "--input", name, "--out", "x.csv"]).output().unwrap();
+        assert_one_line_error(&out, &[name, needle]);
+        assert!(!dir.path().join("x.csv").exists());
+    }
+    let out = mbrl(dir.path())
+        .args(["predict", "--model", "thesis", "--input", "ok.csv", "--horizon", "soon"])
+        .output()
+        .unwrap();
+    assert_one_line_error(&out, &["--horizon 'soon'", "1s"]);
+    let out = mbrl(dir.path()).args(["filter", "--model", "nowhere", "--input", "ok.csv"]).output().unwrap();
+    assert_one_line_error(&out, &["nowhere", "thesis"]);
+    let out = mbrl(dir.path())
+        .args(["collect", "--env", "ball", "--trajectories", "2", "--orientation", "sideways"])
+        .output()
+        .unwrap();
+    assert_one_line_error(&out, &["sideways", "unseen-5"]);
+}
