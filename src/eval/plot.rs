@@ -90,6 +90,50 @@ pub fn line_plot(path: &Path, title: &str, x_label: &str, y_label: &str, series:
     })
 }
 
+/// A median line with a shaded band between a lower and an upper quantile.
+pub struct Band {
+    pub name: String,
+    /// (x, low, middle, high)
+    pub points: Vec<(f64, f64, f64, f64)>,
+}
+
+pub fn band_plot(path: &Path, title: &str, x_label: &str, y_label: &str, bands: &[Band]) -> Result<()> {
+    let (x0, x1) = bounds(bands.iter().flat_map(|b| b.points.iter().map(|p| p.0)));
+    let (y0, y1) = bounds(bands.iter().flat_map(|b| b.points.iter().flat_map(|p| [p.1, p.3])));
+    render_atomic(path, |tmp| {
+        let root = BitMapBackend::new(tmp, SIZE).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| plot_err(path, e))?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 24))
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(60)
+            .build_cartesian_2d(x0..x1, y0.min(0.0)..y1)
+            .map_err(|e| plot_err(path, e))?;
+        chart.configure_mesh().x_desc(x_label).y_desc(y_label).draw().map_err(|e| plot_err(path, e))?;
+        for (i, band) in bands.iter().enumerate() {
+            let color = Palette99::pick(i).to_rgba();
+            let mut outline: Vec<(f64, f64)> = band.points.iter().map(|p| (p.0, p.3)).collect();
+            outline.extend(band.points.iter().rev().map(|p| (p.0, p.1)));
+            chart.draw_series(std::iter::once(Polygon::new(outline, color.mix(0.15)))).map_err(|e| plot_err(path, e))?;
+            chart
+                .draw_series(LineSeries::new(band.points.iter().map(|p| (p.0, p.2)), color.stroke_width(2)))
+                .map_err(|e| plot_err(path, e))?
+                .label(band.name.clone())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2)));
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|e| plot_err(path, e))?;
+        root.present().map_err(|e| plot_err(path, e))?;
+        Ok(())
+    })
+}
+
 pub fn histogram(path: &Path, title: &str, x_label: &str, values: &[f64], bins: usize) -> Result<()> {
     let finite: Vec<f64> = values.iter().copied().filter(|v| v.is_finite()).collect();
     let (lo, hi) = bounds(finite.iter().copied());

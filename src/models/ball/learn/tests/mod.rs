@@ -1,1 +1,5 @@
-
+mod data;
+mod forward;
+mod gradients;
+mod parts;
+mod training;
