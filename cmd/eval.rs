@@ -6,10 +6,12 @@ use anyhow::bail;
 use clap::{Args, Subcommand};
 use mbrl::envs::boards::{GameSpec, LightsOut, TileSwap};
 use mbrl::envs::pendulum::PendulumVariant;
+use mbrl::eval::ball::{self, BallEvalSettings};
 use mbrl::eval::boards::{self, EmbodiedSettings};
 use mbrl::eval::dataset_report;
 use mbrl::eval::quick::run_quick;
 use mbrl::eval::swingup::{self, SwingupSettings};
+use mbrl::models::ball::checkpoint::load_ball_model;
 use mbrl::run::dir::Provenance;
 
 use crate::cem_args::CemArgs;
@@ -23,6 +25,7 @@ Examples:
   mbrl eval quick
   mbrl eval dataset --input datasets/pendulum-random.mcap
   mbrl eval boards
+  mbrl eval ball --model thesis --model initial
   mbrl eval embodied --game lightsout --embodiment cursor --max-depth 5 --boards 200
   mbrl eval pendulum-swingup --model true --episodes 10 --out reports/swingup")]
 pub struct EvalArgs {
@@ -42,6 +45,7 @@ enum Protocol {
     /// Summarise a dataset: rollouts, returns, state ranges, plots.
     #[command(after_help = "Example:\n  mbrl eval dataset --input datasets/pendulum-random.mcap
   mbrl eval boards
+  mbrl eval ball --model thesis --model initial
   mbrl eval embodied --game lightsout --embodiment cursor --max-depth 5 --boards 200 --out reports/dataset")]
     Dataset {
         /// Dataset file written by `mbrl collect` or `mbrl plan`.
@@ -64,6 +68,10 @@ enum Protocol {
                             mbrl eval embodied --game tileswap --embodiment reacher --max-depth 5 --boards 100"
     )]
     Embodied(EmbodiedArgs),
+    /// Ball prediction error vs horizon on simulated shots, default and unseen launcher poses (thesis 6.5).
+    #[command(after_help = "Examples:\n  mbrl eval ball --model thesis --model initial\n  \
+                            mbrl eval ball --model models/ball-ekf --train-shots 108 --test-shots 163 --unseen-shots 30")]
+    Ball(BallArgs),
     /// Pendulum swing-up with MPC: success rate, returns, angle plots.
     #[command(after_help = "Example:\n  mbrl eval pendulum-swingup --model true --episodes 10 --out reports/swingup")]
     PendulumSwingup(SwingupArgs),
@@ -88,6 +96,28 @@ struct EmbodiedArgs {
     split: SplitChoice,
     /// Report directory.
     #[arg(long, default_value = "reports/embodied")]
+    out: PathBuf,
+}
+
+#[derive(Args, Debug)]
+struct BallArgs {
+    /// EKF models to compare (repeatable): thesis, initial, or checkpoint directories.
+    #[arg(long, default_values_t = ["thesis".to_string(), "initial".to_string()])]
+    model: Vec<String>,
+    /// Default-pose shots the black-box baseline is fitted on.
+    #[arg(long, default_value_t = 108)]
+    train_shots: usize,
+    /// Rotated copies per training shot.
+    #[arg(long, default_value_t = 19)]
+    augment_rotations: usize,
+    /// Default-pose test shots.
+    #[arg(long, default_value_t = 163)]
+    test_shots: usize,
+    /// Test shots per unseen pose (5 poses).
+    #[arg(long, default_value_t = 30)]
+    unseen_shots: usize,
+    /// Report directory.
+    #[arg(long, default_value = "reports/ball")]
     out: PathBuf,
 }
 
@@ -157,6 +187,36 @@ pub fn run(global: &GlobalArgs, args: EvalArgs) -> anyhow::Result<()> {
                     r.boards,
                     100.0 * r.solved as f64 / r.boards.max(1) as f64,
                     r.mean_control_steps
+                );
+            }
+            println!("report: {}", a.out.join("report.md").display());
+        }
+        Protocol::Ball(a) => {
+            let models =
+                a.model.iter().map(|m| Ok((m.clone(), load_ball_model(m)?))).collect::<anyhow::Result<Vec<_>>>()?;
+            if a.train_shots == 0 || a.test_shots == 0 || a.unseen_shots == 0 {
+                bail!("--train-shots, --test-shots and --unseen-shots must be at least 1");
+            }
+            let settings = BallEvalSettings {
+                train_shots: a.train_shots,
+                augment_rotations: a.augment_rotations,
+                test_shots_default: a.test_shots,
+                test_shots_unseen: a.unseen_shots,
+                ..BallEvalSettings::default()
+            };
+            let summary = run_job(global, "eval ball", |monitor| {
+                ball::evaluate(&settings, models, &provenance, &a.out, monitor)
+            })?;
+            println!("median prediction error at 1 s horizon:");
+            for r in summary.rows.iter().filter(|r| (r.horizon_s - 1.0).abs() < 1e-9) {
+                println!(
+                    "  {:<32} {:<8} {:6.1} cm  (10-90 %: {:.1}-{:.1} cm, n = {})",
+                    r.method,
+                    r.group,
+                    100.0 * r.median,
+                    100.0 * r.q10,
+                    100.0 * r.q90,
+                    r.count
                 );
             }
             println!("report: {}", a.out.join("report.md").display());

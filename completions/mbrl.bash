@@ -43,6 +43,9 @@ _mbrl() {
             mbrl,watch)
                 cmd="mbrl__subcmd__watch"
                 ;;
+            mbrl__subcmd__eval,ball)
+                cmd="mbrl__subcmd__eval__subcmd__ball"
+                ;;
             mbrl__subcmd__eval,boards)
                 cmd="mbrl__subcmd__eval__subcmd__boards"
                 ;;
@@ -60,6 +63,9 @@ _mbrl() {
                 ;;
             mbrl__subcmd__eval,quick)
                 cmd="mbrl__subcmd__eval__subcmd__quick"
+                ;;
+            mbrl__subcmd__eval__subcmd__help,ball)
+                cmd="mbrl__subcmd__eval__subcmd__help__subcmd__ball"
                 ;;
             mbrl__subcmd__eval__subcmd__help,boards)
                 cmd="mbrl__subcmd__eval__subcmd__help__subcmd__boards"
@@ -105,6 +111,9 @@ _mbrl() {
                 ;;
             mbrl__subcmd__help,watch)
                 cmd="mbrl__subcmd__help__subcmd__watch"
+                ;;
+            mbrl__subcmd__help__subcmd__eval,ball)
+                cmd="mbrl__subcmd__help__subcmd__eval__subcmd__ball"
                 ;;
             mbrl__subcmd__help__subcmd__eval,boards)
                 cmd="mbrl__subcmd__help__subcmd__eval__subcmd__boards"
@@ -234,12 +243,58 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval)
-            opts="-q -h -V --seed --threads --tui --no-tui --quiet --help --version quick dataset boards embodied pendulum-swingup help"
+            opts="-q -h -V --seed --threads --tui --no-tui --quiet --help --version quick dataset boards embodied ball pendulum-swingup help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
             fi
             case "${prev}" in
+                --seed)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mbrl__subcmd__eval__subcmd__ball)
+            opts="-q -h -V --model --train-shots --augment-rotations --test-shots --unseen-shots --out --seed --threads --tui --no-tui --quiet --help --version"
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                --model)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --train-shots)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --augment-rotations)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --test-shots)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --unseen-shots)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --out)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 --seed)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
@@ -358,8 +413,22 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__help)
-            opts="quick dataset boards embodied pendulum-swingup help"
+            opts="quick dataset boards embodied ball pendulum-swingup help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mbrl__subcmd__eval__subcmd__help__subcmd__ball)
+            opts=""
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 4 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
             fi
@@ -628,8 +697,22 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__help__subcmd__eval)
-            opts="quick dataset boards embodied pendulum-swingup"
+            opts="quick dataset boards embodied ball pendulum-swingup"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mbrl__subcmd__help__subcmd__eval__subcmd__ball)
+            opts=""
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 4 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
             fi

@@ -93,3 +93,43 @@ fn csv_recordings_are_filtered_and_bad_ones_rejected() {
         .unwrap();
     assert_one_line_error(&out, &["sideways", "unseen-5"]);
 }
+
+#[test]
+fn eval_ball_compares_models_and_the_baseline() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = mbrl(dir.path())
+        .args([
+            "eval",
+            "ball",
+            "--model",
+            "thesis",
+            "--model",
+            "initial",
+            "--train-shots",
+            "25",
+            "--augment-rotations",
+            "3",
+        ])
+        .args(["--test-shots", "25", "--unseen-shots", "6", "--out", "rep", "-q"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr_of(&out));
+    for file in ["report.md", "summary.csv", "errors.csv", "error_vs_horizon.png", "trajectories.png", "config.json"] {
+        assert!(dir.path().join("rep").join(file).is_file(), "missing {file}");
+    }
+    let summary = std::fs::read_to_string(dir.path().join("rep/summary.csv")).unwrap();
+    let median = |method: &str, group: &str| -> f64 {
+        summary
+            .lines()
+            .find(|l| l.starts_with(&format!("{method},{group},1.000,")))
+            .and_then(|l| l.split(',').nth(5))
+            .and_then(|v| v.parse().ok())
+            .unwrap_or_else(|| panic!("no 1 s row for {method}/{group}:\n{summary}"))
+    };
+    // The generating parameters predict far better than the untrained initial ones (Table C.1).
+    for group in ["default", "unseen"] {
+        assert!(median("thesis", group) < 0.5 * median("initial", group), "{summary}");
+    }
+    let report = std::fs::read_to_string(dir.path().join("rep/report.md")).unwrap();
+    assert!(report.contains("Impact matrix C of `thesis`") && report.contains("-0.92"), "{report}");
+}

@@ -14,6 +14,7 @@ const SUBCOMMANDS: &[&[&str]] = &[
     &["eval", "pendulum-swingup"],
     &["eval", "boards"],
     &["eval", "embodied"],
+    &["eval", "ball"],
     &["solve-board"],
     &["filter"],
     &["predict"],

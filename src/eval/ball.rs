@@ -82,7 +82,13 @@ pub struct ErrorSummary {
     pub q90: f64,
 }
 
-fn shots(orientation: Orientation, count: usize, augment: usize, seed: u64, monitor: &dyn Monitor) -> Result<Vec<Recording>> {
+fn shots(
+    orientation: Orientation,
+    count: usize,
+    augment: usize,
+    seed: u64,
+    monitor: &dyn Monitor,
+) -> Result<Vec<Recording>> {
     let settings = BallCollectSettings {
         trajectories: count,
         orientation,
@@ -99,14 +105,26 @@ pub fn datasets(
     seed: u64,
     monitor: &dyn Monitor,
 ) -> Result<(Vec<Recording>, Vec<(String, Vec<Recording>)>)> {
-    let train = shots(Orientation::Default, settings.train_shots, settings.augment_rotations, derive_seed(seed, &[0]), monitor)?;
+    let train = shots(
+        Orientation::Default,
+        settings.train_shots,
+        settings.augment_rotations,
+        derive_seed(seed, &[0]),
+        monitor,
+    )?;
     let mut tests = vec![(
         "default".to_string(),
         shots(Orientation::Default, settings.test_shots_default, 0, derive_seed(seed, &[1]), monitor)?,
     )];
     let mut unseen = Vec::new();
     for k in 1..=5u8 {
-        unseen.extend(shots(Orientation::Unseen(k), settings.test_shots_unseen, 0, derive_seed(seed, &[2, k as u64]), monitor)?);
+        unseen.extend(shots(
+            Orientation::Unseen(k),
+            settings.test_shots_unseen,
+            0,
+            derive_seed(seed, &[2, k as u64]),
+            monitor,
+        )?);
     }
     tests.push(("unseen".to_string(), unseen));
     Ok((train, tests))
@@ -151,7 +169,11 @@ pub fn evaluate(
         monitor.message(&format!("fitting the {name} on {} training trajectories", train.len()));
         let base = RidgeBaseline::fit(
             &train,
-            &BaselineSettings { horizon_frames: max_horizon, use_launcher_info: launcher, ..BaselineSettings::default() },
+            BaselineSettings {
+                horizon_frames: max_horizon,
+                use_launcher_info: launcher,
+                ..BaselineSettings::default()
+            },
         )?;
         methods.push(Method { name: name.to_string(), predictor: Predictor::Baseline(base) });
     }
@@ -171,7 +193,13 @@ pub fn evaluate(
                     let err = method.predictor.predict(rec, cut, h as usize).and_then(|p| prediction_error(&p, rec));
                     // A method that cannot predict a trajectory scores as infinitely wrong, not as absent.
                     let err = err.unwrap_or(f64::INFINITY);
-                    errors.push(vec![method.name.clone(), group.clone(), format!("{:.3}", h as f64 / FRAME_RATE), rec.id.to_string(), format!("{err:.6}")]);
+                    errors.push(vec![
+                        method.name.clone(),
+                        group.clone(),
+                        format!("{:.3}", h as f64 / FRAME_RATE),
+                        rec.id.to_string(),
+                        format!("{err:.6}"),
+                    ]);
                     errs.push(err);
                 }
                 let q = |p| quantile(&errs, p).unwrap_or(f64::NAN);
@@ -193,10 +221,22 @@ pub fn evaluate(
     let summary_rows: Vec<Vec<String>> = rows
         .iter()
         .map(|r| {
-            vec![r.method.clone(), r.group.clone(), format!("{:.3}", r.horizon_s), r.count.to_string(), format!("{:.4}", r.q10), format!("{:.4}", r.median), format!("{:.4}", r.q90)]
+            vec![
+                r.method.clone(),
+                r.group.clone(),
+                format!("{:.3}", r.horizon_s),
+                r.count.to_string(),
+                format!("{:.4}", r.q10),
+                format!("{:.4}", r.median),
+                format!("{:.4}", r.q90),
+            ]
         })
         .collect();
-    write_csv(&run.file("summary.csv"), &["method", "group", "horizon_s", "trajectories", "q10_m", "median_m", "q90_m"], &summary_rows)?;
+    write_csv(
+        &run.file("summary.csv"),
+        &["method", "group", "horizon_s", "trajectories", "q10_m", "median_m", "q90_m"],
+        &summary_rows,
+    )?;
     let bands: Vec<Band> = methods
         .iter()
         .flat_map(|m| tests.iter().map(move |(g, _)| (m.name.clone(), g.clone())))
@@ -209,7 +249,13 @@ pub fn evaluate(
                 .collect(),
         })
         .collect();
-    band_plot(&run.file("error_vs_horizon.png"), "Prediction error vs horizon (median, 10-90 %)", "horizon [s]", "error [m]", &bands)?;
+    band_plot(
+        &run.file("error_vs_horizon.png"),
+        "Prediction error vs horizon (median, 10-90 %)",
+        "horizon [s]",
+        "error [m]",
+        &bands,
+    )?;
     trajectory_plot(&run.file("trajectories.png"), &methods, &tests)?;
     let md = report_markdown(settings, &methods, &rows);
     let path = run.file("report.md");
@@ -218,36 +264,43 @@ pub fn evaluate(
     Ok(BallEvalSummary { rows })
 }
 
-/// Top-down view of a few unseen-pose test shots: measurements, the filtered part and the 1 s prediction
-/// of the first EKF method.
+/// Side view (y, z) of a few test shots: measurements, the filtered part and the 1 s prediction of the
+/// first EKF method; the side view shows the bounce, where prediction is hardest.
 fn trajectory_plot(path: &Path, methods: &[Method], tests: &[(String, Vec<Recording>)]) -> Result<()> {
     let Some(Method { predictor: Predictor::Ekf(model), name }) = methods.first() else { return Ok(()) };
     let mut series = Vec::new();
-    for rec in tests.iter().flat_map(|(_, r)| r.iter().step_by(37)).take(4) {
+    for (group, rec) in tests.iter().flat_map(|(g, r)| r.iter().step_by(37).take(2).map(move |r| (g, r))) {
         let Some(cut) = protocol_cut(rec, 180) else { continue };
         series.push(Series {
-            name: format!("#{} measured", rec.id),
-            points: rec.positions.iter().flatten().map(|p| (p[0], p[1])).collect(),
+            name: format!("{group} #{} measured", rec.id),
+            points: rec.positions.iter().flatten().map(|p| (p[1], p[2])).collect(),
         });
         if let Ok(track) = filter_recording(model, rec, Some(cut)) {
             series.push(Series {
-                name: format!("#{} filtered", rec.id),
-                points: track.beliefs.iter().map(|b| (b.mean[0], b.mean[1])).collect(),
+                name: format!("{group} #{} filtered", rec.id),
+                points: track.beliefs.iter().map(|b| (b.mean[1], b.mean[2])).collect(),
             });
             if let Some(b) = track.beliefs.last() {
                 let pred = predict_ahead(model, b, *track.frames.last().unwrap_or(&cut), 180);
                 series.push(Series {
-                    name: format!("#{} predicted ({name})", rec.id),
-                    points: pred.iter().filter(|p| p.frame <= *rec.frames.last().unwrap_or(&0)).map(|p| (p.position[0], p.position[1])).collect(),
+                    name: format!("{group} #{} predicted ({name})", rec.id),
+                    points: pred
+                        .iter()
+                        .filter(|p| p.frame <= *rec.frames.last().unwrap_or(&0))
+                        .map(|p| (p.position[0], p.position[1]))
+                        .collect(),
                 });
             }
         }
     }
-    line_plot(path, "Test shots seen from above", "x [m]", "y [m]", &series)
+    line_plot(path, "Test shots from the side", "y [m]", "z [m]", &series)
 }
 
 fn format_c(c: &[[f64; 6]; 6]) -> String {
-    c.iter().map(|row| format!("| {} |", row.iter().map(|v| format!("{v:6.2}")).collect::<Vec<_>>().join(" | "))).collect::<Vec<_>>().join("\n")
+    c.iter()
+        .map(|row| format!("| {} |", row.iter().map(|v| format!("{v:6.2}")).collect::<Vec<_>>().join(" | ")))
+        .collect::<Vec<_>>()
+        .join("\n")
 }
 
 fn report_markdown(settings: &BallEvalSettings, methods: &[Method], rows: &[ErrorSummary]) -> String {
@@ -263,7 +316,13 @@ fn report_markdown(settings: &BallEvalSettings, methods: &[Method], rows: &[Erro
     for r in rows.iter().filter(|r| (r.horizon_s * 10.0).round() as i64 % 5 == 0) {
         md.push_str(&format!(
             "| {} | {} | {:.1} | {} | {:.1} | {:.1} | {:.1} |\n",
-            r.method, r.group, r.horizon_s, r.count, 100.0 * r.q10, 100.0 * r.median, 100.0 * r.q90
+            r.method,
+            r.group,
+            r.horizon_s,
+            r.count,
+            100.0 * r.q10,
+            100.0 * r.median,
+            100.0 * r.q90
         ));
     }
     md.push_str("\nAll horizons: `summary.csv`; per trajectory: `errors.csv`.\n\n![error vs horizon](error_vs_horizon.png)\n\n![trajectories](trajectories.png)\n");
@@ -272,6 +331,9 @@ fn report_markdown(settings: &BallEvalSettings, methods: &[Method], rows: &[Erro
             md.push_str(&format!("\n## Impact matrix C of `{}`\n\nRows/columns: v_x, v_y, v_z, ω_x, ω_y, ω_z.\n\n|  |  |  |  |  |  |\n|---|---|---|---|---|---|\n{}\n", m.name, format_c(&model.params().c)));
         }
     }
-    md.push_str(&format!("\n## Thesis eq. 6.26 for comparison\n\n|  |  |  |  |  |  |\n|---|---|---|---|---|---|\n{}\n", format_c(&BallModelParams::thesis_learned().c)));
+    md.push_str(&format!(
+        "\n## Thesis eq. 6.26 for comparison\n\n|  |  |  |  |  |  |\n|---|---|---|---|---|---|\n{}\n",
+        format_c(&BallModelParams::thesis_learned().c)
+    ));
     md
 }

@@ -1,5 +1,6 @@
 //! Protocols that reproduce the thesis' experiments and write reports (markdown + CSV + PNG).
 
+pub mod ball;
 pub mod boards;
 pub mod dataset_report;
 pub mod plot;

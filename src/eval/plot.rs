@@ -115,7 +115,9 @@ pub fn band_plot(path: &Path, title: &str, x_label: &str, y_label: &str, bands: 
             let color = Palette99::pick(i).to_rgba();
             let mut outline: Vec<(f64, f64)> = band.points.iter().map(|p| (p.0, p.3)).collect();
             outline.extend(band.points.iter().rev().map(|p| (p.0, p.1)));
-            chart.draw_series(std::iter::once(Polygon::new(outline, color.mix(0.15)))).map_err(|e| plot_err(path, e))?;
+            chart
+                .draw_series(std::iter::once(Polygon::new(outline, color.mix(0.15))))
+                .map_err(|e| plot_err(path, e))?;
             chart
                 .draw_series(LineSeries::new(band.points.iter().map(|p| (p.0, p.2)), color.stroke_width(2)))
                 .map_err(|e| plot_err(path, e))?

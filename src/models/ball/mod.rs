@@ -19,6 +19,7 @@
 //! assert_eq!(next_second.len(), 180);
 //! ```
 
+pub mod baseline;
 pub mod checkpoint;
 mod error;
 mod flight;

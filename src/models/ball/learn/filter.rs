@@ -46,10 +46,12 @@ pub fn log_likelihoods(
             // A missing measurement is a prediction alone.
             mean = mean.mask_where(row_mask(measured, [b, 11], device), mean_u);
             cov = cov.mask_where(row_mask(measured, [b, 11, 11], device), cov_u);
+            let missing: Vec<bool> = measured.iter().map(|m| !m).collect();
+            per_slot.push(ll.mask_fill(row_mask(&missing, [b], device), 0.0));
         } else {
             (mean, cov) = (mean_u, cov_u);
+            per_slot.push(ll);
         }
-        per_slot.push(ll);
     }
     Ok(Tensor::stack(per_slot, 1))
 }
