@@ -4,8 +4,12 @@
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use mbrl::data::ball_io::{Recording, RecordingInfo};
+use mbrl::envs::ball::{simulate, CameraModel, LaunchParams, Orientation};
 use mbrl::filtering::{forecast, forecast_means, predict, update, Vector};
+use mbrl::models::ball::track::filter_recording;
 use mbrl::models::ball::{initial_belief, BallModel, BallModelParams, Phase, SpinPrior};
+use rand::SeedableRng;
 
 fn bench(c: &mut Criterion) {
     let model = BallModel::new(BallModelParams::thesis_learned()).unwrap();
@@ -31,6 +35,21 @@ fn bench(c: &mut Criterion) {
     c.bench_function("ball_forecast_1s_with_covariance", |b| b.iter(|| forecast(&model, black_box(&start), 180)));
     c.bench_function("ball_forecast_1s_mean_only", |b| {
         b.iter(|| forecast_means(&model, black_box(&start.mean), Phase::BeforeImpact, 180))
+    });
+
+    // A whole simulated shot (about 200 frames with a bounce and lost frames), filtered from its first two
+    // measurements, as `mbrl filter` does per trajectory.
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
+    let shot = simulate(&LaunchParams::sample(Orientation::Default, &mut rng), &CameraModel::default(), &mut rng);
+    let recording = Recording {
+        id: 0,
+        frames: shot.frame_indices.clone(),
+        positions: shot.positions.clone(),
+        truth: None,
+        info: RecordingInfo::default(),
+    };
+    c.bench_function(&format!("ball_filter_whole_trajectory_{}_frames", recording.frames.len()), |b| {
+        b.iter(|| filter_recording(&model, black_box(&recording), None).unwrap())
     });
 }
 

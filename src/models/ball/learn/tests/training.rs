@@ -58,16 +58,20 @@ fn scratch_training() {
     eprintln!("mean incoming v, w {vin:?}");
     let chunks = cut_chunks(&recs, 50, &physics).unwrap();
     let held: Vec<Chunk> = chunks.iter().step_by(23).cloned().collect();
-    for (launcher, bs) in [(false, 16usize), (true, 16), (false, 64)] {
+    let mut init = crate::models::ball::BallModelParams::thesis_learned();
+    init.c = crate::models::ball::BallModelParams::initial().c;
+    init.a_d0 = 0.1f64.sqrt();
+    init.a_m0 = 0.1f64.sqrt();
+    for (launcher, bs) in [(false, 16usize), (true, 16), (false, 32)] {
         let device = training_device();
         let net = launcher.then(|| SpinNet::init(&mut rand_chacha::ChaCha8Rng::seed_from_u64(3), &device));
-        let mut model = BallParamsModule::from_params(&crate::models::ball::BallModelParams::initial(), net, &device);
+        let mut model = BallParamsModule::from_params(&init, net, &device);
         let mut opt = AdamConfig::new().with_epsilon(1e-8).init();
         let mut order: Vec<usize> = (0..chunks.len()).collect();
         order.shuffle(&mut rng);
         let start = Instant::now();
-        for step in 0..=400usize {
-            if step % 50 == 0 {
+        for step in 0..=200usize {
+            if step % 25 == 0 {
                 let p = model.to_params(&physics);
                 let w = model.spin_net.as_ref().map(|n| n.weights());
                 let vz_out: f64 = (0..3).map(|j| p.c[2][j] * vin[j]).sum();
