@@ -9,6 +9,7 @@ mod filter;
 mod plan;
 mod predict;
 mod solve_board;
+mod train;
 mod watch;
 
 use clap::{Parser, Subcommand};
@@ -40,6 +41,7 @@ pub struct Cli {
 enum Command {
     Collect(collect::CollectArgs),
     Plan(plan::PlanArgs),
+    Train(train::TrainArgs),
     Filter(filter::FilterArgs),
     Predict(predict::PredictArgs),
     SolveBoard(solve_board::SolveBoardArgs),
@@ -53,6 +55,7 @@ fn main() {
     let outcome = common::init_threads(&cli.global).and_then(|()| match cli.command {
         Command::Collect(args) => collect::run(&cli.global, args),
         Command::Plan(args) => plan::run(&cli.global, args),
+        Command::Train(args) => train::run(&cli.global, args),
         Command::Filter(args) => filter::run(&cli.global, args),
         Command::Predict(args) => predict::run(&cli.global, args),
         Command::SolveBoard(args) => solve_board::run(&cli.global, args),

@@ -40,6 +40,9 @@ _mbrl() {
             mbrl,solve-board)
                 cmd="mbrl__subcmd__solve__subcmd__board"
                 ;;
+            mbrl,train)
+                cmd="mbrl__subcmd__train"
+                ;;
             mbrl,watch)
                 cmd="mbrl__subcmd__watch"
                 ;;
@@ -109,6 +112,9 @@ _mbrl() {
             mbrl__subcmd__help,solve-board)
                 cmd="mbrl__subcmd__help__subcmd__solve__subcmd__board"
                 ;;
+            mbrl__subcmd__help,train)
+                cmd="mbrl__subcmd__help__subcmd__train"
+                ;;
             mbrl__subcmd__help,watch)
                 cmd="mbrl__subcmd__help__subcmd__watch"
                 ;;
@@ -137,7 +143,7 @@ _mbrl() {
 
     case "${cmd}" in
         mbrl)
-            opts="-q -h -V --seed --threads --tui --no-tui --quiet --help --version collect plan filter predict solve-board eval watch completions help"
+            opts="-q -h -V --seed --threads --tui --no-tui --quiet --help --version collect plan train filter predict solve-board eval watch completions help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 1 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -655,7 +661,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__help)
-            opts="collect plan filter predict solve-board eval watch completions help"
+            opts="collect plan train filter predict solve-board eval watch completions help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -864,6 +870,20 @@ _mbrl() {
             COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
             return 0
             ;;
+        mbrl__subcmd__help__subcmd__train)
+            opts=""
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
         mbrl__subcmd__help__subcmd__watch)
             opts=""
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
@@ -1030,6 +1050,56 @@ _mbrl() {
                     return 0
                     ;;
                 --max-memory-mib)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --seed)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mbrl__subcmd__train)
+            opts="-q -h -V --method --data --out --steps --batch --chunk --lr --launcher-prior --seed --threads --tui --no-tui --quiet --help --version"
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                --method)
+                    COMPREPLY=($(compgen -W "ball-ekf" -- "${cur}"))
+                    return 0
+                    ;;
+                --data)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --out)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --steps)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --batch)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --chunk)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --lr)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;

@@ -17,6 +17,7 @@ const SUBCOMMANDS: &[&[&str]] = &[
     &["eval", "ball"],
     &["solve-board"],
     &["filter"],
+    &["train"],
     &["predict"],
     &["watch"],
     &["completions"],

@@ -4,14 +4,14 @@ use burn::tensor::{Device, Tensor};
 
 use super::chunks::Chunk;
 use super::device::tensor;
-use super::rotation::launch_rotation;
+use super::rotation::{launch_rotation, motor_actuations};
 use crate::error::{Error, Result};
 
 /// What the launcher spin prior needs per sample.
 pub struct LauncherInputs {
-    /// Motor actuations s_m [B, 3].
+    /// Motor actuations s_m \[B, 3\].
     pub motors: Tensor<2>,
-    /// R_rot [B, 3, 3].
+    /// R_rot \[B, 3, 3\].
     pub rotation: Tensor<3>,
 }
 
@@ -21,11 +21,11 @@ pub struct Batch {
     pub steps: usize,
     pub m1: Tensor<2>,
     pub m2: Tensor<2>,
-    /// Per slot [B, 3]; zeros where a sample has no measurement (its update is computed and discarded).
+    /// Per slot \[B, 3\]; zeros where a sample has no measurement (its update is computed and discarded).
     pub measurements: Vec<Tensor<2>>,
     /// Per slot, per sample: whether it was measured.
     pub measured: Vec<Vec<bool>>,
-    /// [B, steps]: 1 / (measurements in the chunk · B) where measured, 0 elsewhere. −Σ weights ⊙ log-likelihoods is
+    /// \[B, steps\]: 1 / (measurements in the chunk · B) where measured, 0 elsewhere. −Σ weights ⊙ log-likelihoods is
     /// the batch mean of the per-chunk mean innovation NLL.
     pub weights: Tensor<2>,
     pub after_impact: Vec<bool>,
@@ -73,7 +73,7 @@ fn launcher_inputs(chunks: &[&Chunk], device: &Device) -> Result<LauncherInputs>
                 c.recording
             ))
         })?;
-        motors.extend(c.motor_actuations().unwrap_or_default());
+        motors.extend(motor_actuations(&side));
         rotation.extend(launch_rotation(&side).iter().flatten());
     }
     let b = chunks.len();

@@ -1,21 +1,15 @@
 //! The device the ball EKF learns on (burn's flex CPU backend with autodiff) and f64 tensor constructors.
 
-use std::sync::Once;
-
-use burn::tensor::{Bool, DType, Device, FloatDType, Int, Tensor, TensorData};
+use burn::tensor::{Bool, DType, Device, Int, Tensor, TensorData};
 
 /// Flex CPU device with autodiff. The filter subtracts nearly equal covariances (P − K H P) and takes logarithms
-/// of 3×3 determinants around 1e-15, which f32 cannot resolve, so the device's default float is set to f64 once
-/// per process. Other parts of the process may have configured (or used) the shared flex device first, e.g. for
-/// f32 networks; the constructors below therefore name f64 explicitly, and this module never depends on the
-/// default.
+/// of 3×3 determinants around 1e-15, which f32 cannot resolve, so everything here is f64. burn 0.22 offers two
+/// ways: `Device::configure(FloatDType::F64)`, which fixes the default float of the process-wide flex device once
+/// and for all (a second call fails), or an explicit dtype at each tensor's creation, which later operations
+/// inherit. This module does the latter and leaves the device's default alone: networks elsewhere in the same
+/// process train on the same flex device in f32, and whichever module configured it first would otherwise decide
+/// the precision of the other.
 pub fn training_device() -> Device {
-    static CONFIGURE: Once = Once::new();
-    CONFIGURE.call_once(|| {
-        let mut device = Device::flex();
-        // An error only means the defaults were fixed earlier; explicit dtypes make that harmless.
-        let _ = device.configure(FloatDType::F64);
-    });
     Device::flex().autodiff()
 }
 

@@ -13,7 +13,7 @@ use super::update::update;
 use crate::error::Result;
 use crate::models::ball::{BallPhysics, Phase};
 
-/// log N(m_n | μ_n|1:n−1, S_n) [B, steps] for every slot, 0 where a slot has no measurement.
+/// log N(m_n | μ_n|1:n−1, S_n) \[B, steps\] for every slot, 0 where a slot has no measurement.
 pub fn log_likelihoods(
     model: &BallParamsModule,
     batch: &Batch,
@@ -67,7 +67,7 @@ pub fn chunk_loss(
 }
 
 /// C' = blockdiag(I₃, C, 1, 1).
-fn impact_map(c: Tensor<2>, device: &Device) -> Tensor<2> {
+pub(super) fn impact_map(c: Tensor<2>, device: &Device) -> Tensor<2> {
     Tensor::cat(
         vec![
             Tensor::cat(vec![eye(3, device), zeros([3, 8], device)], 1),

@@ -9,7 +9,7 @@
 use burn::tensor::{Device, Tensor};
 
 use super::device::{row_mask, tensor};
-use super::flight::{flight, free_jacobian, free_step, Consts, StepLen};
+use super::flight::{flight, free_jacobian, free_step, Consts, Flight, StepLen};
 use crate::models::ball::impact::crosses_table;
 use crate::models::ball::{BallPhysics, BallState, Phase};
 
@@ -21,13 +21,13 @@ const MIN_HEIGHT_ABOVE_TABLE: f64 = 1e-4;
 pub struct ImpactPlan {
     pub impacting: Vec<bool>,
     /// h was clamped to −1e-4 (∂Δ_imp/∂p_z = 0).
-    clamped_height: Vec<bool>,
+    pub clamped_height: Vec<bool>,
     /// Δ_imp came out beyond the step and was cut to ΔT (zero gradient).
-    capped: Vec<bool>,
+    pub capped: Vec<bool>,
 }
 
 impl ImpactPlan {
-    /// Decides from the means `x` (row-major [B, 11]) which samples hit the table in this step.
+    /// Decides from the means `x` (row-major \[B, 11\]) which samples hit the table in this step.
     pub fn new(x: &[f64], phases: &[Phase], physics: &BallPhysics) -> Self {
         let n = phases.len();
         let mut plan = ImpactPlan { impacting: vec![false; n], clamped_height: vec![false; n], capped: vec![false; n] };
@@ -53,9 +53,10 @@ impl ImpactPlan {
 }
 
 /// g(x) and ∂g/∂x for the impact branch, for every sample; only the rows of impacting samples are meaningful.
-/// `c_full` is C' = blockdiag(I₃, C, 1, 1) [11, 11].
+/// `before` holds the flight quantities at x; `c_full` is C' = blockdiag(I₃, C, 1, 1) \[11, 11\].
 pub fn impact_step(
     x: &Tensor<2>,
+    before: &Flight,
     c_full: &Tensor<2>,
     plan: &ImpactPlan,
     k: &Consts,
@@ -89,16 +90,15 @@ pub fn impact_step(
     };
     let d_toi = (d_pz * unit(2) + d_vz * unit(5)).unsqueeze_dim::<3>(1);
 
-    let before = flight(x, k, physics);
-    let at = StepLen::PerSample(t_imp.clone());
-    let x_minus = free_step(x, &before, &at);
+    let at = StepLen::PerSample(Box::new(t_imp.clone()));
+    let x_minus = free_step(x, before, &at);
     // J2 = C' (J_z(z, Δimp) + J_Δt(z) ∂Δimp/∂z).
-    let j_before = free_jacobian(&before, &at, k) + before.rate.clone().unsqueeze_dim::<3>(2).matmul(d_toi.clone());
+    let j_before = free_jacobian(before, &at, k) + before.rate.clone().unsqueeze_dim::<3>(2).matmul(d_toi.clone());
     let j_before = c_full.clone().unsqueeze::<3>().matmul(j_before);
     let x_plus = x_minus.matmul(c_full.clone().transpose());
 
     let after = flight(&x_plus, k, physics);
-    let rest = StepLen::PerSample(t_imp.neg().add_scalar(physics.dt));
+    let rest = StepLen::PerSample(Box::new(t_imp.neg().add_scalar(physics.dt)));
     let next = free_step(&x_plus, &after, &rest);
     // J = J_z(z⁺, Δrem) J2 − J_Δt(z⁺, Δrem) ∂Δimp/∂z, since ∂Δrem/∂z = −∂Δimp/∂z.
     let jac = free_jacobian(&after, &rest, k).matmul(j_before) - after.rate.unsqueeze_dim::<3>(2).matmul(d_toi);

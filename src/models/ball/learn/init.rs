@@ -11,7 +11,7 @@ use super::spin_net::SpinNet;
 use crate::error::{Error, Result};
 use crate::models::ball::BallPhysics;
 
-/// Mean [B, 11] and covariance [B, 11, 11] at m_2: p = m_2, v by finite difference, a_d, a_m at their learned
+/// Mean \[B, 11\] and covariance \[B, 11, 11\] at m_2: p = m_2, v by finite difference, a_d, a_m at their learned
 /// means, and the spin from the broad prior (no network) or from the launcher network.
 pub fn initial_belief(
     batch: &Batch,
@@ -57,7 +57,7 @@ pub fn initial_belief(
     Ok((mean, cov))
 }
 
-/// ω = R ω→x, Σ_ω = R Σ→x Rᵀ before the bounce; ω = 0, Σ_ω = R diag([σ_ω,ai]⊕) Rᵀ after it (rotated as in the
+/// ω = R ω→x, Σ_ω = R Σ→x Rᵀ before the bounce; ω = 0, Σ_ω = R diag(\[σ_ω,ai\]⊕) Rᵀ after it (rotated as in the
 /// authors' release, see `SpinPrior::Launcher`).
 fn launcher_spin(
     net: &SpinNet,

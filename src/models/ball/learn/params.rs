@@ -9,26 +9,26 @@ use super::positive::{inverse_softplus, softplus, softplus_tensor};
 use super::spin_net::SpinNet;
 use crate::models::ball::{BallModelParams, BallPhysics};
 
-/// Ψ without the physical constants. Variances are held as raw values x with variance [x]⊕ (Table C.1 lists
-/// them as inv[·]⊕); C, a_d0 and a_m0 are unconstrained.
+/// Ψ without the physical constants. Variances are held as raw values x with variance \[x\]⊕ (Table C.1 lists
+/// them as inv\[·\]⊕); C, a_d0 and a_m0 are unconstrained.
 #[derive(Module, Debug)]
 pub struct BallParamsModule {
-    /// Impact matrix, row-major [6, 6].
+    /// Impact matrix, row-major \[6, 6\].
     pub c: Param<Tensor<2>>,
-    /// Raw diag(Q) [11].
+    /// Raw diag(Q) \[11\].
     pub q: Param<Tensor<1>>,
-    /// Raw diag(R) [3].
+    /// Raw diag(R) \[3\].
     pub r: Param<Tensor<1>>,
-    /// Raw Σ_p, Σ_v [3] each.
+    /// Raw Σ_p, Σ_v \[3\] each.
     pub init_pos: Param<Tensor<1>>,
     pub init_vel: Param<Tensor<1>>,
-    /// Raw σ_ω (broad spin prior) and σ_ω,ai (after the impact, launcher prior) [3] each.
+    /// Raw σ_ω (broad spin prior) and σ_ω,ai (after the impact, launcher prior) \[3\] each.
     pub init_spin: Param<Tensor<1>>,
     pub init_spin_after_impact: Param<Tensor<1>>,
-    /// Initial means of a_d and a_m [1] each.
+    /// Initial means of a_d and a_m \[1\] each.
     pub a_d0: Param<Tensor<1>>,
     pub a_m0: Param<Tensor<1>>,
-    /// Raw initial variances of a_d and a_m [1] each.
+    /// Raw initial variances of a_d and a_m \[1\] each.
     pub a_d_var: Param<Tensor<1>>,
     pub a_m_var: Param<Tensor<1>>,
     /// The launcher spin network of C.1.3; `None` trains with the broad spin prior.

@@ -1,9 +1,9 @@
-//! The thesis' positivity map [x]⊕ = log(1 + eˣ) + 1e-6 (6.4.3) and its inverse: variances are optimized as
+//! The thesis' positivity map \[x\]⊕ = log(1 + eˣ) + 1e-6 (6.4.3) and its inverse: variances are optimized as
 //! unconstrained raw values and stored as variances.
 
 use burn::tensor::Tensor;
 
-/// Smallest variance [·]⊕ can produce.
+/// Smallest variance \[·\]⊕ can produce.
 pub const FLOOR: f64 = 1e-6;
 
 /// Variances at (or, from hand-edited files, below) the floor have no finite preimage; Table C.2 lists several

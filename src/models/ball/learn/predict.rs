@@ -11,9 +11,9 @@ use crate::models::ball::{BallPhysics, Phase};
 /// Per-forward-pass inputs of the prediction that do not change between steps.
 pub struct PredictInputs<'a> {
     pub consts: &'a Consts,
-    /// C' = blockdiag(I₃, C, 1, 1) [11, 11].
+    /// C' = blockdiag(I₃, C, 1, 1) \[11, 11\].
     pub c_full: Tensor<2>,
-    /// diag(Q) as [1, 11, 11].
+    /// diag(Q) as \[1, 11, 11\].
     pub q: Tensor<3>,
     pub physics: &'a BallPhysics,
     pub device: &'a Device,
@@ -30,7 +30,7 @@ pub fn predict(mean: Tensor<2>, cov: Tensor<3>, phases: &mut [Phase], inp: &Pred
     if phases.contains(&Phase::BeforeImpact) {
         let plan = ImpactPlan::new(&values(&mean), phases, physics);
         if plan.any() {
-            let (next_imp, jac_imp) = impact_step(&mean, &inp.c_full, &plan, k, physics, inp.device);
+            let (next_imp, jac_imp) = impact_step(&mean, &f, &inp.c_full, &plan, k, physics, inp.device);
             next = next.mask_where(row_mask(&plan.impacting, [k.batch, 11], inp.device), next_imp);
             jac = jac.mask_where(row_mask(&plan.impacting, [k.batch, 11, 11], inp.device), jac_imp);
             for (phase, hit) in phases.iter_mut().zip(&plan.impacting) {

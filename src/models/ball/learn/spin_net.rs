@@ -1,5 +1,5 @@
-//! The spin initialization network of C.1.3: w = W₂ max(W₁ s_m, 0) ∈ ℝ⁶ from the motor actuations s_m ∈ [0, 1]³,
-//! with the canonical spin mean w[1:3] and covariance diag([w[4:6]]⊕) for a launch along +x. W₁ ∈ ℝ²⁵⁶ˣ³,
+//! The spin initialization network of C.1.3: w = W₂ max(W₁ s_m, 0) ∈ ℝ⁶ from the motor actuations s_m ∈ \[0, 1\]³,
+//! with the canonical spin mean w\[1:3\] and covariance diag(\[w\[4:6\]\]⊕) for a launch along +x. W₁ ∈ ℝ²⁵⁶ˣ³,
 //! W₂ ∈ ℝ⁶ˣ²⁵⁶, no biases (as the thesis writes it). The launch direction enters only through the rotation
 //! R_rot applied afterwards (`rotation`), so the network sees s_m alone, not all seven side-information values.
 
@@ -17,7 +17,7 @@ use crate::models::ball::SpinPrior;
 
 pub const HIDDEN: usize = 256;
 
-/// Weights stored transposed ([3, 256] and [256, 6]) so that a batch of row vectors multiplies from the left.
+/// Weights stored transposed (\[3, 256\] and \[256, 6\]) so that a batch of row vectors multiplies from the left.
 #[derive(Module, Debug)]
 pub struct SpinNet {
     pub w1_t: Param<Tensor<2>>,
@@ -26,7 +26,7 @@ pub struct SpinNet {
 
 impl SpinNet {
     /// torch.nn.Linear's default initialization U(±1/√fan_in), which the authors' PyTorch layers started from.
-    /// The outputs then start near 0: a canonical spin of about 0 with variance ≈ [0]⊕ = ln 2.
+    /// The outputs then start near 0: a canonical spin of about 0 with variance ≈ \[0\]⊕ = ln 2.
     pub fn init<R: Rng + ?Sized>(rng: &mut R, device: &Device) -> Self {
         let mut uniform = |n: usize, fan_in: usize| -> Vec<f64> {
             let bound = 1.0 / (fan_in as f64).sqrt();
@@ -51,7 +51,7 @@ impl SpinNet {
         })
     }
 
-    /// Canonical spin mean [B, 3] and variances [B, 3] for motor actuations [B, 3].
+    /// Canonical spin mean \[B, 3\] and variances \[B, 3\] for motor actuations \[B, 3\].
     pub fn forward(&self, s_m: Tensor<2>) -> (Tensor<2>, Tensor<2>) {
         let out = relu(s_m.matmul(self.w1_t.val())).matmul(self.w2_t.val());
         let b = out.dims()[0];
@@ -72,9 +72,9 @@ impl SpinNet {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SpinNetWeights {
-    /// W₁, row-major [256][3].
+    /// W₁, row-major \[256\]\[3\].
     pub w1: Vec<f64>,
-    /// W₂, row-major [6][256].
+    /// W₂, row-major \[6\]\[256\].
     pub w2: Vec<f64>,
 }
 

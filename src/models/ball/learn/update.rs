@@ -1,12 +1,12 @@
-//! The batched EKF correction with H = [I₃, 0] and the innovation log-likelihood log N(m | Hμ, S), the summand
+//! The batched EKF correction with H = \[I₃, 0\] and the innovation log-likelihood log N(m | Hμ, S), the summand
 //! of eq. 6.24.
 
 use burn::tensor::Tensor;
 
 use super::linalg::{inverse_3x3, symmetrize};
 
-/// Corrects every sample with its measurement m [B, 3]; `r` is diag(R) as [1, 3, 3]. Returns the corrected
-/// belief and log N(m | Hμ, S) [B]. As in the reference filter, the covariance update is (I − K H) Σ followed by
+/// Corrects every sample with its measurement m \[B, 3\]; `r` is diag(R) as \[1, 3, 3\]. Returns the corrected
+/// belief and log N(m | Hμ, S) \[B\]. As in the reference filter, the covariance update is (I − K H) Σ followed by
 /// symmetrization.
 pub fn update(mean: Tensor<2>, cov: Tensor<3>, m: Tensor<2>, r: &Tensor<3>) -> (Tensor<2>, Tensor<3>, Tensor<1>) {
     let [b, n] = mean.dims();

@@ -1,5 +1,6 @@
 //! burn's autodiff gradients of the batched loss against central differences of the nalgebra loss.
 
+use burn::tensor::DType;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
@@ -75,7 +76,11 @@ fn broad_prior_gradients_match_central_differences() {
     let exact = module.to_params(&start.physics);
     let refs: Vec<&Chunk> = chunks.iter().collect();
     let batch = Batch::new(&refs, false, &device).unwrap();
-    let grads = chunk_loss(&module, &batch, &start.physics, &device).unwrap().backward();
+    let loss = chunk_loss(&module, &batch, &start.physics, &device).unwrap();
+    let grads = loss.backward();
+    // f64 end to end, whatever the flex device's default float is in this process.
+    assert_eq!(loss.dtype(), DType::F64);
+    assert_eq!(module.c.val().grad(&grads).unwrap().dtype(), DType::F64);
     let h = 1e-6;
     for probe in probes() {
         let loss_at = |step: f64| {
