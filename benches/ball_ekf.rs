@@ -49,7 +49,7 @@ fn bench(c: &mut Criterion) {
         info: RecordingInfo::default(),
     };
     c.bench_function(&format!("ball_filter_whole_trajectory_{}_frames", recording.frames.len()), |b| {
-        b.iter(|| filter_recording(&model, black_box(&recording), None).unwrap())
+        b.iter(|| filter_recording(&model, black_box(&recording), None, &SpinPrior::Uninformed).unwrap())
     });
 }
 

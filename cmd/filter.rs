@@ -42,7 +42,7 @@ pub fn run(global: &GlobalArgs, args: FilterArgs) -> anyhow::Result<()> {
         let mut estimates = Vec::new();
         let mut likelihoods = Vec::new();
         for (k, rec) in recordings.iter().enumerate() {
-            let track = filter_recording(&model, rec, None)?;
+            let track = filter_recording(&model.model, rec, None, &model.prior(rec))?;
             likelihoods.push((rec.id, track.log_likelihood, track.frames.len()));
             let measured: std::collections::HashMap<u64, [f64; 3]> =
                 rec.frames.iter().zip(&rec.positions).filter_map(|(f, p)| p.map(|p| (*f, p))).collect();

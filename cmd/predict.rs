@@ -70,10 +70,10 @@ pub fn run(global: &GlobalArgs, args: PredictArgs) -> anyhow::Result<()> {
             let cut = args.from_frame.or_else(|| protocol_cut(rec, steps)).ok_or_else(|| {
                 mbrl::Error::InvalidInput(format!("trajectory {}: fewer than ten measurements to filter", rec.id))
             })?;
-            let track = filter_recording(&model, rec, Some(cut))?;
+            let track = filter_recording(&model.model, rec, Some(cut), &model.prior(rec))?;
             let (from_frame, belief) =
                 (*track.frames.last().unwrap_or(&cut), *track.beliefs.last().expect("start belief"));
-            let points = predict_ahead(&model, &belief, from_frame, steps as usize);
+            let points = predict_ahead(&model.model, &belief, from_frame, steps as usize);
             let start = [belief.mean[0], belief.mean[1], belief.mean[2]];
             let crossing = args.plane_y.and_then(|y| plane_crossing(&points, start, from_frame as f64 / FRAME_RATE, y));
             summaries.push((rec.id, from_frame, prediction_error(&points, rec), landing(&points, &belief), crossing));

@@ -133,3 +133,31 @@ fn eval_ball_compares_models_and_the_baseline() {
     let report = std::fs::read_to_string(dir.path().join("rep/report.md")).unwrap();
     assert!(report.contains("Impact matrix C of `thesis`") && report.contains("-0.92"), "{report}");
 }
+
+#[test]
+fn trained_checkpoints_are_usable_models() {
+    let dir = tempfile::tempdir().unwrap();
+    mbrl(dir.path())
+        .args(["collect", "--env", "ball", "--trajectories", "8", "--out", "t.mcap", "-q"])
+        .assert()
+        .success();
+    let out = mbrl(dir.path())
+        .args([
+            "train", "--method", "ball-ekf", "--data", "t.mcap", "--out", "models/b", "--steps", "15", "--batch", "16",
+            "-q",
+        ])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr_of(&out));
+    assert!(stdout_of(&out).contains("learned C"), "{}", stdout_of(&out));
+    for file in ["params.json", "config.json", "metrics.jsonl", "losses.csv", "loss.png"] {
+        assert!(dir.path().join("models/b").join(file).is_file(), "missing {file}");
+    }
+    let losses = std::fs::read_to_string(dir.path().join("models/b/losses.csv")).unwrap();
+    assert_eq!(losses.lines().count(), 16, "header + one loss per step");
+    let out = mbrl(dir.path()).args(["predict", "--model", "models/b", "--input", "t.mcap", "-q"]).output().unwrap();
+    assert!(out.status.success(), "{}", stderr_of(&out));
+    let out =
+        mbrl(dir.path()).args(["train", "--method", "ball-ekf", "--data", "t.mcap", "--lr", "nan"]).output().unwrap();
+    assert!(!out.status.success());
+}

@@ -15,8 +15,10 @@ use crate::data::collect_ball::{collect_ball, BallCollectSettings};
 use crate::envs::ball::Orientation;
 use crate::error::{Error, Result};
 use crate::models::ball::baseline::{BaselineSettings, RidgeBaseline};
+use crate::models::ball::checkpoint::LoadedBallModel;
+use crate::models::ball::learn::SpinNetWeights;
 use crate::models::ball::track::{filter_recording, predict_ahead, prediction_error, protocol_cut, PredictedPoint};
-use crate::models::ball::{BallModel, BallModelParams};
+use crate::models::ball::{BallModel, BallModelParams, SpinPrior};
 use crate::planning::seeding::derive_seed;
 use crate::run::atomic::write_atomic;
 use crate::run::dir::{Provenance, RunDir};
@@ -49,15 +51,26 @@ impl Default for BallEvalSettings {
 
 /// Something that predicts a recording's future from a cut frame.
 pub enum Predictor {
-    Ekf(BallModel),
+    /// The EKF; with a spin network its spin prior comes from the launcher settings.
+    Ekf {
+        model: BallModel,
+        spin_net: Option<SpinNetWeights>,
+    },
     Baseline(RidgeBaseline),
+}
+
+fn spin_prior(spin_net: &Option<SpinNetWeights>, rec: &Recording) -> SpinPrior {
+    match (spin_net, rec.info.side_info) {
+        (Some(net), Some(side)) => net.prior(&side),
+        _ => SpinPrior::Uninformed,
+    }
 }
 
 impl Predictor {
     fn predict(&self, rec: &Recording, cut: u64, steps: usize) -> Option<Vec<PredictedPoint>> {
         match self {
-            Predictor::Ekf(model) => {
-                let track = filter_recording(model, rec, Some(cut)).ok()?;
+            Predictor::Ekf { model, spin_net } => {
+                let track = filter_recording(model, rec, Some(cut), &spin_prior(spin_net, rec)).ok()?;
                 let belief = track.beliefs.last()?;
                 Some(predict_ahead(model, belief, *track.frames.last()?, steps))
             }
@@ -147,7 +160,7 @@ impl BallEvalSummary {
 /// report into `out_dir`.
 pub fn evaluate(
     settings: &BallEvalSettings,
-    ekf_models: Vec<(String, BallModel)>,
+    ekf_models: Vec<(String, LoadedBallModel)>,
     provenance: &Provenance,
     out_dir: &Path,
     monitor: &dyn Monitor,
@@ -156,15 +169,24 @@ pub fn evaluate(
     run.write_config(&serde_json::json!({
         "job": "eval ball",
         "settings": settings,
-        "models": ekf_models.iter().map(|(n, m)| serde_json::json!({"name": n, "params": m.params()})).collect::<Vec<_>>(),
+        "models": ekf_models.iter().map(|(n, m)| serde_json::json!({"name": n, "params": m.model.params()})).collect::<Vec<_>>(),
         "provenance": provenance,
     }))?;
     let metrics = run.metrics()?;
     let monitor = Tee { first: monitor, second: &metrics };
     let (train, tests) = datasets(settings, provenance.seed, &monitor)?;
     let max_horizon = settings.horizons.iter().copied().max().unwrap_or(180) as usize;
-    let mut methods: Vec<Method> =
-        ekf_models.into_iter().map(|(name, model)| Method { name, predictor: Predictor::Ekf(model) }).collect();
+    let mut methods = Vec::new();
+    for (name, loaded) in ekf_models {
+        // A checkpoint with a launcher network is scored both ways: the broad prior is its ablation.
+        if let Some(net) = loaded.spin_net {
+            methods.push(Method {
+                name: format!("{name} + launch info"),
+                predictor: Predictor::Ekf { model: loaded.model.clone(), spin_net: Some(net) },
+            });
+        }
+        methods.push(Method { name, predictor: Predictor::Ekf { model: loaded.model, spin_net: None } });
+    }
     for (name, launcher) in [("ridge baseline", false), ("ridge baseline + launch info", true)] {
         monitor.message(&format!("fitting the {name} on {} training trajectories", train.len()));
         let base = RidgeBaseline::fit(
@@ -267,7 +289,7 @@ pub fn evaluate(
 /// Side view (y, z) of a few test shots: measurements, the filtered part and the 1 s prediction of the
 /// first EKF method; the side view shows the bounce, where prediction is hardest.
 fn trajectory_plot(path: &Path, methods: &[Method], tests: &[(String, Vec<Recording>)]) -> Result<()> {
-    let Some(Method { predictor: Predictor::Ekf(model), name }) = methods.first() else { return Ok(()) };
+    let Some(Method { predictor: Predictor::Ekf { model, spin_net }, name }) = methods.first() else { return Ok(()) };
     let mut series = Vec::new();
     for (group, rec) in tests.iter().flat_map(|(g, r)| r.iter().step_by(37).take(2).map(move |r| (g, r))) {
         let Some(cut) = protocol_cut(rec, 180) else { continue };
@@ -275,7 +297,7 @@ fn trajectory_plot(path: &Path, methods: &[Method], tests: &[(String, Vec<Record
             name: format!("{group} #{} measured", rec.id),
             points: rec.positions.iter().flatten().map(|p| (p[1], p[2])).collect(),
         });
-        if let Ok(track) = filter_recording(model, rec, Some(cut)) {
+        if let Ok(track) = filter_recording(model, rec, Some(cut), &spin_prior(spin_net, rec)) {
             series.push(Series {
                 name: format!("{group} #{} filtered", rec.id),
                 points: track.beliefs.iter().map(|b| (b.mean[1], b.mean[2])).collect(),
@@ -327,7 +349,7 @@ fn report_markdown(settings: &BallEvalSettings, methods: &[Method], rows: &[Erro
     }
     md.push_str("\nAll horizons: `summary.csv`; per trajectory: `errors.csv`.\n\n![error vs horizon](error_vs_horizon.png)\n\n![trajectories](trajectories.png)\n");
     for m in methods {
-        if let Predictor::Ekf(model) = &m.predictor {
+        if let Predictor::Ekf { model, .. } = &m.predictor {
             md.push_str(&format!("\n## Impact matrix C of `{}`\n\nRows/columns: v_x, v_y, v_z, ω_x, ω_y, ω_z.\n\n|  |  |  |  |  |  |\n|---|---|---|---|---|---|\n{}\n", m.name, format_c(&model.params().c)));
         }
     }

@@ -21,8 +21,14 @@ fn model_error(what: impl std::fmt::Display) -> Error {
     Error::InvalidInput(format!("ball model: {what}"))
 }
 
-/// Filters `recording` up to and including frame `until` (all frames when `None`).
-pub fn filter_recording(model: &BallModel, recording: &Recording, until: Option<u64>) -> Result<Track> {
+/// Filters `recording` up to and including frame `until` (all frames when `None`), starting with the given
+/// spin prior (broad, or from the launcher settings).
+pub fn filter_recording(
+    model: &BallModel,
+    recording: &Recording,
+    until: Option<u64>,
+    prior: &SpinPrior,
+) -> Result<Track> {
     let measured: Vec<(usize, [f64; 3])> =
         recording.positions.iter().enumerate().filter_map(|(i, p)| p.map(|p| (i, p))).take(2).collect();
     let [(i1, m1), (i2, m2)] = measured[..] else {
@@ -33,7 +39,7 @@ pub fn filter_recording(model: &BallModel, recording: &Recording, until: Option<
     };
     let gap = u32::try_from(recording.frames[i2] - recording.frames[i1])
         .map_err(|_| Error::InvalidInput(format!("trajectory {}: first measurements too far apart", recording.id)))?;
-    let start = initial_belief(model.params(), m1, m2, gap, false, &SpinPrior::Uninformed).map_err(model_error)?;
+    let start = initial_belief(model.params(), m1, m2, gap, false, prior).map_err(model_error)?;
     let last = until.unwrap_or(u64::MAX);
     // One slot per camera frame after the second measurement; frames missing from the recording are
     // dropouts too.
@@ -146,7 +152,7 @@ mod tests {
     fn filtering_tracks_the_simulated_ball() {
         let model = BallModel::new(BallModelParams::thesis_learned()).unwrap();
         let rec = recording(3);
-        let track = filter_recording(&model, &rec, None).unwrap();
+        let track = filter_recording(&model, &rec, None, &SpinPrior::Uninformed).unwrap();
         assert_eq!(*track.frames.last().unwrap(), *rec.frames.last().unwrap());
         let truth = rec.truth.as_ref().unwrap();
         let last = track.beliefs.last().unwrap();
@@ -159,7 +165,7 @@ mod tests {
     fn prediction_lands_on_the_table_and_crosses_planes() {
         let model = BallModel::new(BallModelParams::thesis_learned()).unwrap();
         let rec = recording(4);
-        let track = filter_recording(&model, &rec, Some(rec.frames[0] + 20)).unwrap();
+        let track = filter_recording(&model, &rec, Some(rec.frames[0] + 20), &SpinPrior::Uninformed).unwrap();
         let belief = track.beliefs.last().unwrap();
         let points = predict_ahead(&model, belief, *track.frames.last().unwrap(), 180);
         let land = landing(&points, belief).expect("the shot lands on the table");

@@ -1,7 +1,6 @@
 //! Short training runs on simulated shots, and the trainer's contract (monitor, cancellation, errors, seeds).
 
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::time::Instant;
 
 use super::super::*;
 use super::data::recordings;
@@ -147,20 +146,4 @@ fn bad_input_is_a_clear_error() {
     let launcher = TrainSettings { launcher_prior: true, ..settings.clone() };
     assert!(msg(&[no_side], &launcher).contains("side information"));
     assert!(msg(&good, &TrainSettings { learning_rate: f64::NAN, ..settings }).contains("learning_rate"));
-}
-
-/// Seconds per optimizer step at the thesis' batch (64 chunks of 50 frames); run with `--ignored --nocapture`.
-#[test]
-#[ignore]
-fn time_per_training_step() {
-    let recs = recordings(40, 1);
-    for launcher_prior in [false, true] {
-        let settings = TrainSettings { steps: 3, launcher_prior, ..TrainSettings::default() };
-        train(&recs, &settings, &NullMonitor).unwrap();
-        let settings = TrainSettings { steps: 30, ..settings };
-        let start = Instant::now();
-        train(&recs, &settings, &NullMonitor).unwrap();
-        let per_step = start.elapsed().as_secs_f64() / 30.0;
-        eprintln!("launcher prior {launcher_prior}: {:.1} ms per step (batch 64 × 50 frames)", per_step * 1e3);
-    }
 }

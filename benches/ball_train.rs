@@ -1,0 +1,30 @@
+//! One optimizer step of the ball EKF's likelihood training at the thesis' batch (64 chunks of 50 frames):
+//! forward filter, backward pass through burn's autodiff, Adam update. Measured as 10 steps per sample.
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use mbrl::data::collect_ball::{collect_ball, BallCollectSettings};
+use mbrl::envs::ball::Orientation;
+use mbrl::models::ball::learn::{train, TrainSettings};
+use mbrl::run::NullMonitor;
+
+fn bench(c: &mut Criterion) {
+    let settings = BallCollectSettings {
+        trajectories: 40,
+        orientation: Orientation::Default,
+        augment_rotations: 0,
+        seed: 1,
+        command_line: String::new(),
+    };
+    let recordings = collect_ball(&settings, &NullMonitor).unwrap().recordings;
+    let mut group = c.benchmark_group("ball_ekf_train_10_steps_batch64x50");
+    group.sample_size(10);
+    for launcher_prior in [false, true] {
+        let train_settings = TrainSettings { steps: 10, launcher_prior, ..TrainSettings::default() };
+        let name = if launcher_prior { "launcher_prior" } else { "broad_prior" };
+        group.bench_function(name, |b| b.iter(|| train(&recordings, &train_settings, &NullMonitor).unwrap()));
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
