@@ -4,7 +4,7 @@
 MBRL := target/release/mbrl
 SEED ?= 0
 
-.PHONY: build test bench completions repro-quick repro-swingup repro-pendulum-data repro-boards clean-reports
+.PHONY: build test bench completions repro-quick repro-swingup repro-pendulum-data repro-boards repro-ball clean-reports
 
 build:
 	cargo build --release
@@ -42,6 +42,15 @@ repro-boards: build
 		$(MBRL) eval embodied --game $$game --embodiment $$arm --max-depth 5 --boards 500 --seed $(SEED) \
 			--no-tui --out reports/embodied-$$game-$$arm || exit 1; \
 	done; done
+
+# Thesis chapter 6: train the ball EKF on simulated default-pose shots (augmented by rotation) and compare
+# with the thesis' parameters and the black-box baseline on default and unseen launcher poses.
+repro-ball: build
+	$(MBRL) collect --env ball --trajectories 108 --augment-rotations 19 --seed $(SEED) --no-tui --out datasets/ball-train.mcap
+	$(MBRL) train --method ball-ekf --data datasets/ball-train.mcap --steps 5000 --seed $(SEED) --no-tui --out models/ball-ekf
+	$(MBRL) train --method ball-ekf --data datasets/ball-train.mcap --steps 5000 --launcher-prior --seed $(SEED) --no-tui \
+		--out models/ball-ekf-launch
+	$(MBRL) eval ball --model models/ball-ekf-launch --model models/ball-ekf --model thesis --seed $(SEED) --no-tui --out reports/ball
 
 completions: build
 	$(MBRL) completions bash > completions/mbrl.bash
