@@ -161,3 +161,12 @@ fn trained_checkpoints_are_usable_models() {
         mbrl(dir.path()).args(["train", "--method", "ball-ekf", "--data", "t.mcap", "--lr", "nan"]).output().unwrap();
     assert!(!out.status.success());
 }
+
+#[cfg(not(feature = "hdf5"))]
+#[test]
+fn hdf5_input_without_the_feature_says_how_to_get_it() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("release.hdf5"), "x").unwrap();
+    let out = mbrl(dir.path()).args(["filter", "--model", "thesis", "--input", "release.hdf5"]).output().unwrap();
+    assert_one_line_error(&out, &["release.hdf5", "--features hdf5", "libhdf5-dev"]);
+}

@@ -262,13 +262,28 @@ pub fn read_ball_csv(path: &Path) -> Result<Recording> {
     Ok(rec)
 }
 
-/// Recordings from a `.mcap` ball dataset or a single `.csv` recording.
+/// Recordings from a `.mcap` ball dataset, a single `.csv` recording, or (built with the `hdf5` feature)
+/// an `.hdf5`/`.h5` file in the layout of the authors' release.
 pub fn read_recordings(path: &Path) -> Result<Vec<Recording>> {
     match path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).as_deref() {
         Some("csv") => Ok(vec![read_ball_csv(path)?]),
         Some("mcap") => Ok(read_ball_dataset(path)?.recordings),
-        _ => Err(Error::bad_file(path, "expected a .mcap ball dataset or a .csv recording")),
+        Some("hdf5" | "h5") => read_hdf5(path),
+        _ => Err(Error::bad_file(path, "expected a .mcap ball dataset, a .csv recording or an .hdf5 release file")),
     }
+}
+
+#[cfg(feature = "hdf5")]
+fn read_hdf5(path: &Path) -> Result<Vec<Recording>> {
+    Ok(super::ball_hdf5::read_hdf5_recordings(path)?.into_iter().map(|t| t.recording).collect())
+}
+
+#[cfg(not(feature = "hdf5"))]
+fn read_hdf5(path: &Path) -> Result<Vec<Recording>> {
+    Err(Error::bad_file(
+        path,
+        "HDF5 import needs a build with `--features hdf5` (and the system HDF5 library: apt-get install libhdf5-dev)",
+    ))
 }
 
 #[cfg(test)]

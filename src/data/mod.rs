@@ -1,6 +1,8 @@
 //! Rollouts and datasets on disk.
 
 pub mod ball_estimates;
+#[cfg(feature = "hdf5")]
+pub mod ball_hdf5;
 pub mod ball_io;
 pub mod boardset;
 pub mod collect;
