@@ -43,14 +43,19 @@ repro-boards: build
 			--no-tui --out reports/embodied-$$game-$$arm || exit 1; \
 	done; done
 
-# Thesis chapter 6: train the ball EKF on simulated default-pose shots (augmented by rotation) and compare
-# with the thesis' parameters and the black-box baseline on default and unseen launcher poses.
+# Thesis chapter 6: train the ball EKF on simulated default-pose shots, with rotation augmentation (with
+# and without the launcher spin network) and without augmentation, and compare with the thesis' parameters
+# and the black-box baseline on default and unseen launcher poses.
 repro-ball: build
 	$(MBRL) collect --env ball --trajectories 108 --augment-rotations 19 --seed $(SEED) --no-tui --out datasets/ball-train.mcap
-	$(MBRL) train --method ball-ekf --data datasets/ball-train.mcap --steps 5000 --seed $(SEED) --no-tui --out models/ball-ekf
-	$(MBRL) train --method ball-ekf --data datasets/ball-train.mcap --steps 5000 --launcher-prior --seed $(SEED) --no-tui \
+	$(MBRL) collect --env ball --trajectories 108 --seed $(SEED) --no-tui --out datasets/ball-train-noaug.mcap
+	$(MBRL) train --method ball-ekf --data datasets/ball-train.mcap --steps 2000 --seed $(SEED) --no-tui --out models/ball-ekf
+	$(MBRL) train --method ball-ekf --data datasets/ball-train.mcap --steps 2000 --launcher-prior --seed $(SEED) --no-tui \
 		--out models/ball-ekf-launch
-	$(MBRL) eval ball --model models/ball-ekf-launch --model models/ball-ekf --model thesis --seed $(SEED) --no-tui --out reports/ball
+	$(MBRL) train --method ball-ekf --data datasets/ball-train-noaug.mcap --steps 2000 --seed $(SEED) --no-tui \
+		--out models/ball-ekf-noaug
+	$(MBRL) eval ball --model models/ball-ekf-launch --model models/ball-ekf --model models/ball-ekf-noaug --model thesis \
+		--seed $(SEED) --no-tui --out reports/ball
 
 completions: build
 	$(MBRL) completions bash > completions/mbrl.bash

@@ -178,14 +178,16 @@ pub fn evaluate(
     let max_horizon = settings.horizons.iter().copied().max().unwrap_or(180) as usize;
     let mut methods = Vec::new();
     for (name, loaded) in ekf_models {
-        // A checkpoint with a launcher network is scored both ways: the broad prior is its ablation.
-        if let Some(net) = loaded.spin_net {
-            methods.push(Method {
+        // A checkpoint trained with the launcher network is scored with it; its broad-prior ablation is a
+        // model trained without the network (thesis Fig. 6.4b), not this one with its prior removed.
+        let method = match loaded.spin_net {
+            Some(net) => Method {
                 name: format!("{name} + launch info"),
-                predictor: Predictor::Ekf { model: loaded.model.clone(), spin_net: Some(net) },
-            });
-        }
-        methods.push(Method { name, predictor: Predictor::Ekf { model: loaded.model, spin_net: None } });
+                predictor: Predictor::Ekf { model: loaded.model, spin_net: Some(net) },
+            },
+            None => Method { name, predictor: Predictor::Ekf { model: loaded.model, spin_net: None } },
+        };
+        methods.push(method);
     }
     for (name, launcher) in [("ridge baseline", false), ("ridge baseline + launch info", true)] {
         monitor.message(&format!("fitting the {name} on {} training trajectories", train.len()));
