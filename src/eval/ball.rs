@@ -20,7 +20,7 @@ use crate::models::ball::learn::SpinNetWeights;
 use crate::models::ball::track::{filter_recording, predict_ahead, prediction_error, protocol_cut, PredictedPoint};
 use crate::models::ball::{BallModel, BallModelParams, SpinPrior};
 use crate::planning::seeding::derive_seed;
-use crate::run::atomic::write_atomic;
+use crate::run::atomic::write_text;
 use crate::run::dir::{Provenance, RunDir};
 use crate::run::{Event, Monitor, Tee};
 
@@ -112,12 +112,15 @@ fn shots(
     Ok(collect_ball(&settings, monitor)?.recordings)
 }
 
+/// A named group of test recordings (`default`, `unseen`).
+pub type TestSet = (String, Vec<Recording>);
+
 /// The simulated train set and the test sets (default pose first, then unseen-1..5).
 pub fn datasets(
     settings: &BallEvalSettings,
     seed: u64,
     monitor: &dyn Monitor,
-) -> Result<(Vec<Recording>, Vec<(String, Vec<Recording>)>)> {
+) -> Result<(Vec<Recording>, Vec<TestSet>)> {
     let train = shots(
         Orientation::Default,
         settings.train_shots,
@@ -283,14 +286,14 @@ pub fn evaluate(
     trajectory_plot(&run.file("trajectories.png"), &methods, &tests)?;
     let md = report_markdown(settings, &methods, &rows);
     let path = run.file("report.md");
-    write_atomic(&path, |w| w.write_all(md.as_bytes()).map_err(|e| Error::io(&path, e)))?;
+    write_text(&path, &md)?;
     metrics.emit(&Event::Finished { ok: true });
     Ok(BallEvalSummary { rows })
 }
 
 /// Side view (y, z) of a few test shots: measurements, the filtered part and the 1 s prediction of the
 /// first EKF method; the side view shows the bounce, where prediction is hardest.
-fn trajectory_plot(path: &Path, methods: &[Method], tests: &[(String, Vec<Recording>)]) -> Result<()> {
+fn trajectory_plot(path: &Path, methods: &[Method], tests: &[TestSet]) -> Result<()> {
     let Some(Method { predictor: Predictor::Ekf { model, spin_net }, name }) = methods.first() else { return Ok(()) };
     let mut series = Vec::new();
     for (group, rec) in tests.iter().flat_map(|(g, r)| r.iter().step_by(37).take(2).map(move |r| (g, r))) {

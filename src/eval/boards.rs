@@ -11,11 +11,11 @@ use crate::envs::boards::depth::{DenseIndex, DepthTable};
 use crate::envs::boards::sets::boards_at;
 use crate::envs::boards::{split_of, LightsOut, Split, TileSwap};
 use crate::envs::embodiments::Embodiment;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::planning::bfs::SearchLimits;
 use crate::planning::seeding::rng_for;
 use crate::planning::solve_board::{execute_plan, plan_board, SearchKind};
-use crate::run::atomic::write_atomic;
+use crate::run::atomic::write_text;
 use crate::run::dir::{Provenance, RunDir};
 use crate::run::{Event, Monitor, NullMonitor, Tee};
 
@@ -94,7 +94,7 @@ pub fn depth_report(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monit
     let mismatches = rows.iter().filter(|r| r.thesis.is_some_and(|t| t != r.boards)).count();
     md.push_str(&format!("\nRows differing from Table 7.1: {mismatches}.\n"));
     let path = run.file("report.md");
-    write_atomic(&path, |w| w.write_all(md.as_bytes()).map_err(|e| Error::io(&path, e)))?;
+    write_text(&path, &md)?;
     // Only the run's own file is told it finished: the caller's view may have more jobs to show.
     metrics.emit(&Event::Finished { ok: true });
     Ok(rows)
@@ -205,7 +205,7 @@ pub fn embodied_report<G: DenseIndex>(
         ));
     }
     let path = run.file("report.md");
-    write_atomic(&path, |w| w.write_all(md.as_bytes()).map_err(|e| Error::io(&path, e)))?;
+    write_text(&path, &md)?;
     // Only the run's own file is told it finished: the caller's view may have more jobs to show.
     metrics.emit(&Event::Finished { ok: true });
     Ok(rows)

@@ -9,7 +9,7 @@ use super::stats::{mean, quantile};
 use super::table::write_csv;
 use crate::data::{read_dataset, Rollout};
 use crate::error::{Error, Result};
-use crate::run::atomic::write_atomic;
+use crate::run::atomic::write_text;
 use crate::run::dir::{Provenance, RunDir};
 
 /// Rollouts drawn in the state plot; more would be unreadable.
@@ -88,7 +88,7 @@ pub fn report(input: &Path, provenance: &Provenance, out_dir: &Path) -> Result<D
     };
     let md = markdown(input, &data.meta, &summary, &returns);
     let path = run.file("report.md");
-    write_atomic(&path, |w| w.write_all(md.as_bytes()).map_err(|e| Error::io(&path, e)))?;
+    write_text(&path, &md)?;
     Ok(summary)
 }
 

@@ -15,7 +15,7 @@ use crate::error::{Error, Result};
 use crate::models::ball::checkpoint::{load_ball_model, LoadedBallModel};
 use crate::models::ball::learn::{train, TrainSettings};
 use crate::models::ball::BallModel;
-use crate::run::atomic::write_atomic;
+use crate::run::atomic::write_text;
 use crate::run::dir::Provenance;
 use crate::run::Monitor;
 
@@ -65,7 +65,7 @@ pub fn run_quick(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor)
         md.push_str(&format!("- {line}\n"));
     }
     let path = out_dir.join("report.md");
-    write_atomic(&path, |w| w.write_all(md.as_bytes()).map_err(|e| Error::io(&path, e)))?;
+    write_text(&path, &md)?;
     Ok(QuickSummary { lines })
 }
 

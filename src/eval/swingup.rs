@@ -15,7 +15,7 @@ use crate::error::Result;
 use crate::planning::mpc::run_mpc_episode;
 use crate::planning::seeding::{derive_seed, rng_for};
 use crate::planning::{Cem, CemConfig};
-use crate::run::atomic::write_atomic;
+use crate::run::atomic::write_text;
 use crate::run::dir::{Provenance, RunDir};
 use crate::run::{Event, Monitor, PanelSpec, Tee};
 
@@ -239,9 +239,7 @@ fn write_outputs(
         &episodes_dataset(settings, provenance.seed, &provenance.command_line, results),
     )?;
     let report = report_markdown(settings, provenance, results);
-    write_atomic(&run.file("report.md"), |w| {
-        w.write_all(report.as_bytes()).map_err(|e| crate::Error::io(&run.file("report.md"), e))
-    })
+    write_text(&run.file("report.md"), &report)
 }
 
 /// (time, wrapped angle) with a NaN break wherever the angle wraps around ±π.

@@ -55,6 +55,10 @@ pub fn partial_file_builder() -> tempfile::Builder<'static, 'static> {
     builder
 }
 
+pub fn write_text(path: &Path, text: &str) -> Result<()> {
+    write_atomic(path, |w| w.write_all(text.as_bytes()).map_err(|e| Error::io(path, e)))
+}
+
 pub fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> Result<()> {
     write_atomic(path, |w| {
         serde_json::to_writer_pretty(&mut *w, value).map_err(|e| Error::io(path, e.into()))?;

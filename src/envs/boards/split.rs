@@ -20,7 +20,7 @@ impl Split {
 }
 
 pub fn split_of(canonical: &str) -> Split {
-    if crc32fast::hash(canonical.as_bytes()) % 3 == 0 {
+    if crc32fast::hash(canonical.as_bytes()).is_multiple_of(3) {
         Split::Train
     } else {
         Split::Test
