@@ -11,8 +11,8 @@ use crate::error::{Error, Result};
 pub const BALL_FORMAT_VERSION: u32 = 1;
 pub const METADATA_NAME: &str = "mbrl.balls";
 pub const TOPIC: &str = "/ball/frames";
-/// Camera frame rate of the recordings (thesis 6.5.1).
-pub const FRAME_RATE: f64 = 180.0;
+/// Camera frame rate of the recordings (thesis 6.5.1), the same the simulator's camera uses.
+pub use crate::envs::ball::camera::FRAME_RATE;
 /// Launcher side information in the layout of the authors' public release.
 pub const SIDE_INFO_COLUMNS: [&str; 7] = ["sin_phi_f", "cos_phi_f", "s_phi", "s_theta", "s_tl", "s_tr", "s_b"];
 
