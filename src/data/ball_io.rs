@@ -5,7 +5,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use super::mcap_io::{check_version, read_messages, write_messages, Layout};
+use super::mcap_io::{check_version, metadata_field, metadata_seed, read_messages, write_messages, Layout};
 use crate::error::{Error, Result};
 
 pub const BALL_FORMAT_VERSION: u32 = 1;
@@ -130,9 +130,7 @@ pub fn write_ball_dataset(path: &Path, data: &BallDataset) -> Result<()> {
 pub fn read_ball_dataset(path: &Path) -> Result<BallDataset> {
     let (meta, messages) = read_messages::<BallFrame>(path, METADATA_NAME, TOPIC)?;
     check_version(path, &meta, BALL_FORMAT_VERSION)?;
-    let field = |key: &str| {
-        meta.get(key).cloned().ok_or_else(|| Error::bad_file(path, format!("metadata lacks the field '{key}'")))
-    };
+    let field = |key: &str| metadata_field(path, &meta, key);
     let infos: BTreeMap<u32, RecordingInfo> = serde_json::from_str(&field("recordings")?)
         .map_err(|e| Error::bad_file(path, format!("metadata field 'recordings': {e}")))?;
     let mut recordings: Vec<Recording> = Vec::new();
@@ -164,9 +162,7 @@ pub fn read_ball_dataset(path: &Path) -> Result<BallDataset> {
     }
     Ok(BallDataset {
         source: field("source")?,
-        seed: field("seed")?
-            .parse()
-            .map_err(|_| Error::bad_file(path, "metadata field 'seed': expected an integer"))?,
+        seed: metadata_seed(path, &meta)?,
         command_line: field("command_line")?,
         mbrl_version: field("mbrl_version")?,
         recordings,

@@ -4,9 +4,9 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use super::mcap_io::{check_version, read_messages, write_messages, Layout};
+use super::mcap_io::{check_version, metadata_field, metadata_seed, read_messages, write_messages, Layout};
 use crate::envs::boards::sets::BoardRecord;
-use crate::error::{Error, Result};
+use crate::error::Result;
 
 pub const BOARDSET_VERSION: u32 = 1;
 pub const METADATA_NAME: &str = "mbrl.boardset";
@@ -52,14 +52,10 @@ pub fn write_board_set(path: &Path, set: &BoardSet) -> Result<()> {
 pub fn read_board_set(path: &Path) -> Result<BoardSet> {
     let (meta, messages) = read_messages::<BoardRecord>(path, METADATA_NAME, TOPIC)?;
     check_version(path, &meta, BOARDSET_VERSION)?;
-    let field = |key: &str| {
-        meta.get(key).cloned().ok_or_else(|| Error::bad_file(path, format!("metadata lacks the field '{key}'")))
-    };
+    let field = |key: &str| metadata_field(path, &meta, key);
     Ok(BoardSet {
         game: field("game")?,
-        seed: field("seed")?
-            .parse()
-            .map_err(|_| Error::bad_file(path, "metadata field 'seed': expected an integer"))?,
+        seed: metadata_seed(path, &meta)?,
         command_line: field("command_line")?,
         mbrl_version: field("mbrl_version")?,
         boards: messages.into_iter().map(|(_, b)| b).collect(),

@@ -120,3 +120,15 @@ pub fn check_version(path: &Path, metadata: &BTreeMap<String, String>, supported
     }
     Ok(version)
 }
+
+/// A required metadata field, with an error naming the file and the field.
+pub fn metadata_field(path: &Path, metadata: &BTreeMap<String, String>, key: &str) -> Result<String> {
+    metadata.get(key).cloned().ok_or_else(|| Error::bad_file(path, format!("metadata lacks the field '{key}'")))
+}
+
+/// The `seed` field every mbrl file records.
+pub fn metadata_seed(path: &Path, metadata: &BTreeMap<String, String>) -> Result<u64> {
+    metadata_field(path, metadata, "seed")?
+        .parse()
+        .map_err(|_| Error::bad_file(path, "metadata field 'seed': expected an integer"))
+}
