@@ -4,7 +4,7 @@
 MBRL := target/release/mbrl
 SEED ?= 0
 
-.PHONY: build test bench completions repro-quick repro-swingup repro-pendulum-data repro-boards repro-ball clean-reports
+.PHONY: build test bench completions repro-quick repro-swingup repro-pendulum-data repro-boards repro-ball repro-pets repro-pets-loop clean-reports
 
 build:
 	cargo build --release
@@ -31,6 +31,35 @@ repro-pendulum-data: build
 	for env in pendulum pendulum:light pendulum:heavy pendulum:inverted; do \
 		$(MBRL) collect --env $$env --rollouts 500 --steps 30 --seed $(SEED) --no-tui \
 			--out datasets/$$(echo $$env | tr ':' '-')-random.mcap || exit 1; \
+	done
+
+# The basic model-based loop with PETS: 200 random rollouts of 30 steps, an ensemble of 5 trained on them,
+# and swing-ups planned on the learned model at the thesis' CEM settings (1000 candidates, 100 elites,
+# 10 iterations, horizon 20; 20 TS-inf particles). Each of 10 seeds trains its own ensemble on its own data
+# and plans one episode; the ground-truth model plans the same 10 episodes for comparison.
+PETS_SEEDS ?= 0 1 2 3 4 5 6 7 8 9
+repro-pets: build
+	for s in $(PETS_SEEDS); do \
+		$(MBRL) collect --env pendulum --rollouts 200 --steps 30 --seed $$s --no-tui -q --out datasets/pets/random-$$s.mcap || exit 1; \
+		$(MBRL) train --method pets --env pendulum --data datasets/pets/random-$$s.mcap --seed $$s --no-tui -q --out models/pets/seed-$$s || exit 1; \
+		$(MBRL) eval pendulum-swingup --model models/pets/seed-$$s --episodes 1 --seed $$s --no-tui -q --out reports/pets/seed-$$s || exit 1; \
+		$(MBRL) eval pendulum-swingup --model true --episodes 1 --seed $$s --no-tui -q --out reports/pets/truth-$$s || exit 1; \
+	done
+	@echo "seed,model,return,success" > reports/pets/summary.csv
+	@for s in $(PETS_SEEDS); do for m in seed truth; do \
+		tail -n 1 reports/pets/$$m-$$s/episodes.csv | awk -F, -v s=$$s -v m=$$m '{print s "," (m=="seed"?"pets":"true") "," $$2 "," $$3}' >> reports/pets/summary.csv; \
+	done; done
+	@cat reports/pets/summary.csv
+
+# The iterative loop users of mbrl-lib know: start from a few random rollouts, then alternate planning an
+# episode on the current model (executed in the simulator and saved) with retraining on all data so far.
+LOOP_ITERATIONS ?= 5
+repro-pets-loop: build
+	$(MBRL) collect --env pendulum --rollouts 10 --steps 30 --seed $(SEED) --no-tui -q --out datasets/pets-loop/iter-0.mcap
+	for i in $$(seq 1 $(LOOP_ITERATIONS)); do \
+		data=$$(ls datasets/pets-loop/iter-*.mcap | sed 's/^/--data /' | tr '\n' ' '); \
+		$(MBRL) train --method pets --env pendulum $$data --steps 1000 --seed $(SEED) --no-tui -q --out models/pets-loop || exit 1; \
+		$(MBRL) plan --env pendulum --model models/pets-loop --steps 150 --seed $$i --no-tui --out datasets/pets-loop/iter-$$i.mcap || exit 1; \
 	done
 
 # Thesis chapter 7 environments: depth/split tables, board sets, embodied play with scripted controllers.

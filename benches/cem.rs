@@ -14,7 +14,7 @@ fn mpc_step(c: &mut Criterion) {
         let config = CemConfig { noise, ..CemConfig::for_box(&[-2.0], &[2.0]) };
         let mut cem = Cem::new(config, 0).unwrap();
         group.bench_function(name, |b| {
-            b.iter(|| cem.plan(&ReturnObjective { dynamics: &dynamics, init: &init }, |_| {}));
+            b.iter(|| cem.plan(&ReturnObjective::new(&dynamics, &init, 0), |_| {}));
         });
     }
     group.finish();

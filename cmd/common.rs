@@ -112,10 +112,10 @@ pub fn file_stem(env: &str) -> String {
     env.chars().map(|c| if c.is_ascii_alphanumeric() || c == '.' || c == '-' { c } else { '-' }).collect()
 }
 
-/// Which dynamics model a planner uses. Learned models join this list as their methods land.
+/// The successor model a board search uses. The learned SEADS model joins this list when it lands.
 #[derive(Copy, Clone, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum ModelChoice {
-    /// The simulator's own equations (ground truth).
+    /// The game's own rules (ground truth).
     True,
 }
 

@@ -15,7 +15,8 @@ use mbrl::models::ball::checkpoint::load_ball_model;
 use mbrl::run::dir::Provenance;
 
 use crate::cem_args::CemArgs;
-use crate::common::{command_line, pendulum_variant, run_job, GlobalArgs, ModelChoice};
+use crate::common::{command_line, pendulum_variant, run_job, GlobalArgs};
+use crate::model_args::ModelArgs;
 use crate::solve_board::{EmbodimentChoice, SplitChoice};
 
 /// Run an evaluation protocol and write a report directory (report.md, CSV, PNG).
@@ -73,7 +74,10 @@ enum Protocol {
                             mbrl eval ball --model models/ball-ekf --train-shots 108 --test-shots 163 --unseen-shots 30")]
     Ball(BallArgs),
     /// Pendulum swing-up with MPC: success rate, returns, angle plots.
-    #[command(after_help = "Example:\n  mbrl eval pendulum-swingup --model true --episodes 10 --out reports/swingup")]
+    #[command(
+        after_help = "Example:\n  mbrl eval pendulum-swingup --model true --episodes 10 --out reports/swingup\n  \
+                            mbrl eval pendulum-swingup --model models/pets-pendulum --episodes 10"
+    )]
     PendulumSwingup(SwingupArgs),
 }
 
@@ -123,9 +127,8 @@ struct BallArgs {
 
 #[derive(Args, Debug)]
 struct SwingupArgs {
-    /// Dynamics model the planner uses.
-    #[arg(long, value_enum)]
-    model: ModelChoice,
+    #[command(flatten)]
+    model: ModelArgs,
     /// Number of episodes (each with its own start state).
     #[arg(long, default_value_t = 10)]
     episodes: usize,
@@ -234,15 +237,16 @@ pub fn run(global: &GlobalArgs, args: EvalArgs) -> anyhow::Result<()> {
             );
         }
         Protocol::PendulumSwingup(a) => {
-            let ModelChoice::True = a.model;
             let variant = pendulum_variant(&a.env)?;
+            let model = a.model.load(&mbrl::envs::parse_env(&a.env)?)?;
+            let model = model.as_deref();
             if a.episodes == 0 || a.steps < swingup::SUCCESS_WINDOW {
                 bail!("--episodes must be at least 1 and --steps at least {}", swingup::SUCCESS_WINDOW);
             }
             let settings = swingup_settings(variant, a.steps, &a.cem);
             settings.cem.validate()?;
             let summary = run_job(global, "eval pendulum-swingup", |monitor| {
-                swingup::evaluate(&settings, a.episodes, &provenance, &a.out, monitor)
+                swingup::evaluate(&settings, model, a.episodes, &provenance, &a.out, monitor)
             })?;
             println!(
                 "{}/{} episodes succeeded; mean return {:.1}; report: {}",

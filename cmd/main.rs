@@ -6,6 +6,7 @@ mod common;
 mod completions;
 mod eval;
 mod filter;
+mod model_args;
 mod plan;
 mod predict;
 mod solve_board;

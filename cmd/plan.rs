@@ -8,7 +8,8 @@ use mbrl::data::write_dataset;
 use mbrl::eval::swingup::{self, SwingupSettings};
 
 use crate::cem_args::CemArgs;
-use crate::common::{command_line, file_stem, pendulum_variant, run_job, GlobalArgs, ModelChoice};
+use crate::common::{command_line, file_stem, pendulum_variant, run_job, GlobalArgs};
+use crate::model_args::ModelArgs;
 
 /// Plan with CEM on a model and execute the plan in the simulator (MPC).
 #[derive(Args, Debug)]
@@ -16,6 +17,7 @@ use crate::common::{command_line, file_stem, pendulum_variant, run_job, GlobalAr
 Examples:
   mbrl plan --env pendulum --model true --horizon 20 --candidates 1000 --elites 100 --iters 10 --steps 150
   mbrl plan --env pendulum:heavy --model true --noise colored --beta 0.5 --out datasets/heavy-plan.mcap
+  mbrl plan --env pendulum --model models/pets-pendulum --particles 20 --propagation tsinf
 
 The pendulum starts hanging (θ ~ U[π-0.05, π+0.05], θ̇ ~ U[-0.05, 0.05]); success means each of the
 last 25 rewards is above -1 (thesis 3.5.2).")]
@@ -23,9 +25,8 @@ pub struct PlanArgs {
     /// Environment: pendulum[:light|heavy|mass=<m>|inverted|quadrant].
     #[arg(long)]
     env: String,
-    /// Dynamics model the planner uses.
-    #[arg(long, value_enum)]
-    model: ModelChoice,
+    #[command(flatten)]
+    model: ModelArgs,
     /// Steps to execute.
     #[arg(long, default_value_t = 150)]
     steps: usize,
@@ -48,11 +49,14 @@ pub fn run(global: &GlobalArgs, args: PlanArgs) -> anyhow::Result<()> {
     let out = args
         .out
         .unwrap_or_else(|| PathBuf::from(format!("datasets/plan-{}.mcap", file_stem(&settings.variant.env_name()))));
-    let ModelChoice::True = args.model;
+    let env = mbrl::envs::parse_env(&args.env)?;
+    let model = args.model.load(&env)?;
+    let model = model.as_deref();
     let seed = global.seed;
+    let title = format!("plan: pendulum swing-up with {}", swingup::model_description(model));
     let episode = run_job(global, "plan: pendulum swing-up", |monitor| {
-        monitor.emit(&swingup::layout("plan: pendulum swing-up with the ground-truth model"));
-        let episode = swingup::run_episode(&settings, seed, 0, monitor)?;
+        monitor.emit(&swingup::layout(&title, model.is_some()));
+        let episode = swingup::run_episode(&settings, model, seed, 0, monitor)?;
         write_dataset(
             &out,
             &swingup::episodes_dataset(&settings, seed, &command_line(), std::slice::from_ref(&episode)),

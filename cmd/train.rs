@@ -1,7 +1,8 @@
 //! `mbrl train`: fit a model to a dataset and write a checkpoint directory.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
+use anyhow::{bail, Context};
 use clap::{Args, ValueEnum};
 use mbrl::data::ball_io::read_recordings;
 use mbrl::eval::plot::{line_plot, Series};
@@ -9,71 +10,251 @@ use mbrl::eval::table::write_csv;
 use mbrl::models::ball::checkpoint::save_ball_params;
 use mbrl::models::ball::learn::{train, TrainSettings};
 use mbrl::models::ball::BallModelParams;
+use mbrl::models::pets::{self, PetsConfig, Preset, RewardSource};
 use mbrl::run::atomic::write_json;
 use mbrl::run::dir::{Provenance, RunDir};
 use mbrl::run::{Event, Monitor, PanelSpec, Tee};
+use mbrl::train::config::apply_toml_file;
+use mbrl::train::OpenedCheckpoint;
 
-use crate::common::{command_line, run_job, GlobalArgs};
+use crate::common::{command_line, file_stem, run_job, GlobalArgs};
 
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
 pub enum Method {
+    /// Probabilistic ensemble of MLPs on (state, action) → state change (PETS, Chua et al. 2018), for any
+    /// env that `collect` rolls out; plan with it via `mbrl plan --model DIR`.
+    Pets,
     /// Gray-box table-tennis ball EKF: learn the impact matrix, noise levels and initial values by
     /// maximizing the filter's marginal likelihood (thesis 6.4.4, eq. 6.24).
     BallEkf,
 }
 
-/// Train a model and write it to a checkpoint directory (config.json, metrics.jsonl, weights).
+#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
+pub enum PresetChoice {
+    /// 3 hidden layers × 64 SiLU units, 2000 steps (≈ 10 s on 2 cores).
+    Small,
+    /// 4 × 200 SiLU units, 5000 steps: mbrl-lib's PETS pendulum network.
+    Medium,
+}
+
+#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
+pub enum RewardChoice {
+    /// The env's closed-form reward (pendulum variants without hidden actuators).
+    Known,
+    /// An extra output of the network, trained on the dataset's rewards.
+    Learned,
+}
+
+/// Train a model and write it to a checkpoint directory (config.json, weights, metrics.jsonl).
 #[derive(Args, Debug)]
 #[command(after_help = "\
 Examples:
+  mbrl collect --env pendulum --rollouts 200 --steps 30 --out datasets/pendulum-random.mcap
+  mbrl train --method pets --env pendulum --data datasets/pendulum-random.mcap --out models/pets-pendulum
+  mbrl train --method pets --data a.mcap --data b.mcap --preset medium --config pets.toml --out models/pets-big
+  mbrl train --resume models/pets-big
   mbrl collect --env ball --trajectories 108 --augment-rotations 19 --out datasets/ball-train.mcap
   mbrl train --method ball-ekf --data datasets/ball-train.mcap --out models/ball-ekf --steps 2000
-  mbrl predict --model models/ball-ekf --input datasets/ball-default.mcap --horizon 1s")]
+
+A config file (TOML) sets any key of the method's config.json `config` table; unknown keys are errors.
+Flags given explicitly override the file. `--resume DIR` continues a stopped run from its last checkpoint
+with the config and data it was started with, and ends with the same bytes as an uninterrupted run.")]
 pub struct TrainArgs {
     /// What to train.
-    #[arg(long, value_enum)]
-    method: Method,
-    /// Training data (ball: a .mcap ball dataset or a .csv recording).
+    #[arg(long, value_enum, required_unless_present = "resume")]
+    method: Option<Method>,
+    /// Training data (repeatable). pets: rollout datasets (.mcap) of one env; ball-ekf: a ball dataset (.mcap)
+    /// or a .csv recording.
+    #[arg(long, required_unless_present = "resume")]
+    data: Vec<PathBuf>,
+    /// The env the data must come from (pets; default: the dataset's env).
     #[arg(long)]
-    data: PathBuf,
-    /// Checkpoint directory.
-    #[arg(long, default_value = "models/ball-ekf")]
-    out: PathBuf,
-    /// Optimizer steps.
-    #[arg(long, default_value_t = 1000)]
-    steps: u64,
-    /// Chunks per batch (thesis: 64).
-    #[arg(long, default_value_t = 64)]
-    batch: usize,
-    /// Frames per chunk (thesis: 50).
+    env: Option<String>,
+    /// Checkpoint directory (default: models/<method>-<env>, models/ball-ekf).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Continue the stopped run in this checkpoint directory.
+    #[arg(long, conflicts_with_all = ["method", "data", "env", "out", "config", "preset", "ensemble", "steps", "batch", "lr", "reward", "launcher_prior"])]
+    resume: Option<PathBuf>,
+    /// Hyperparameters from a TOML file (pets), over the preset's.
+    #[arg(long)]
+    config: Option<PathBuf>,
+    /// Network size and training length (pets).
+    #[arg(long, value_enum)]
+    preset: Option<PresetChoice>,
+    /// Ensemble members (pets; default 5).
+    #[arg(long)]
+    ensemble: Option<usize>,
+    /// Optimizer steps (pets: preset's; ball-ekf: 1000).
+    #[arg(long)]
+    steps: Option<u64>,
+    /// Batch size: transitions per member (pets, 256) or chunks (ball-ekf, thesis 64).
+    #[arg(long)]
+    batch: Option<usize>,
+    /// Adam learning rate (pets: 1e-3; ball-ekf: thesis 5e-3).
+    #[arg(long, value_parser = crate::common::finite_f64)]
+    lr: Option<f64>,
+    /// Where the model's reward comes from (pets; default: known where the env has a closed form).
+    #[arg(long, value_enum)]
+    reward: Option<RewardChoice>,
+    /// Frames per chunk (ball-ekf; thesis: 50).
     #[arg(long, default_value_t = 50)]
     chunk: usize,
-    /// Adam learning rate (thesis: 5e-3).
-    #[arg(long, default_value_t = 5e-3, value_parser = crate::common::finite_f64)]
-    lr: f64,
-    /// Learn the spin prior from launcher settings (thesis C.1.3); recordings need side information.
+    /// Learn the spin prior from launcher settings (ball-ekf, thesis C.1.3); recordings need side information.
     #[arg(long)]
     launcher_prior: bool,
 }
 
 pub fn run(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
-    let Method::BallEkf = args.method;
-    let recordings = read_recordings(&args.data)?;
+    if let Some(dir) = &args.resume {
+        return resume(global, dir);
+    }
+    if args.steps == Some(0) {
+        bail!("--steps must be at least 1");
+    }
+    match args.method.expect("clap requires --method without --resume") {
+        Method::Pets => train_pets(global, args),
+        Method::BallEkf => train_ball(global, args),
+    }
+}
+
+fn resume(global: &GlobalArgs, dir: &Path) -> anyhow::Result<()> {
+    let method = OpenedCheckpoint::open(dir)?.manifest.method;
+    match method.as_str() {
+        pets::METHOD => {
+            let report = run_job(global, "train pets (resumed)", |monitor| pets::resume(dir, monitor))?;
+            print_pets_report(&report, dir);
+            Ok(())
+        }
+        other => bail!("{}: '{other}' runs cannot be resumed; resumable methods: {}", dir.display(), pets::METHOD),
+    }
+}
+
+fn pets_config(args: &TrainArgs) -> anyhow::Result<PetsConfig> {
+    let preset = match args.preset.unwrap_or(PresetChoice::Small) {
+        PresetChoice::Small => Preset::Small,
+        PresetChoice::Medium => Preset::Medium,
+    };
+    let mut config = PetsConfig::preset(preset);
+    if let Some(path) = &args.config {
+        config = apply_toml_file(&config, path)?;
+    }
+    if let Some(n) = args.ensemble {
+        config.ensemble = n;
+    }
+    if let Some(n) = args.steps {
+        config.steps = n;
+    }
+    if let Some(n) = args.batch {
+        config.batch_size = n;
+    }
+    if let Some(lr) = args.lr {
+        config.optimizer.learning_rate = lr;
+    }
+    if let Some(r) = args.reward {
+        config.reward = match r {
+            RewardChoice::Known => RewardSource::Known,
+            RewardChoice::Learned => RewardSource::Learned,
+        };
+    }
+    if args.launcher_prior {
+        bail!("--launcher-prior is a ball-ekf flag; pets has no launcher");
+    }
+    config.validate()?;
+    Ok(config)
+}
+
+fn train_pets(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
+    let mut config = pets_config(&args)?;
+    let first = args.data.first().context("--data is required")?;
+    if args.reward.is_none() && args.config.is_none() {
+        // Default to the closed form where the env has one: peek at the dataset's env.
+        let env = args.env.clone().map(Ok).unwrap_or_else(|| mbrl::data::read_dataset(first).map(|d| d.meta.env))?;
+        if mbrl::envs::parse_env(&env)?.known_reward().is_none() {
+            config.reward = RewardSource::Learned;
+        }
+    }
+    let out = args.out.clone().unwrap_or_else(|| {
+        let env = args.env.as_deref().map(file_stem).unwrap_or_else(|| "model".into());
+        PathBuf::from(format!("models/pets-{env}"))
+    });
+    let request = pets::TrainRequest {
+        out: out.clone(),
+        data: args.data.clone(),
+        env: args.env.clone(),
+        config,
+        seed: global.seed,
+        provenance: Provenance::new(command_line(), global.seed, global.thread_count()),
+    };
+    let report = run_job(global, "train pets", |monitor| pets::train(&request, false, monitor))?;
+    print_pets_report(&report, &out);
+    Ok(())
+}
+
+fn print_pets_report(report: &pets::TrainReport, out: &Path) {
+    let run = &report.run;
+    let c = &run.config;
+    println!(
+        "trained a PETS ensemble of {} ({}×{} {}, {} parameters, reward {}) on {} transitions of {} ({} rollouts; {} held out)",
+        c.ensemble,
+        c.hidden_layers,
+        c.hidden_units,
+        c.activation.name(),
+        report.parameters,
+        match c.reward {
+            RewardSource::Known => "known",
+            RewardSource::Learned => "learned",
+        },
+        run.transitions.train,
+        run.env,
+        run.transitions.train_rollouts,
+        run.transitions.valid_rollouts
+    );
+    let o = &report.outcome;
+    if let Some(loss) = o.last_train_loss {
+        println!("final training loss (Gaussian NLL) {loss:.4} after {} steps", o.steps);
+    }
+    if let (Some(step), Some(v)) = (o.best_step, o.best_valid_loss) {
+        println!("best validation MSE {v:.3e} at step {step} (saved as model.safetensors)");
+    }
+    println!("checkpoint: {}", out.display());
+}
+
+fn train_ball(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
+    for (flag, given) in [
+        ("--env", args.env.is_some()),
+        ("--config", args.config.is_some()),
+        ("--preset", args.preset.is_some()),
+        ("--ensemble", args.ensemble.is_some()),
+        ("--reward", args.reward.is_some()),
+    ] {
+        if given {
+            bail!("{flag} is a pets flag; ball-ekf takes --data, --out, --steps, --batch, --chunk, --lr, --launcher-prior");
+        }
+    }
+    let [data] = args.data.as_slice() else {
+        bail!("ball-ekf trains on one --data file, got {}", args.data.len());
+    };
+    let out = args.out.clone().unwrap_or_else(|| PathBuf::from("models/ball-ekf"));
+    let steps = args.steps.unwrap_or(1000);
+    let batch = args.batch.unwrap_or(64);
+    let lr = args.lr.unwrap_or(5e-3);
+    let recordings = read_recordings(data)?;
     let settings = TrainSettings {
-        steps: args.steps,
-        batch_size: args.batch,
+        steps,
+        batch_size: batch,
         chunk_len: args.chunk,
-        learning_rate: args.lr,
+        learning_rate: lr,
         seed: global.seed,
         launcher_prior: args.launcher_prior,
         ..TrainSettings::default()
     };
     let provenance = Provenance::new(command_line(), global.seed, global.thread_count());
     let outcome = run_job(global, "train ball-ekf", |monitor| {
-        let run = RunDir::create(&args.out)?;
+        let run = RunDir::create(&out)?;
         run.write_config(&serde_json::json!({
             "job": "train ball-ekf",
-            "data": args.data.display().to_string(),
+            "data": data.display().to_string(),
             "recordings": recordings.len(),
             "settings": settings,
             "provenance": provenance,
@@ -129,6 +310,6 @@ pub fn run(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
         p.a_m0,
         p.a_m0 * p.a_m0 + 0.05
     );
-    println!("checkpoint: {}", args.out.display());
+    println!("checkpoint: {}", out.display());
     Ok(())
 }

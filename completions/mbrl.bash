@@ -531,14 +531,22 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__pendulum__subcmd__swingup)
-            opts="-q -h -V --model --episodes --env --steps --horizon --candidates --elites --iters --noise --beta --no-warm-start --out --seed --threads --tui --no-tui --quiet --help --version"
+            opts="-q -h -V --model --particles --propagation --episodes --env --steps --horizon --candidates --elites --iters --noise --beta --no-warm-start --out --seed --threads --tui --no-tui --quiet --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
             fi
             case "${prev}" in
                 --model)
-                    COMPREPLY=($(compgen -W "true" -- "${cur}"))
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --particles)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --propagation)
+                    COMPREPLY=($(compgen -W "ts1 tsinf expectation" -- "${cur}"))
                     return 0
                     ;;
                 --episodes)
@@ -899,7 +907,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__plan)
-            opts="-q -h -V --env --model --steps --horizon --candidates --elites --iters --noise --beta --no-warm-start --out --seed --threads --tui --no-tui --quiet --help --version"
+            opts="-q -h -V --env --model --particles --propagation --steps --horizon --candidates --elites --iters --noise --beta --no-warm-start --out --seed --threads --tui --no-tui --quiet --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -910,7 +918,15 @@ _mbrl() {
                     return 0
                     ;;
                 --model)
-                    COMPREPLY=($(compgen -W "true" -- "${cur}"))
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --particles)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --propagation)
+                    COMPREPLY=($(compgen -W "ts1 tsinf expectation" -- "${cur}"))
                     return 0
                     ;;
                 --steps)
@@ -1069,21 +1085,41 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__train)
-            opts="-q -h -V --method --data --out --steps --batch --chunk --lr --launcher-prior --seed --threads --tui --no-tui --quiet --help --version"
+            opts="-q -h -V --method --data --env --out --resume --config --preset --ensemble --steps --batch --lr --reward --chunk --launcher-prior --seed --threads --tui --no-tui --quiet --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
             fi
             case "${prev}" in
                 --method)
-                    COMPREPLY=($(compgen -W "ball-ekf" -- "${cur}"))
+                    COMPREPLY=($(compgen -W "pets ball-ekf" -- "${cur}"))
                     return 0
                     ;;
                 --data)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
+                --env)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 --out)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --resume)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --config)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --preset)
+                    COMPREPLY=($(compgen -W "small medium" -- "${cur}"))
+                    return 0
+                    ;;
+                --ensemble)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
@@ -1095,11 +1131,15 @@ _mbrl() {
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
-                --chunk)
+                --lr)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
-                --lr)
+                --reward)
+                    COMPREPLY=($(compgen -W "known learned" -- "${cur}"))
+                    return 0
+                    ;;
+                --chunk)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;

@@ -33,7 +33,7 @@ complete -c mbrl -n "__fish_mbrl_needs_command" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_needs_command" -s V -l version -d 'Print version'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "collect" -d 'Collect rollouts from a simulator into an MCAP dataset'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "plan" -d 'Plan with CEM on a model and execute the plan in the simulator (MPC)'
-complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "train" -d 'Train a model and write it to a checkpoint directory (config.json, metrics.jsonl, weights)'
+complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "train" -d 'Train a model and write it to a checkpoint directory (config.json, weights, metrics.jsonl)'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "filter" -d 'Filter table-tennis ball recordings with the gray-box EKF (thesis chapter 6)'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "predict" -d 'Predict table-tennis ball trajectories: filter until a horizon before the end, then predict ahead'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "solve-board" -d 'Find a shortest solution of a LightsOut or TileSwap board and optionally play it with a manipulator'
@@ -61,7 +61,11 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -s q -l quiet -d 'Pri
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -s V -l version -d 'Print version'
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l env -d 'Environment: pendulum[:light|heavy|mass=<m>|inverted|quadrant]' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l model -d 'Dynamics model the planner uses' -r -f -a "true\t'The simulator\'s own equations (ground truth)'"
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l model -d 'Dynamics the planner uses: `true` (the simulator\'s equations) or a checkpoint directory written by `mbrl train` (e.g. models/pets-pendulum)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l particles -d 'Particles per candidate for stochastic learned models (PETS: trajectory sampling)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l propagation -d 'How particles use the ensemble members' -r -f -a "ts1\t'TS-1: each particle draws an ensemble member anew at every step'
+tsinf\t'TS-∞: each particle keeps one member for the whole horizon'
+expectation\t'Each member\'s mean prediction, no sampling'"
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l steps -d 'Steps to execute' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l horizon -d 'Planning horizon in steps' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l candidates -d 'Candidate action sequences per iteration' -r
@@ -79,16 +83,25 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l no-tui -d 'Print plai
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -s V -l version -d 'Print version'
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l method -d 'What to train' -r -f -a "ball-ekf\t'Gray-box table-tennis ball EKF: learn the impact matrix, noise levels and initial values by maximizing the filter\'s marginal likelihood (thesis 6.4.4, eq. 6.24)'"
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l data -d 'Training data (ball: a .mcap ball dataset or a .csv recording)' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l out -d 'Checkpoint directory' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l steps -d 'Optimizer steps' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l batch -d 'Chunks per batch (thesis: 64)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l chunk -d 'Frames per chunk (thesis: 50)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l lr -d 'Adam learning rate (thesis: 5e-3)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l method -d 'What to train' -r -f -a "pets\t'Probabilistic ensemble of MLPs on (state, action) → state change (PETS, Chua et al. 2018), for any env that `collect` rolls out; plan with it via `mbrl plan --model DIR`'
+ball-ekf\t'Gray-box table-tennis ball EKF: learn the impact matrix, noise levels and initial values by maximizing the filter\'s marginal likelihood (thesis 6.4.4, eq. 6.24)'"
+complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l data -d 'Training data (repeatable). pets: rollout datasets (.mcap) of one env; ball-ekf: a ball dataset (.mcap) or a .csv recording' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l env -d 'The env the data must come from (pets; default: the dataset\'s env)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l out -d 'Checkpoint directory (default: models/<method>-<env>, models/ball-ekf)' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l resume -d 'Continue the stopped run in this checkpoint directory' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l config -d 'Hyperparameters from a TOML file (pets), over the preset\'s' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l preset -d 'Network size and training length (pets)' -r -f -a "small\t'3 hidden layers × 64 SiLU units, 2000 steps (≈ 10 s on 2 cores)'
+medium\t'4 × 200 SiLU units, 5000 steps: mbrl-lib\'s PETS pendulum network'"
+complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l ensemble -d 'Ensemble members (pets; default 5)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l steps -d 'Optimizer steps (pets: preset\'s; ball-ekf: 1000)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l batch -d 'Batch size: transitions per member (pets, 256) or chunks (ball-ekf, thesis 64)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l lr -d 'Adam learning rate (pets: 1e-3; ball-ekf: thesis 5e-3)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l reward -d 'Where the model\'s reward comes from (pets; default: known where the env has a closed form)' -r -f -a "known\t'The env\'s closed-form reward (pendulum variants without hidden actuators)'
+learned\t'An extra output of the network, trained on the dataset\'s rewards'"
+complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l chunk -d 'Frames per chunk (ball-ekf; thesis: 50)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l threads -d 'Worker threads (0 = one per core)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l launcher-prior -d 'Learn the spin prior from launcher settings (thesis C.1.3); recordings need side information'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l launcher-prior -d 'Learn the spin prior from launcher settings (ball-ekf, thesis C.1.3); recordings need side information'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -s q -l quiet -d 'Print only results and errors'
@@ -123,7 +136,7 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l board -d 'The 
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l random-depth -d 'Draw a random board whose shortest solution has this many moves (5x5 LightsOut, TileSwap)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l split -d 'Draw the random board from this split only (thesis appendix D.1.4)' -r -f -a "train\t''
 test\t''"
-complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l model -d 'Successor model used by the search' -r -f -a "true\t'The simulator\'s own equations (ground truth)'"
+complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l model -d 'Successor model used by the search' -r -f -a "true\t'The game\'s own rules (ground truth)'"
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l embodiment -d 'Play the plan with this manipulator\'s scripted controller' -r -f -a "cursor\t'A point moved by steps of at most 0.2, pushing where it stands (10 steps per move)'
 reacher\t'A torque-driven two-link arm over a 0.3 m board (50 steps per move)'"
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l search -d 'Search algorithm' -r -f -a "bidirectional\t'From both ends (moves undo themselves); far fewer states'
@@ -205,7 +218,11 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -s V -l version -d 'Print version'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l model -d 'Dynamics model the planner uses' -r -f -a "true\t'The simulator\'s own equations (ground truth)'"
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l model -d 'Dynamics the planner uses: `true` (the simulator\'s equations) or a checkpoint directory written by `mbrl train` (e.g. models/pets-pendulum)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l particles -d 'Particles per candidate for stochastic learned models (PETS: trajectory sampling)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l propagation -d 'How particles use the ensemble members' -r -f -a "ts1\t'TS-1: each particle draws an ensemble member anew at every step'
+tsinf\t'TS-∞: each particle keeps one member for the whole horizon'
+expectation\t'Each member\'s mean prediction, no sampling'"
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l episodes -d 'Number of episodes (each with its own start state)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l env -d 'Environment variant: pendulum[:light|heavy|mass=<m>|inverted|quadrant]' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l steps -d 'Steps per episode' -r
@@ -248,7 +265,7 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -s h -l help -d '
 complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -s V -l version -d 'Print version'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train filter predict solve-board eval watch completions help" -f -a "collect" -d 'Collect rollouts from a simulator into an MCAP dataset'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train filter predict solve-board eval watch completions help" -f -a "plan" -d 'Plan with CEM on a model and execute the plan in the simulator (MPC)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train filter predict solve-board eval watch completions help" -f -a "train" -d 'Train a model and write it to a checkpoint directory (config.json, metrics.jsonl, weights)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train filter predict solve-board eval watch completions help" -f -a "train" -d 'Train a model and write it to a checkpoint directory (config.json, weights, metrics.jsonl)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train filter predict solve-board eval watch completions help" -f -a "filter" -d 'Filter table-tennis ball recordings with the gray-box EKF (thesis chapter 6)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train filter predict solve-board eval watch completions help" -f -a "predict" -d 'Predict table-tennis ball trajectories: filter until a horizon before the end, then predict ahead'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train filter predict solve-board eval watch completions help" -f -a "solve-board" -d 'Find a shortest solution of a LightsOut or TileSwap board and optionally play it with a manipulator'

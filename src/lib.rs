@@ -7,8 +7,10 @@ pub mod error;
 pub mod eval;
 pub mod filtering;
 pub mod models;
+pub mod nn;
 pub mod planning;
 pub mod run;
+pub mod train;
 pub mod tui;
 
 pub use error::{Error, Result};

@@ -45,6 +45,15 @@ impl EnvName {
         }
     }
 
+    /// The reward in closed form, where the env has one that learned models may use instead of learning it.
+    pub fn known_reward(&self) -> Option<Box<dyn super::RewardFn>> {
+        match self {
+            EnvName::Pendulum(v) => super::pendulum::dynamics::PendulumReward::for_params(&v.fixed_params())
+                .map(|r| Box::new(r) as Box<dyn super::RewardFn>),
+            EnvName::Board(_) | EnvName::Ball => None,
+        }
+    }
+
     pub fn canonical(&self) -> String {
         match self {
             EnvName::Pendulum(v) => v.env_name(),

@@ -6,15 +6,19 @@ use std::path::Path;
 use super::ball::{self, BallEvalSettings};
 use super::boards::{self, EmbodiedSettings};
 use super::swingup::{self, SwingupSettings};
+use crate::data::collect::{collect_random, CollectSettings};
 use crate::data::collect_ball::{collect_ball, BallCollectSettings};
+use crate::data::write_dataset;
 use crate::envs::ball::Orientation;
 use crate::envs::boards::{LightsOut, Split};
 use crate::envs::embodiments::Embodiment;
 use crate::envs::pendulum::PendulumVariant;
+use crate::envs::EnvName;
 use crate::error::{Error, Result};
 use crate::models::ball::checkpoint::{load_ball_model, LoadedBallModel};
 use crate::models::ball::learn::{train, TrainSettings};
 use crate::models::ball::BallModel;
+use crate::models::pets::{self, PetsConfig, Preset, Propagation};
 use crate::run::atomic::write_text;
 use crate::run::dir::Provenance;
 use crate::run::Monitor;
@@ -24,6 +28,15 @@ pub const EMBODIED_BOARDS_PER_DEPTH: usize = 20;
 /// Enough to see the likelihood climb; the thesis-scale run is `make repro-ball`.
 pub const QUICK_BALL_TRAIN_STEPS: u64 = 150;
 
+/// The learned-model loop at a size that keeps `eval quick` around a minute; `make repro-pets` runs the thesis'
+/// CEM settings on 10 seeds.
+pub const QUICK_PETS_ROLLOUTS: usize = 200;
+pub const QUICK_PETS_TRAIN_STEPS: u64 = 1500;
+pub const QUICK_PETS_EPISODES: usize = 3;
+pub const QUICK_PETS_SWINGUP_STEPS: usize = 100;
+pub const QUICK_PETS_CANDIDATES: usize = 400;
+pub const QUICK_PETS_PARTICLES: usize = 5;
+
 pub struct QuickSummary {
     pub lines: Vec<String>,
 }
@@ -31,7 +44,8 @@ pub struct QuickSummary {
 pub fn run_quick(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) -> Result<QuickSummary> {
     std::fs::create_dir_all(out_dir).map_err(|e| Error::io(out_dir, e))?;
     let settings = SwingupSettings::thesis(PendulumVariant::Standard);
-    let swing = swingup::evaluate(&settings, SWINGUP_EPISODES, provenance, &out_dir.join("pendulum-swingup"), monitor)?;
+    let swing =
+        swingup::evaluate(&settings, None, SWINGUP_EPISODES, provenance, &out_dir.join("pendulum-swingup"), monitor)?;
     let mut lines = vec![format!(
         "pendulum swing-up (ground-truth model, CEM {}×{}×{}): {}/{} episodes succeeded; see pendulum-swingup/report.md",
         settings.cem.candidates, settings.cem.horizon, settings.cem.iterations, swing.successes, swing.episodes
@@ -59,6 +73,7 @@ pub fn run_quick(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor)
     lines.push(format!(
         "LightsOut played by the Reacher's scripted controller, depths 1-5 (test split): {solved}/{total} boards solved; see lightsout-reacher/report.md"
     ));
+    lines.push(pets_slice(provenance, out_dir, monitor)?);
     lines.push(ball_slice(provenance, out_dir, monitor)?);
     let mut md = String::from("# mbrl quick reproduction\n\nSmall-scale runs of each implemented method.\n\n");
     for line in &lines {
@@ -67,6 +82,53 @@ pub fn run_quick(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor)
     let path = out_dir.join("report.md");
     write_text(&path, &md)?;
     Ok(QuickSummary { lines })
+}
+
+/// The basic model-based loop: random pendulum data → a trained PETS ensemble → MPC swing-ups planned on the
+/// learned model (and executed in the simulator).
+fn pets_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) -> Result<String> {
+    let dir = out_dir.join("pets");
+    let data_path = dir.join("pendulum-random.mcap");
+    let collect = CollectSettings {
+        env: EnvName::Pendulum(PendulumVariant::Standard),
+        rollouts: QUICK_PETS_ROLLOUTS,
+        steps: 30,
+        seed: provenance.seed,
+        command_line: provenance.command_line.clone(),
+    };
+    write_dataset(&data_path, &collect_random(&collect, monitor)?)?;
+    let mut config = PetsConfig::preset(Preset::Small);
+    config.steps = QUICK_PETS_TRAIN_STEPS;
+    let request = pets::TrainRequest {
+        out: dir.join("model"),
+        data: vec![data_path],
+        env: None,
+        config,
+        seed: provenance.seed,
+        provenance: provenance.clone(),
+    };
+    let trained = pets::train(&request, false, monitor)?;
+    let model = pets::load_dynamics(&request.out, &collect.env, Propagation::TsInf, QUICK_PETS_PARTICLES)?;
+    let mut settings = SwingupSettings::thesis(PendulumVariant::Standard);
+    settings.steps = QUICK_PETS_SWINGUP_STEPS;
+    settings.cem.candidates = QUICK_PETS_CANDIDATES;
+    settings.cem.elites = QUICK_PETS_CANDIDATES / 10;
+    let swing =
+        swingup::evaluate(&settings, Some(&model), QUICK_PETS_EPISODES, provenance, &dir.join("swingup"), monitor)?;
+    let mean_return = swing.returns.iter().sum::<f64>() / swing.episodes.max(1) as f64;
+    Ok(format!(
+        "PETS: ensemble of 5 trained {} steps on {} random transitions (validation MSE {}); swing-up planned on the \
+         learned model (CEM {}×{}×{}, {} TS-∞ particles): {}/{} episodes succeeded, mean return {mean_return:.1}; see pets/swingup/report.md",
+        QUICK_PETS_TRAIN_STEPS,
+        trained.run.transitions.train,
+        trained.outcome.best_valid_loss.map(|v| format!("{v:.2e}")).unwrap_or_else(|| "–".into()),
+        settings.cem.candidates,
+        settings.cem.horizon,
+        settings.cem.iterations,
+        QUICK_PETS_PARTICLES,
+        swing.successes,
+        swing.episodes
+    ))
 }
 
 /// Ball: a short EKF training run from Table C.1 on simulated shots, then the prediction protocol for

@@ -10,7 +10,7 @@ use super::stats::{mean, quantile};
 use super::table::write_csv;
 use crate::data::{write_dataset, Dataset, DatasetMeta, Rollout, FORMAT_VERSION};
 use crate::envs::pendulum::{angle_normalize, Pendulum, PendulumVariant, StartDistribution};
-use crate::envs::Env;
+use crate::envs::{BatchDynamics, Env};
 use crate::error::Result;
 use crate::planning::mpc::run_mpc_episode;
 use crate::planning::seeding::{derive_seed, rng_for};
@@ -56,56 +56,75 @@ pub struct SwingupEpisode {
     pub success: bool,
 }
 
-/// The live-view panels of a swing-up job.
-pub fn layout(title: &str) -> Event {
-    Event::Layout {
-        title: title.to_string(),
-        panels: vec![
-            PanelSpec {
-                title: "pendulum (current episode)".into(),
-                x_label: "step".into(),
-                series: vec!["pendulum/angle".into(), "pendulum/action".into()],
-                restart_on_rewind: true,
-            },
-            PanelSpec {
-                title: "CEM (current MPC step)".into(),
-                x_label: "iteration".into(),
-                series: vec!["cem/best_cost".into(), "cem/elite_mean_cost".into()],
-                restart_on_rewind: true,
-            },
-        ],
+/// The live-view panels of a swing-up job; with a learned model, also its one-step predictions beside what
+/// happened.
+pub fn layout(title: &str, learned_model: bool) -> Event {
+    let mut panels = vec![
+        PanelSpec {
+            title: "pendulum (current episode)".into(),
+            x_label: "step".into(),
+            series: vec!["pendulum/angle".into(), "pendulum/action".into()],
+            restart_on_rewind: true,
+        },
+        PanelSpec {
+            title: "CEM (current MPC step)".into(),
+            x_label: "iteration".into(),
+            series: vec!["cem/best_cost".into(), "cem/elite_mean_cost".into()],
+            restart_on_rewind: true,
+        },
+    ];
+    if learned_model {
+        panels.push(PanelSpec {
+            title: "model: predicted vs executed angle".into(),
+            x_label: "step".into(),
+            series: vec!["model/predicted_angle".into(), "model/executed_angle".into()],
+            restart_on_rewind: true,
+        });
     }
+    Event::Layout { title: title.to_string(), panels }
 }
 
-/// Runs one MPC swing-up with the ground-truth model. Episode `k` under `seed` always starts from the same
-/// state and samples the same candidates.
+/// Runs one MPC swing-up, planning on `model` (`None`: the simulator's own equations). Episode `k` under
+/// `seed` always starts from the same state and samples the same candidates.
 pub fn run_episode(
     settings: &SwingupSettings,
+    model: Option<&dyn BatchDynamics>,
     seed: u64,
     episode: u64,
     monitor: &dyn Monitor,
 ) -> Result<SwingupEpisode> {
+    let model_is_learned = model.is_some();
     let mut env = Pendulum::new(settings.variant.clone()).with_start(StartDistribution::Hanging);
     let mut rng = rng_for(seed, &[episode, 0]);
     env.sample_instance(&mut rng);
     env.reset(&mut rng);
-    let model = env.pendulum_dynamics();
+    let truth = env.pendulum_dynamics();
+    let model: &dyn BatchDynamics = match model {
+        Some(m) => m,
+        None => &truth,
+    };
     let mut cem = Cem::new(settings.cem.clone(), derive_seed(seed, &[episode, 1]))?;
     let phase = format!("episode {} MPC", episode + 1);
     let rollout = run_mpc_episode(
         &mut env,
-        &model,
+        model,
         &mut cem,
         settings.steps,
+        derive_seed(seed, &[episode, 2]),
         monitor,
         |_, it| {
             monitor.scalar("cem/best_cost", it.iteration as u64, it.best_cost);
             monitor.scalar("cem/elite_mean_cost", it.iteration as u64, it.elite_mean_cost);
         },
-        |t, state, action, _| {
-            monitor.scalar("pendulum/angle", t as u64, angle_normalize(state[0]));
-            monitor.scalar("pendulum/action", t as u64, action[0]);
-            monitor.progress(&phase, t as u64 + 1, settings.steps as u64);
+        |step| {
+            let t = step.t as u64;
+            monitor.scalar("pendulum/angle", t, angle_normalize(step.state[0]));
+            monitor.scalar("pendulum/action", t, step.action[0]);
+            if model_is_learned {
+                monitor.scalar("model/predicted_angle", t + 1, angle_normalize(step.predicted_next[0]));
+                monitor.scalar("model/executed_angle", t + 1, angle_normalize(step.next_state[0]));
+            }
+            monitor.progress(&phase, t + 1, settings.steps as u64);
         },
     )?;
     let total_return = rollout.total_reward();
@@ -145,7 +164,7 @@ struct SwingupConfigRecord<'a> {
     #[serde(flatten)]
     provenance: &'a Provenance,
     episodes: usize,
-    model: &'static str,
+    model: String,
     settings: &'a SwingupSettings,
 }
 
@@ -159,6 +178,7 @@ pub struct SwingupSummary {
 /// episodes.csv, angle.png, returns.png, rollouts.mcap, config.json and metrics.jsonl.
 pub fn evaluate(
     settings: &SwingupSettings,
+    model: Option<&dyn BatchDynamics>,
     episodes: usize,
     provenance: &Provenance,
     report_dir: &Path,
@@ -169,16 +189,16 @@ pub fn evaluate(
         job: "eval pendulum-swingup",
         provenance,
         episodes,
-        model: "true",
+        model: model_description(model),
         settings,
     })?;
     let metrics = run.metrics()?;
     let monitor = Tee { first: monitor, second: &metrics };
-    monitor.emit(&layout("pendulum swing-up, ground-truth model + CEM"));
+    monitor.emit(&layout(&format!("pendulum swing-up, {} + CEM", model_description(model)), model.is_some()));
     let mut results = Vec::with_capacity(episodes);
     for k in 0..episodes as u64 {
         monitor.progress("episodes", k, episodes as u64);
-        let ep = run_episode(settings, provenance.seed, k, &monitor)?;
+        let ep = run_episode(settings, model, provenance.seed, k, &monitor)?;
         monitor.message(&format!(
             "episode {}: return {:.1}, {}",
             k + 1,
@@ -188,7 +208,7 @@ pub fn evaluate(
         results.push(ep);
     }
     monitor.progress("episodes", episodes as u64, episodes as u64);
-    write_outputs(settings, provenance, &run, &results)?;
+    write_outputs(settings, &model_description(model), provenance, &run, &results)?;
     // Only the run's own file is told it finished: the caller's view may have more jobs to show.
     metrics.emit(&Event::Finished { ok: true });
     Ok(SwingupSummary {
@@ -198,8 +218,14 @@ pub fn evaluate(
     })
 }
 
+/// What the planner planned on, in words for reports.
+pub fn model_description(model: Option<&dyn BatchDynamics>) -> String {
+    model.map(|m| m.describe()).unwrap_or_else(|| "ground-truth model".into())
+}
+
 fn write_outputs(
     settings: &SwingupSettings,
+    model: &str,
     provenance: &Provenance,
     run: &RunDir,
     results: &[SwingupEpisode],
@@ -238,7 +264,7 @@ fn write_outputs(
         &run.file("rollouts.mcap"),
         &episodes_dataset(settings, provenance.seed, &provenance.command_line, results),
     )?;
-    let report = report_markdown(settings, provenance, results);
+    let report = report_markdown(settings, model, provenance, results);
     write_text(&run.file("report.md"), &report)
 }
 
@@ -255,13 +281,18 @@ fn wrapped_angle_points(states: &[Vec<f64>], dt: f64) -> Vec<(f64, f64)> {
     points
 }
 
-fn report_markdown(settings: &SwingupSettings, provenance: &Provenance, results: &[SwingupEpisode]) -> String {
+fn report_markdown(
+    settings: &SwingupSettings,
+    model: &str,
+    provenance: &Provenance,
+    results: &[SwingupEpisode],
+) -> String {
     let returns: Vec<f64> = results.iter().map(|e| e.total_return).collect();
     let successes = results.iter().filter(|e| e.success).count();
     let fmt = |v: Option<f64>| v.map(|x| format!("{x:.1}")).unwrap_or_else(|| "–".into());
     let c = &settings.cem;
     let mut md = format!(
-        "# Pendulum swing-up: ground-truth model + CEM\n\n\
+        "# Pendulum swing-up: {model} + CEM\n\n\
          Environment `{}`, start θ ∼ U[π−0.05, π+0.05], θ̇ ∼ U[−0.05, 0.05], {} steps.\n\
          CEM: horizon {}, {} candidates, {} elites, {} iterations, noise {:?}, warm start {}.\n\
          Seed {}, command `{}`.\n\n\

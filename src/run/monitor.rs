@@ -231,6 +231,30 @@ impl JsonlMonitor {
         let file = std::fs::File::create(path)?;
         Ok(JsonlMonitor { out: Mutex::new(BufWriter::new(file)) })
     }
+
+    /// Continues a log after its first `keep_bytes` bytes, dropping what a stopped run wrote after its last
+    /// checkpoint, so that a resumed run's log equals an uninterrupted one.
+    pub fn resume(path: &Path, keep_bytes: u64) -> std::io::Result<Self> {
+        use std::io::{Seek, SeekFrom};
+        let mut file = std::fs::OpenOptions::new().write(true).open(path)?;
+        if file.metadata()?.len() < keep_bytes {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::UnexpectedEof,
+                format!("shorter than the {keep_bytes} bytes the checkpoint recorded"),
+            ));
+        }
+        file.set_len(keep_bytes)?;
+        file.seek(SeekFrom::End(0))?;
+        Ok(JsonlMonitor { out: Mutex::new(BufWriter::new(file)) })
+    }
+
+    /// Flushes and returns the log's length.
+    pub fn flush_position(&self) -> std::io::Result<u64> {
+        use std::io::Seek;
+        let mut out = self.out.lock().unwrap_or_else(|e| e.into_inner());
+        out.flush()?;
+        out.get_mut().stream_position()
+    }
 }
 
 impl Monitor for JsonlMonitor {

@@ -111,6 +111,7 @@ impl<G: BoardGame> Env for EmbodiedBoard<G> {
             action_low: self.manipulator.action_low(),
             action_high: self.manipulator.action_high(),
             dt: self.manipulator.dt(),
+            angular: vec![false; self.manipulator.state().len() + board.len() + 1],
         }
     }
 

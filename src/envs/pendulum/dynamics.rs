@@ -1,7 +1,7 @@
 //! The pendulum's transition and reward as pure functions, shared by the environment and by planners.
 
 use super::params::{angle_normalize, quadrant_of, PendulumParams};
-use crate::envs::Dynamics;
+use crate::envs::{Dynamics, RewardFn};
 
 /// One simulator step of gym Pendulum-v0. The order matters: the reward is computed on the pre-step
 /// state, θ advances with the *unclipped* new velocity, and only then is θ̇ clipped (gymnasium v1 clips
@@ -56,5 +56,48 @@ impl Dynamics for PendulumDynamics {
         state[0] = s[0];
         state[1] = s[1];
         r
+    }
+}
+
+/// gym's pendulum reward from the pre-step state and the action, for learned models that predict the state
+/// alone. Exact where one action is one simulator step and no hidden actuator scales the torque's magnitude
+/// (every variant but `quadrant`): mass changes leave the cost alone, and an inverted action has the same square.
+#[derive(Clone, Debug)]
+pub struct PendulumReward {
+    pub max_torque: f64,
+}
+
+impl PendulumReward {
+    pub fn for_params(p: &PendulumParams) -> Option<Self> {
+        let magnitude_kept = (p.action_factor.abs() - 1.0).abs() < 1e-12;
+        (p.quadrants.is_none() && p.action_repeat == 1 && magnitude_kept)
+            .then_some(PendulumReward { max_torque: p.max_torque })
+    }
+}
+
+impl RewardFn for PendulumReward {
+    fn reward(&self, state: &[f64], action: &[f64], _next_state: &[f64]) -> f64 {
+        let torque = action[0].clamp(-self.max_torque, self.max_torque);
+        -(angle_normalize(state[0]).powi(2) + 0.1 * state[1].powi(2) + 0.001 * torque.powi(2))
+    }
+}
+
+#[cfg(test)]
+mod reward_tests {
+    use super::*;
+    use crate::envs::pendulum::PendulumVariant;
+
+    #[test]
+    fn known_reward_equals_the_simulator_reward() {
+        for name in ["", "light", "heavy", "inverted"] {
+            let p = PendulumVariant::parse(name).unwrap().fixed_params();
+            let reward = PendulumReward::for_params(&p).expect("variant has a closed-form reward");
+            for (theta, speed, action) in [(3.0, 0.5, 1.5), (-0.2, -7.0, -3.0), (7.5, 2.0, 0.3)] {
+                let mut s = [theta, speed];
+                let r = env_step(&p, &mut s, action);
+                assert!((reward.reward(&[theta, speed], &[action], &s) - r).abs() < 1e-12, "{name}");
+            }
+        }
+        assert!(PendulumReward::for_params(&PendulumVariant::parse("quadrant").unwrap().fixed_params()).is_none());
     }
 }

@@ -62,6 +62,7 @@ impl Env for Pendulum {
             action_low: vec![-self.params.max_torque],
             action_high: vec![self.params.max_torque],
             dt: self.params.dt * self.params.action_repeat as f64,
+            angular: vec![true, false],
         }
     }
 

@@ -1,0 +1,275 @@
+//! PETS (Chua et al. 2018, as in mbrl-lib): an ensemble of probabilistic MLPs predicting the state change,
+//! bootstrapped per member, planned over with CEM and trajectory sampling. The first learned dynamics model of
+//! mbrl and the reference for the ones that follow.
+
+pub mod config;
+pub mod data;
+pub mod dynamics;
+pub mod net;
+pub mod train;
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+pub use config::{PetsConfig, Preset, RewardSource};
+pub use dynamics::{PetsDynamics, Propagation};
+pub use train::PetsTrainer;
+
+use crate::data::{read_dataset, Dataset};
+use crate::envs::{parse_env, EnvName};
+use crate::error::{Error, Result};
+use crate::nn::Normalizer;
+use crate::run::dir::Provenance;
+use crate::run::Monitor;
+use crate::train::checkpoint::read_bounded;
+use crate::train::tensors::{to_params, TensorData};
+use crate::train::{run_training, training_layout, FitOutcome, FitSettings, OpenedCheckpoint, MODEL_FILE};
+
+pub const METHOD: &str = "pets";
+/// Datasets larger than this are refused before reading (≈ 20 M transitions of a small env).
+const MAX_DATASET_BYTES: u64 = 4 << 30;
+
+/// A dataset file as the run saw it, so `--resume` can tell when the data changed underneath.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DataFile {
+    pub path: PathBuf,
+    pub bytes: u64,
+    pub crc32: u32,
+}
+
+/// What the model is a model of: enough to rebuild features and check an env at planning time.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelSpec {
+    pub state_names: Vec<String>,
+    pub angular: Vec<bool>,
+    pub action_dim: usize,
+    pub input_dim: usize,
+    pub target_dim: usize,
+}
+
+/// config.json of a PETS checkpoint.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PetsRun {
+    pub method: String,
+    pub env: String,
+    pub data: Vec<DataFile>,
+    pub seed: u64,
+    pub model: ModelSpec,
+    pub config: PetsConfig,
+    pub transitions: TransitionCounts,
+    pub provenance: Provenance,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TransitionCounts {
+    pub train: usize,
+    pub valid: usize,
+    pub train_rollouts: usize,
+    pub valid_rollouts: usize,
+}
+
+pub struct TrainRequest {
+    pub out: PathBuf,
+    pub data: Vec<PathBuf>,
+    /// The env the user named; must agree with the datasets'. `None`: take the datasets' env.
+    pub env: Option<String>,
+    pub config: PetsConfig,
+    pub seed: u64,
+    pub provenance: Provenance,
+}
+
+pub struct TrainReport {
+    pub run: PetsRun,
+    pub outcome: FitOutcome,
+    pub parameters: usize,
+}
+
+/// Reads and concatenates datasets of one env (rollout ids renumbered so they stay distinct).
+pub fn load_datasets(paths: &[PathBuf]) -> Result<(Dataset, Vec<DataFile>)> {
+    let mut merged: Option<Dataset> = None;
+    let mut files = Vec::new();
+    for path in paths {
+        let bytes = read_bounded(path, MAX_DATASET_BYTES)?;
+        files.push(DataFile { path: path.clone(), bytes: bytes.len() as u64, crc32: crc32fast::hash(&bytes) });
+        let mut dataset = read_dataset(path)?;
+        match &mut merged {
+            None => merged = Some(dataset),
+            Some(m) => {
+                if dataset.meta.env != m.meta.env
+                    || dataset.meta.state_names != m.meta.state_names
+                    || dataset.meta.action_dim != m.meta.action_dim
+                {
+                    return Err(Error::bad_file(
+                        path,
+                        format!("is a dataset of '{}'; the first dataset is of '{}'", dataset.meta.env, m.meta.env),
+                    ));
+                }
+                let offset = m.steps.iter().map(|s| s.rollout + 1).max().unwrap_or(0);
+                for step in &mut dataset.steps {
+                    step.rollout =
+                        step.rollout.checked_add(offset).ok_or_else(|| Error::bad_file(path, "too many rollouts"))?;
+                }
+                m.steps.extend(dataset.steps);
+            }
+        }
+    }
+    let dataset = merged.ok_or_else(|| Error::config("no dataset given; pass --data FILE.mcap"))?;
+    Ok((dataset, files))
+}
+
+fn env_of(dataset: &Dataset, requested: Option<&str>, data: &Path) -> Result<EnvName> {
+    let env = parse_env(&dataset.meta.env).map_err(|e| Error::bad_file(data, format!("dataset env: {e}")))?;
+    if let Some(requested) = requested {
+        let requested_env = parse_env(requested)?;
+        if requested_env.canonical() != env.canonical() {
+            return Err(Error::bad_file(
+                data,
+                format!("holds '{}' rollouts; --env asked for '{}'", env.canonical(), requested_env.canonical()),
+            ));
+        }
+    }
+    Ok(env)
+}
+
+/// Trains (or, with `resume`, continues) a PETS ensemble into `request.out`.
+pub fn train(request: &TrainRequest, resume: bool, monitor: &dyn Monitor) -> Result<TrainReport> {
+    request.config.validate()?;
+    let (dataset, files) = load_datasets(&request.data)?;
+    let env = env_of(&dataset, request.env.as_deref(), &request.data[0])?;
+    let spec = env.build()?.spec();
+    if request.config.reward == RewardSource::Known && env.known_reward().is_none() {
+        return Err(Error::config(format!(
+            "env '{}' has no closed-form reward; train with --reward learned",
+            env.canonical()
+        )));
+    }
+    let split = data::split_dataset(
+        &dataset,
+        &spec.angular,
+        request.config.reward,
+        request.config.validation_fraction,
+        request.seed,
+    )?;
+    let run = PetsRun {
+        method: METHOD.into(),
+        env: env.canonical(),
+        data: files,
+        seed: request.seed,
+        model: ModelSpec {
+            state_names: dataset.meta.state_names.clone(),
+            angular: spec.angular.clone(),
+            action_dim: dataset.meta.action_dim,
+            input_dim: split.train.input_dim,
+            target_dim: split.train.target_dim,
+        },
+        config: request.config.clone(),
+        transitions: TransitionCounts {
+            train: split.train.len(),
+            valid: split.valid.len(),
+            train_rollouts: split.train_rollouts,
+            valid_rollouts: split.valid_rollouts,
+        },
+        provenance: request.provenance.clone(),
+    };
+    let mut trainer = PetsTrainer::new(request.config.clone(), request.seed, split.train, split.valid)?;
+    let parameters = trainer.parameter_count();
+    let settings = FitSettings {
+        method: METHOD.into(),
+        env: Some(run.env.clone()),
+        total_steps: request.config.steps,
+        validate_every: request.config.validate_every,
+        checkpoint_every: request.config.checkpoint_every,
+    };
+    let config = serde_json::to_value(&run).map_err(|e| Error::config(e.to_string()))?;
+    let title = format!(
+        "train PETS on {} ({} transitions, ensemble of {})",
+        run.env, run.transitions.train, request.config.ensemble
+    );
+    let outcome =
+        run_training(&request.out, &config, &settings, &mut trainer, resume, &training_layout(&title), monitor)?;
+    Ok(TrainReport { run, outcome, parameters })
+}
+
+/// Continues the run in `dir` from its last checkpoint, with the config and data it was started with.
+pub fn resume(dir: &Path, monitor: &dyn Monitor) -> Result<TrainReport> {
+    let opened = OpenedCheckpoint::open(dir)?;
+    let run: PetsRun = serde_json::from_value(opened.config.clone())
+        .map_err(|e| Error::bad_file(&opened.dir.file("config.json"), format!("not a PETS run config: {e}")))?;
+    for file in &run.data {
+        let bytes = read_bounded(&file.path, MAX_DATASET_BYTES)?;
+        if bytes.len() as u64 != file.bytes || crc32fast::hash(&bytes) != file.crc32 {
+            return Err(Error::bad_file(
+                &file.path,
+                "changed since the run started; resuming would not continue the same run",
+            ));
+        }
+    }
+    let request = TrainRequest {
+        out: dir.to_path_buf(),
+        data: run.data.iter().map(|f| f.path.clone()).collect(),
+        env: Some(run.env.clone()),
+        config: run.config.clone(),
+        seed: run.seed,
+        provenance: run.provenance.clone(),
+    };
+    train(&request, true, monitor)
+}
+
+/// A finished PETS checkpoint as a planner's dynamics in `env` (which must be the env it was trained on).
+pub fn load_dynamics(dir: &Path, env: &EnvName, propagation: Propagation, particles: usize) -> Result<PetsDynamics> {
+    let opened = OpenedCheckpoint::open(dir)?;
+    opened.expect_finished(METHOD)?;
+    let run: PetsRun = serde_json::from_value(opened.config.clone())
+        .map_err(|e| Error::bad_file(&opened.dir.file("config.json"), format!("not a PETS run config: {e}")))?;
+    if run.env != env.canonical() {
+        return Err(Error::bad_file(
+            dir,
+            format!("is a model of '{}'; it cannot plan in '{}'", run.env, env.canonical()),
+        ));
+    }
+    run.config.validate().map_err(|e| Error::bad_file(&opened.dir.file("config.json"), e.to_string()))?;
+    let stored = opened.tensors(MODEL_FILE)?;
+    let model_path = opened.dir.file(MODEL_FILE);
+    let normalizer_part = |name: &str| -> Result<Vec<f32>> {
+        match stored.iter().find(|t| t.name == name).map(|t| &t.data) {
+            Some(TensorData::F32(v)) if v.len() == run.model.input_dim => Ok(v.clone()),
+            _ => Err(Error::bad_file(&model_path, format!("lacks '{name}' with {} f32 values", run.model.input_dim))),
+        }
+    };
+    let normalizer = Normalizer { mean: normalizer_part(net::INPUT_MEAN)?, std: normalizer_part(net::INPUT_STD)? };
+    normalizer.validate().map_err(|e| Error::bad_file(&model_path, e.to_string()))?;
+    let layout = layout_of(&run)?;
+    let weights: Vec<_> = stored.iter().filter(|t| !t.name.starts_with("input_normalizer.")).cloned().collect();
+    let weights = to_params(&model_path, &weights, &layout)?;
+    let reward = match run.config.reward {
+        RewardSource::Known => Some(env.known_reward().ok_or_else(|| {
+            Error::config(format!("env '{}' has no closed-form reward for this model", env.canonical()))
+        })?),
+        RewardSource::Learned => None,
+    };
+    PetsDynamics::new(
+        &run.config,
+        &weights,
+        normalizer,
+        run.model.angular.clone(),
+        run.model.action_dim,
+        reward,
+        propagation,
+        particles,
+    )
+    .map_err(|e| Error::bad_file(&model_path, e.to_string()))
+}
+
+/// The parameter names and shapes a network of this run has (built on the inference device, weights unused).
+fn layout_of(run: &PetsRun) -> Result<crate::nn::ParamSet> {
+    use rand::SeedableRng;
+    let device = crate::nn::tensor::inference_device();
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0);
+    let net = net::PetsNet::init(&run.config, run.model.input_dim, run.model.target_dim, &device, &mut rng);
+    Ok(crate::nn::ParamSet::from_module(&net, net::torch_name))
+}

@@ -1,0 +1,182 @@
+//! Training the ensemble: one [`TrainingMethod`] step draws a batch per member (from its bootstrap resample),
+//! takes the Gaussian NLL through burn's autodiff and updates the weights with our Adam.
+
+use burn::tensor::Device;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use super::config::PetsConfig;
+use super::data::Transitions;
+use super::net::{torch_name, PetsNet, INPUT_MEAN, INPUT_STD};
+use crate::error::{Error, Result};
+use crate::nn::tensor::{scalar, tensor, training_device};
+use crate::nn::{gaussian_nll, Adam, Normalizer, ParamSet};
+use crate::planning::seeding::{derive_seed, rng_for};
+use crate::train::tensors::TensorData;
+use crate::train::{StoredTensor, TrainingMethod};
+
+const INIT_STREAM: u64 = 1;
+const BOOTSTRAP_STREAM: u64 = 2;
+const BATCH_STREAM: u64 = 3;
+/// Validation looks at this many held-out rows at most, the first ones, so its cost stays bounded.
+const MAX_VALID_ROWS: usize = 4096;
+
+pub struct PetsTrainer {
+    config: PetsConfig,
+    seed: u64,
+    device: Device,
+    net: Option<PetsNet>,
+    params: ParamSet,
+    adam: Adam<f32>,
+    normalizer: Normalizer,
+    train: Transitions,
+    valid: Transitions,
+    /// Per member: the training rows it draws its batches from.
+    members_rows: Vec<Vec<u32>>,
+}
+
+impl PetsTrainer {
+    /// A fresh ensemble for `train` (raw inputs; the normalizer is fitted here) and `valid`.
+    pub fn new(config: PetsConfig, seed: u64, mut train: Transitions, mut valid: Transitions) -> Result<Self> {
+        config.validate()?;
+        if train.is_empty() {
+            return Err(Error::data("no training transitions"));
+        }
+        if train.len() > u32::MAX as usize {
+            return Err(Error::Budget(format!("{} training transitions; at most {} supported", train.len(), u32::MAX)));
+        }
+        let normalizer = Normalizer::fit(&train.inputs, train.input_dim)?;
+        normalizer.apply(&mut train.inputs);
+        normalizer.apply(&mut valid.inputs);
+        let device = training_device();
+        let mut init_rng = ChaCha8Rng::seed_from_u64(derive_seed(seed, &[INIT_STREAM]));
+        let net = PetsNet::init(&config, train.input_dim, train.target_dim, &device, &mut init_rng);
+        let params = ParamSet::from_module(&net, torch_name);
+        let sizes: Vec<usize> = params.tensors.iter().map(|t| t.values.len()).collect();
+        let adam = Adam::new(config.optimizer, &sizes);
+        let n = train.len();
+        let members_rows = (0..config.ensemble as u64)
+            .map(|e| {
+                if config.bootstrap {
+                    let mut rng = rng_for(seed, &[BOOTSTRAP_STREAM, e]);
+                    (0..n).map(|_| rng.random_range(0..n) as u32).collect()
+                } else {
+                    (0..n as u32).collect()
+                }
+            })
+            .collect();
+        Ok(PetsTrainer { config, seed, device, net: Some(net), params, adam, normalizer, train, valid, members_rows })
+    }
+
+    fn net(&self) -> &PetsNet {
+        self.net.as_ref().expect("the network is only taken out while loading new weights")
+    }
+
+    fn load_params(&mut self) -> Result<()> {
+        let net = self.net.take().expect("network present");
+        self.net = Some(self.params.load_into(net, &self.device)?);
+        Ok(())
+    }
+
+    pub fn parameter_count(&self) -> usize {
+        self.params.count()
+    }
+}
+
+impl TrainingMethod for PetsTrainer {
+    fn step(&mut self, step: u64) -> Result<f64> {
+        let (e, b) = (self.config.ensemble, self.config.batch_size);
+        let (din, dout) = (self.train.input_dim, self.train.target_dim);
+        let mut rng = rng_for(self.seed, &[BATCH_STREAM, step]);
+        let mut inputs = Vec::with_capacity(e * b * din);
+        let mut targets = Vec::with_capacity(e * b * dout);
+        for rows in &self.members_rows {
+            for _ in 0..b {
+                let row = rows[rng.random_range(0..rows.len())] as usize;
+                inputs.extend_from_slice(&self.train.inputs[row * din..(row + 1) * din]);
+                targets.extend_from_slice(&self.train.targets[row * dout..(row + 1) * dout]);
+            }
+        }
+        let net = self.net();
+        let (mean, logvar) = net.forward(tensor(inputs, [e, b, din], &self.device));
+        let loss = gaussian_nll(mean, logvar, tensor(targets, [e, b, dout], &self.device)) + net.bounds.penalty();
+        let value = scalar(&loss);
+        if !value.is_finite() {
+            return Ok(value);
+        }
+        let mut grads = ParamSet::gradients(net, &loss.backward());
+        self.adam.update(&mut self.params.values_mut(), &mut grads)?;
+        self.load_params()?;
+        Ok(value)
+    }
+
+    fn validate(&mut self) -> Result<Option<f64>> {
+        let rows = self.valid.len().min(MAX_VALID_ROWS);
+        if rows == 0 {
+            return Ok(None);
+        }
+        let (e, din, dout) = (self.config.ensemble, self.valid.input_dim, self.valid.target_dim);
+        let inputs: Vec<f32> = self.valid.inputs[..rows * din].repeat(e);
+        let targets: Vec<f32> = self.valid.targets[..rows * dout].repeat(e);
+        let (mean, _) = self.net().forward(tensor(inputs, [e, rows, din], &self.device));
+        let mse = (mean - tensor(targets, [e, rows, dout], &self.device)).powi_scalar(2).mean();
+        Ok(Some(scalar(&mse.reshape([1]))))
+    }
+
+    fn weights(&self) -> Vec<StoredTensor> {
+        let mut out = crate::train::tensors::from_params(&self.params);
+        let d = self.normalizer.dim();
+        out.push(StoredTensor::f32(INPUT_MEAN, vec![d], self.normalizer.mean.clone()));
+        out.push(StoredTensor::f32(INPUT_STD, vec![d], self.normalizer.std.clone()));
+        out
+    }
+
+    fn state(&self) -> Vec<StoredTensor> {
+        let mut out = Vec::with_capacity(3 * self.params.len() + 1);
+        for (k, t) in self.params.tensors.iter().enumerate() {
+            out.push(StoredTensor::f32(format!("live.{}", t.name), t.shape.clone(), t.values.clone()));
+            out.push(StoredTensor::f32(
+                format!("adam.exp_avg.{}", t.name),
+                t.shape.clone(),
+                self.adam.exp_avg[k].clone(),
+            ));
+            out.push(StoredTensor::f32(
+                format!("adam.exp_avg_sq.{}", t.name),
+                t.shape.clone(),
+                self.adam.exp_avg_sq[k].clone(),
+            ));
+        }
+        out.push(StoredTensor::f64("adam.step", vec![1], vec![self.adam.step as f64]));
+        out
+    }
+
+    fn restore(&mut self, state: &[StoredTensor]) -> Result<()> {
+        let find = |name: &str| -> Result<&Vec<f32>> {
+            match state.iter().find(|t| t.name == name).map(|t| &t.data) {
+                Some(TensorData::F32(v)) => Ok(v),
+                _ => Err(Error::config(format!("training state lacks the f32 tensor '{name}'"))),
+            }
+        };
+        for k in 0..self.params.len() {
+            let name = self.params.tensors[k].name.clone();
+            let n = self.params.tensors[k].values.len();
+            let (live, m, v) = (
+                find(&format!("live.{name}"))?,
+                find(&format!("adam.exp_avg.{name}"))?,
+                find(&format!("adam.exp_avg_sq.{name}"))?,
+            );
+            if live.len() != n || m.len() != n || v.len() != n {
+                return Err(Error::config(format!("training state: '{name}' has the wrong size")));
+            }
+            self.params.tensors[k].values = live.clone();
+            self.adam.exp_avg[k] = m.clone();
+            self.adam.exp_avg_sq[k] = v.clone();
+        }
+        let step = match state.iter().find(|t| t.name == "adam.step").map(|t| &t.data) {
+            Some(TensorData::F64(v)) if v.len() == 1 && v[0] >= 0.0 && v[0].fract() == 0.0 => v[0] as u64,
+            _ => return Err(Error::config("training state lacks a valid 'adam.step'")),
+        };
+        self.adam.step = step;
+        self.load_params()
+    }
+}

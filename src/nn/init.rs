@@ -1,0 +1,24 @@
+//! Initial weights drawn from our seeded RNG in the distributions the reference PyTorch code uses.
+
+use rand::Rng;
+use rand_distr::StandardNormal;
+
+/// torch.nn.Linear's and GRUCell's default: U(−1/√fan_in, 1/√fan_in).
+pub fn torch_uniform<R: Rng + ?Sized>(rng: &mut R, n: usize, fan_in: usize) -> Vec<f32> {
+    let bound = 1.0 / (fan_in.max(1) as f64).sqrt();
+    (0..n).map(|_| rng.random_range(-bound..bound) as f32).collect()
+}
+
+/// mbrl-lib's ensemble-layer initialization: normal with std 1/(2√fan_in), redrawn outside two standard
+/// deviations.
+pub fn truncated_normal<R: Rng + ?Sized>(rng: &mut R, n: usize, fan_in: usize) -> Vec<f32> {
+    let std = 1.0 / (2.0 * (fan_in.max(1) as f64).sqrt());
+    (0..n)
+        .map(|_| loop {
+            let z: f64 = rng.sample(StandardNormal);
+            if z.abs() <= 2.0 {
+                break (z * std) as f32;
+            }
+        })
+        .collect()
+}

@@ -1,0 +1,159 @@
+//! The training loop every method shares: steps, validation, best-validation snapshot, periodic checkpoints,
+//! divergence detection, cancellation, progress and metrics, and `--resume`. A method only says how to take one
+//! step, how to validate and what its state is.
+
+use std::collections::BTreeMap;
+
+use super::checkpoint::{CheckpointDir, FileEntry, Manifest, CHECKPOINT_FORMAT};
+use super::tensors::{to_bytes, StoredTensor};
+use crate::error::{Error, Result};
+use crate::run::{JsonlMonitor, Monitor};
+
+pub const CONFIG_FILE: &str = "config.json";
+pub const MODEL_FILE: &str = "model.safetensors";
+pub const STATE_FILE: &str = "state.safetensors";
+
+/// What a learning method contributes to the shared loop.
+pub trait TrainingMethod {
+    /// One optimizer step (`step` counts from 1); returns the training loss of its batch. All randomness of a
+    /// step must derive from the seed and `step`, so that a resumed run draws what the uninterrupted run drew.
+    fn step(&mut self, step: u64) -> Result<f64>;
+    /// Loss on held-out data (lower is better), or `None` when the method keeps none back.
+    fn validate(&mut self) -> Result<Option<f64>>;
+    /// The weights a user loads, named as the equivalent PyTorch module's `state_dict`.
+    fn weights(&self) -> Vec<StoredTensor>;
+    /// Everything else a resumed run needs: live weights, optimizer moments and counters.
+    fn state(&self) -> Vec<StoredTensor>;
+    fn restore(&mut self, state: &[StoredTensor]) -> Result<()>;
+}
+
+#[derive(Clone, Debug)]
+pub struct FitSettings {
+    pub method: String,
+    pub env: Option<String>,
+    pub total_steps: u64,
+    pub validate_every: u64,
+    pub checkpoint_every: u64,
+}
+
+/// Where a resumed run picks up (read from the checkpoint by [`super::resume`]).
+#[derive(Clone, Debug)]
+pub struct ResumePoint {
+    pub step: u64,
+    pub best_step: Option<u64>,
+    pub best_valid_loss: Option<f64>,
+    pub best_weights: Vec<StoredTensor>,
+}
+
+#[derive(Clone, Debug)]
+pub struct FitOutcome {
+    pub steps: u64,
+    pub best_step: Option<u64>,
+    pub best_valid_loss: Option<f64>,
+    pub last_train_loss: Option<f64>,
+}
+
+struct Best {
+    step: Option<u64>,
+    loss: Option<f64>,
+    weights: Vec<StoredTensor>,
+}
+
+/// Runs `method` to `settings.total_steps` in `dir`, whose `config.json` (already written) is vouched for by
+/// `config_entry`. Every scalar goes to `monitor` (live view) and `metrics` (the run's file).
+pub fn fit(
+    method: &mut dyn TrainingMethod,
+    settings: &FitSettings,
+    dir: &CheckpointDir,
+    config_entry: &FileEntry,
+    resume: Option<ResumePoint>,
+    metrics: &JsonlMonitor,
+    monitor: &dyn Monitor,
+) -> Result<FitOutcome> {
+    if settings.total_steps == 0 {
+        return Err(Error::config("training needs at least one step"));
+    }
+    let every = |n: u64| n.max(1);
+    let (start, mut best) = match resume {
+        Some(r) => (r.step, Best { step: r.best_step, loss: r.best_valid_loss, weights: r.best_weights }),
+        None => (0, Best { step: None, loss: None, weights: method.weights() }),
+    };
+    let mut last_checkpoint = start;
+    let mut last_loss = None;
+    for step in start + 1..=settings.total_steps {
+        if monitor.is_cancelled() {
+            return Err(Error::Cancelled);
+        }
+        let loss = method.step(step)?;
+        if !loss.is_finite() {
+            return Err(diverged(settings, step, "training", loss, last_checkpoint));
+        }
+        last_loss = Some(loss);
+        monitor.scalar("train/loss", step, loss);
+        let last = step == settings.total_steps;
+        if step % every(settings.validate_every) == 0 || last {
+            if let Some(valid) = method.validate()? {
+                if !valid.is_finite() {
+                    return Err(diverged(settings, step, "validation", valid, last_checkpoint));
+                }
+                monitor.scalar("valid/loss", step, valid);
+                if best.loss.is_none_or(|b| valid < b) {
+                    best = Best { step: Some(step), loss: Some(valid), weights: method.weights() };
+                }
+            } else {
+                best.weights = method.weights();
+            }
+        }
+        monitor.progress("train", step, settings.total_steps);
+        if step % every(settings.checkpoint_every) == 0 || last {
+            save(method, settings, dir, config_entry, &best, step, metrics)?;
+            last_checkpoint = step;
+        }
+    }
+    Ok(FitOutcome {
+        steps: settings.total_steps,
+        best_step: best.step,
+        best_valid_loss: best.loss,
+        last_train_loss: last_loss,
+    })
+}
+
+fn diverged(settings: &FitSettings, step: u64, what: &str, value: f64, checkpoint: u64) -> Error {
+    let saved = if checkpoint > 0 {
+        format!("the checkpoint of step {checkpoint} is intact and can be resumed")
+    } else {
+        "no checkpoint was written".to_string()
+    };
+    Error::Diverged(format!(
+        "{} diverged: {what} loss {value} at step {step}; {saved}. Lower the learning rate or check the data for outliers",
+        settings.method
+    ))
+}
+
+fn save(
+    method: &dyn TrainingMethod,
+    settings: &FitSettings,
+    dir: &CheckpointDir,
+    config_entry: &FileEntry,
+    best: &Best,
+    step: u64,
+    metrics: &JsonlMonitor,
+) -> Result<()> {
+    let mut files = BTreeMap::new();
+    files.insert(CONFIG_FILE.to_string(), config_entry.clone());
+    files.insert(MODEL_FILE.to_string(), dir.write_file(MODEL_FILE, &to_bytes(&best.weights)?)?);
+    files.insert(STATE_FILE.to_string(), dir.write_file(STATE_FILE, &to_bytes(&method.state())?)?);
+    let metrics_bytes = metrics.flush_position().map_err(|e| Error::io(&dir.file("metrics.jsonl"), e))?;
+    dir.commit(&Manifest {
+        format_version: CHECKPOINT_FORMAT,
+        method: settings.method.clone(),
+        env: settings.env.clone(),
+        step,
+        total_steps: settings.total_steps,
+        complete: step == settings.total_steps,
+        best_step: best.step,
+        best_valid_loss: best.loss,
+        metrics_bytes,
+        files,
+    })
+}

@@ -1,0 +1,81 @@
+//! A training run in its checkpoint directory, fresh or resumed: the part of every `mbrl train` that is the
+//! same for all methods.
+
+use std::path::Path;
+
+use super::checkpoint::CheckpointDir;
+use super::fit::{fit, FitOutcome, FitSettings, TrainingMethod, CONFIG_FILE, STATE_FILE};
+use super::OpenedCheckpoint;
+use crate::error::{Error, Result};
+use crate::run::dir::METRICS_FILE;
+use crate::run::{Event, JsonlMonitor, Monitor, Tee};
+
+/// Runs `method` to the end in `dir`. A fresh run writes `config` (the full description a resumed run is rebuilt
+/// from) and starts the metrics log with `layout`; with `resume`, `dir` must hold an unfinished checkpoint of
+/// the same config, and the run continues from it so that it ends with the bytes an uninterrupted run would.
+pub fn run_training(
+    dir: &Path,
+    config: &serde_json::Value,
+    settings: &FitSettings,
+    method: &mut dyn TrainingMethod,
+    resume: bool,
+    layout: &Event,
+    monitor: &dyn Monitor,
+) -> Result<FitOutcome> {
+    let config_bytes = config_bytes(config)?;
+    monitor.emit(layout);
+    if resume {
+        let opened = OpenedCheckpoint::open(dir)?;
+        if opened.manifest.complete {
+            return Err(Error::bad_file(
+                dir,
+                format!(
+                    "training already finished ({} of {} steps); nothing to resume",
+                    opened.manifest.step, opened.manifest.total_steps
+                ),
+            ));
+        }
+        let entry = opened.manifest.files.get(CONFIG_FILE).cloned().expect("checked by OpenedCheckpoint::open");
+        if opened.dir.read_verified(CONFIG_FILE, &entry)? != config_bytes {
+            return Err(Error::bad_file(&opened.dir.file(CONFIG_FILE), "differs from the run being resumed"));
+        }
+        method.restore(&opened.tensors(STATE_FILE)?)?;
+        let metrics_path = opened.dir.file(METRICS_FILE);
+        let metrics = JsonlMonitor::resume(&metrics_path, opened.manifest.metrics_bytes)
+            .map_err(|e| Error::io(&metrics_path, e))?;
+        let point = opened.resume_point()?;
+        monitor.message(&format!("resuming at step {} of {}", point.step, settings.total_steps));
+        let tee = Tee { first: monitor, second: &metrics };
+        let outcome = fit(method, settings, &opened.dir, &entry, Some(point), &metrics, &tee)?;
+        metrics.emit(&Event::Finished { ok: true });
+        return Ok(outcome);
+    }
+    let ckpt = CheckpointDir::start(dir)?;
+    let entry = ckpt.write_file(CONFIG_FILE, &config_bytes)?;
+    let metrics_path = ckpt.file(METRICS_FILE);
+    let metrics = JsonlMonitor::create(&metrics_path).map_err(|e| Error::io(&metrics_path, e))?;
+    metrics.emit(layout);
+    let tee = Tee { first: monitor, second: &metrics };
+    let outcome = fit(method, settings, &ckpt, &entry, None, &metrics, &tee)?;
+    metrics.emit(&Event::Finished { ok: true });
+    Ok(outcome)
+}
+
+fn config_bytes(config: &serde_json::Value) -> Result<Vec<u8>> {
+    let mut bytes = serde_json::to_vec_pretty(config).map_err(|e| Error::config(format!("config.json: {e}")))?;
+    bytes.push(b'\n');
+    Ok(bytes)
+}
+
+/// The live-view layout of a training run: loss curves, train and validation together.
+pub fn training_layout(title: &str) -> Event {
+    Event::Layout {
+        title: title.to_string(),
+        panels: vec![crate::run::PanelSpec {
+            title: "loss".into(),
+            x_label: "step".into(),
+            series: vec!["train/loss".into(), "valid/loss".into()],
+            restart_on_rewind: false,
+        }],
+    }
+}

@@ -1,0 +1,82 @@
+//! Training shared by every learned method: the loop ([`fit`]), checkpoints written as a unit
+//! ([`checkpoint`]), weights as safetensors ([`tensors`]) and config files ([`config`]).
+
+pub mod checkpoint;
+pub mod config;
+pub mod fit;
+pub mod job;
+pub mod tensors;
+
+pub use checkpoint::{CheckpointDir, Manifest};
+pub use fit::{fit, FitOutcome, FitSettings, ResumePoint, TrainingMethod, CONFIG_FILE, MODEL_FILE, STATE_FILE};
+pub use job::{run_training, training_layout};
+pub use tensors::StoredTensor;
+
+use std::path::Path;
+
+use crate::error::{Error, Result};
+
+/// An opened checkpoint with its config, verified against the manifest.
+pub struct OpenedCheckpoint {
+    pub dir: CheckpointDir,
+    pub manifest: Manifest,
+    pub config: serde_json::Value,
+}
+
+impl OpenedCheckpoint {
+    pub fn open(path: &Path) -> Result<Self> {
+        let (dir, manifest) = CheckpointDir::open(path)?;
+        let entry = manifest
+            .files
+            .get(CONFIG_FILE)
+            .ok_or_else(|| Error::bad_file(&dir.file(checkpoint::MANIFEST_FILE), format!("lists no {CONFIG_FILE}")))?;
+        let bytes = dir.read_verified(CONFIG_FILE, entry)?;
+        let config = serde_json::from_slice(&bytes)
+            .map_err(|e| Error::bad_file(&dir.file(CONFIG_FILE), format!("not valid JSON: {e}")))?;
+        Ok(OpenedCheckpoint { dir, manifest, config })
+    }
+
+    /// Refuses checkpoints of another method, and models still in training.
+    pub fn expect_finished(&self, method: &str) -> Result<()> {
+        let path = self.dir.path();
+        if self.manifest.method != method {
+            return Err(Error::bad_file(
+                path,
+                format!("is a '{}' checkpoint; expected '{method}'", self.manifest.method),
+            ));
+        }
+        if !self.manifest.complete {
+            return Err(Error::bad_file(
+                path,
+                format!(
+                    "training stopped at step {} of {}; finish it with `mbrl train --resume {}`",
+                    self.manifest.step,
+                    self.manifest.total_steps,
+                    path.display()
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The tensors of one listed file.
+    pub fn tensors(&self, name: &str) -> Result<Vec<StoredTensor>> {
+        let entry = self
+            .manifest
+            .files
+            .get(name)
+            .ok_or_else(|| Error::bad_file(self.dir.path(), format!("the checkpoint lists no {name}")))?;
+        let bytes = self.dir.read_verified(name, entry)?;
+        tensors::parse(&self.dir.file(name), &bytes)
+    }
+
+    /// Where to pick the run up again, for `--resume`.
+    pub fn resume_point(&self) -> Result<ResumePoint> {
+        Ok(ResumePoint {
+            step: self.manifest.step,
+            best_step: self.manifest.best_step,
+            best_valid_loss: self.manifest.best_valid_loss,
+            best_weights: self.tensors(MODEL_FILE)?,
+        })
+    }
+}

@@ -1,0 +1,189 @@
+//! End to end: collect → train a PETS ensemble → plan with it, resume, and the errors a user can run into.
+
+mod common;
+
+use std::path::Path;
+
+use common::*;
+use mbrl::data::{read_dataset, write_dataset};
+use mbrl::models::pets::{self, PetsConfig, Preset};
+use mbrl::run::dir::Provenance;
+use mbrl::run::{Event, Monitor};
+
+/// A network small enough to train in a second; checkpoints every 20 steps.
+const TINY: &str = "hidden_layers = 2\nhidden_units = 16\nvalidate_every = 10\ncheckpoint_every = 20\n";
+
+fn collect(dir: &Path, name: &str, env: &str, rollouts: &str) {
+    mbrl(dir)
+        .args(["collect", "--env", env, "--rollouts", rollouts, "--steps", "30", "-q", "--out", name])
+        .assert()
+        .success();
+}
+
+fn tiny_config(dir: &Path) {
+    std::fs::write(dir.join("tiny.toml"), TINY).unwrap();
+}
+
+#[test]
+fn collect_train_plan_round_trip() {
+    let dir = tempfile::tempdir().unwrap();
+    collect(dir.path(), "random.mcap", "pendulum", "30");
+    tiny_config(dir.path());
+    let out = mbrl(dir.path())
+        .args(["train", "--method", "pets", "--env", "pendulum", "--data", "random.mcap", "--config", "tiny.toml"])
+        .args(["--ensemble", "2", "--steps", "60", "--out", "models/p", "--no-tui"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr_of(&out));
+    let text = stdout_of(&out);
+    assert!(text.contains("PETS ensemble of 2") && text.contains("best validation MSE"), "{text}");
+    for file in ["checkpoint.json", "config.json", "model.safetensors", "state.safetensors", "metrics.jsonl"] {
+        assert!(dir.path().join("models/p").join(file).is_file(), "{file} missing");
+    }
+    let manifest: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("models/p/checkpoint.json")).unwrap()).unwrap();
+    assert_eq!(manifest["complete"], true);
+    assert_eq!(manifest["method"], "pets");
+    let config: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("models/p/config.json")).unwrap()).unwrap();
+    assert_eq!(config["config"]["hidden_units"], 16);
+    assert_eq!(config["config"]["optimizer"]["epsilon"], 1e-8);
+
+    let out = mbrl(dir.path())
+        .args(["plan", "--env", "pendulum", "--model", "models/p", "--candidates", "40", "--elites", "5"])
+        .args(["--iters", "2", "--steps", "10", "--particles", "4", "-q", "--out", "plan.mcap"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr_of(&out));
+    assert!(stdout_of(&out).contains("return"), "{}", stdout_of(&out));
+    assert_eq!(read_dataset(&dir.path().join("plan.mcap")).unwrap().steps.len(), 10);
+}
+
+/// Stops the run after `stop_after` training steps, as quitting the live view does.
+struct StopAfter {
+    stop_after: u64,
+    seen: std::sync::atomic::AtomicU64,
+}
+
+impl Monitor for StopAfter {
+    fn emit(&self, event: &Event) {
+        if let Event::Progress { phase, done, .. } = event {
+            if phase == "train" {
+                self.seen.store(*done, std::sync::atomic::Ordering::Relaxed);
+            }
+        }
+    }
+
+    fn is_cancelled(&self) -> bool {
+        self.seen.load(std::sync::atomic::Ordering::Relaxed) >= self.stop_after
+    }
+}
+
+fn dir_bytes(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut names: Vec<_> =
+        std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap()).collect();
+    names.sort();
+    names.into_iter().map(|n| (n.clone(), std::fs::read(dir.join(&n)).unwrap())).collect()
+}
+
+#[test]
+fn resume_ends_with_the_bytes_of_an_uninterrupted_run() {
+    let dir = tempfile::tempdir().unwrap();
+    collect(dir.path(), "random.mcap", "pendulum", "20");
+    let mut config = PetsConfig::preset(Preset::Small);
+    config = mbrl::train::config::apply_toml(&config, TINY).unwrap();
+    config.ensemble = 2;
+    config.steps = 70;
+    let request = |out: &str| pets::TrainRequest {
+        out: dir.path().join(out),
+        data: vec![dir.path().join("random.mcap")],
+        env: None,
+        config: config.clone(),
+        seed: 5,
+        provenance: Provenance::new("mbrl train …".into(), 5, 1),
+    };
+    pets::train(&request("whole"), false, &mbrl::run::NullMonitor).unwrap();
+    // Stopped after step 50: the last checkpoint is step 40, so steps 41–50 are redone after resuming.
+    let stop = StopAfter { stop_after: 50, seen: 0.into() };
+    let err = pets::train(&request("stopped"), false, &stop).err().unwrap();
+    assert!(matches!(err, mbrl::Error::Cancelled), "{err}");
+    let manifest: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("stopped/checkpoint.json")).unwrap()).unwrap();
+    assert_eq!((manifest["step"].as_u64(), manifest["complete"].as_bool()), (Some(40), Some(false)));
+    // A stopped run is not a model.
+    let plan = mbrl(dir.path()).args(["plan", "--env", "pendulum", "--model", "stopped", "-q"]).output().unwrap();
+    assert!(!plan.status.success() && stderr_of(&plan).contains("--resume"), "{}", stderr_of(&plan));
+
+    let out = mbrl(dir.path()).args(["train", "--resume", "stopped", "--no-tui"]).output().unwrap();
+    assert!(out.status.success(), "{}", stderr_of(&out));
+    assert_eq!(dir_bytes(&dir.path().join("whole")), dir_bytes(&dir.path().join("stopped")));
+}
+
+#[test]
+fn config_errors_name_the_key_and_leave_nothing_behind() {
+    let dir = tempfile::tempdir().unwrap();
+    collect(dir.path(), "random.mcap", "pendulum", "4");
+    for (text, expected) in [("hiden_units = 3", "unknown key 'hiden_units'"), ("steps = \"many\"", "wrong value type")]
+    {
+        std::fs::write(dir.path().join("bad.toml"), text).unwrap();
+        let out = mbrl(dir.path())
+            .args(["train", "--method", "pets", "--data", "random.mcap", "--config", "bad.toml", "--out", "m", "-q"])
+            .output()
+            .unwrap();
+        let err = stderr_of(&out);
+        assert!(!out.status.success() && err.contains("bad.toml") && err.contains(expected), "{err}");
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+        assert!(!dir.path().join("m").exists());
+    }
+}
+
+#[test]
+fn unusable_data_and_mismatched_checkpoints_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    collect(dir.path(), "random.mcap", "pendulum", "4");
+    let mut data = read_dataset(&dir.path().join("random.mcap")).unwrap();
+    // A dataset without actions.
+    let mut no_actions = data.clone();
+    no_actions.meta.action_dim = 0;
+    no_actions.steps.iter_mut().for_each(|s| s.action.clear());
+    write_dataset(&dir.path().join("no-actions.mcap"), &no_actions).unwrap();
+    // NaN in a state (JSON has no NaN: it is written as null, which the reader refuses by name).
+    data.steps[3].next_state[1] = f64::NAN;
+    write_dataset(&dir.path().join("nan.mcap"), &data).unwrap();
+    for (file, expected) in [("no-actions.mcap", "no actions"), ("nan.mcap", "null, expected f64")] {
+        let out =
+            mbrl(dir.path()).args(["train", "--method", "pets", "--data", file, "--out", "m", "-q"]).output().unwrap();
+        let err = stderr_of(&out);
+        assert!(!out.status.success() && err.contains(expected), "{file}: {err}");
+        assert!(!dir.path().join("m/checkpoint.json").exists());
+    }
+    // --env disagreeing with the data.
+    let out = mbrl(dir.path())
+        .args(["train", "--method", "pets", "--env", "pendulum:heavy", "--data", "random.mcap", "-q"])
+        .output()
+        .unwrap();
+    assert!(stderr_of(&out).contains("'pendulum' rollouts"), "{}", stderr_of(&out));
+
+    tiny_config(dir.path());
+    mbrl(dir.path())
+        .args(["train", "--method", "pets", "--data", "random.mcap", "--config", "tiny.toml", "--steps", "5"])
+        .args(["--ensemble", "1", "--out", "m", "-q"])
+        .assert()
+        .success();
+    // A model of another env.
+    let out = mbrl(dir.path()).args(["plan", "--env", "pendulum:heavy", "--model", "m", "-q"]).output().unwrap();
+    assert!(stderr_of(&out).contains("is a model of 'pendulum'"), "{}", stderr_of(&out));
+    // A checkpoint of another method: the ball EKF's parameter directory.
+    std::fs::create_dir_all(dir.path().join("ball")).unwrap();
+    std::fs::write(dir.path().join("ball/params.json"), "{}").unwrap();
+    let out = mbrl(dir.path()).args(["plan", "--env", "pendulum", "--model", "ball", "-q"]).output().unwrap();
+    assert!(stderr_of(&out).contains("ball EKF"), "{}", stderr_of(&out));
+    // Weights changed after training: the manifest no longer vouches for them.
+    let weights = dir.path().join("m/model.safetensors");
+    let mut bytes = std::fs::read(&weights).unwrap();
+    let last = bytes.len() - 1;
+    bytes[last] ^= 1;
+    std::fs::write(&weights, bytes).unwrap();
+    let out = mbrl(dir.path()).args(["plan", "--env", "pendulum", "--model", "m", "-q"]).output().unwrap();
+    assert!(stderr_of(&out).contains("CRC-32"), "{}", stderr_of(&out));
+}
