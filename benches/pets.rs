@@ -56,7 +56,7 @@ fn trained_like(preset: Preset) -> (PetsConfig, PetsNet, ParamSet, Normalizer) {
     let config = config(preset);
     let device = inference_device();
     let net = PetsNet::init(&config, 4, 2, &device, &mut ChaCha8Rng::seed_from_u64(2));
-    let params = ParamSet::from_module(&net, torch_name);
+    let params = ParamSet::<f32>::from_module(&net, torch_name);
     let normalizer = Normalizer { mean: vec![0.0, 0.0, 0.0, 0.0], std: vec![0.7, 0.7, 4.0, 1.2] };
     (config, net, params, normalizer)
 }

@@ -146,7 +146,7 @@ mod tests {
             let (members, d_in, d_out, rows) = (3, 5, 4, 37);
             let mlp = EnsembleMlpConfig::new(members, d_in, d_out, 2, 16, activation).init(&device, &mut rng);
             // Random weights of a trained-looking scale, not the small initial ones.
-            let mut params = ParamSet::from_module(&mlp, |p| p.to_string());
+            let mut params = ParamSet::<f32>::from_module(&mlp, |p| p.to_string());
             params.tensors.iter_mut().flat_map(|t| t.values.iter_mut()).for_each(|v| *v = rng.random_range(-1.0..1.0));
             let mlp = params.load_into(mlp, &device).unwrap();
             let input: Vec<f32> = (0..members * rows * d_in).map(|_| rng.random_range(-2.0..2.0)).collect();

@@ -3,28 +3,54 @@
 //! is used for what it is best at, the forward pass and autodiff.
 
 use burn::module::{Module, ModuleMapper, ModuleVisitor, Param};
-use burn::tensor::{Device, Gradients, Tensor};
+use burn::tensor::{DType, Device, Gradients, Tensor, TensorData};
 
-use super::tensor::{tensor, values};
 use crate::error::{Error, Result};
 
+/// The element types parameters are kept in: f32 for networks, f64 for gray-box models such as the ball EKF.
+pub trait ParamScalar: burn::tensor::Element + num_traits::Float + Send + Sync + 'static {
+    const DTYPE: DType;
+}
+
+impl ParamScalar for f32 {
+    const DTYPE: DType = DType::F32;
+}
+
+impl ParamScalar for f64 {
+    const DTYPE: DType = DType::F64;
+}
+
+fn tensor<T: ParamScalar, const D: usize>(values: Vec<T>, shape: [usize; D], device: &Device) -> Tensor<D> {
+    Tensor::from_data(TensorData::new(values, shape), (device, T::DTYPE))
+}
+
+fn values<T: ParamScalar, const D: usize>(t: &Tensor<D>) -> Vec<T> {
+    t.to_data().convert::<T>().try_to_vec::<T>().expect("float tensor data converts to the parameter type")
+}
+
 #[derive(Clone, Debug, PartialEq)]
-pub struct NamedTensor {
+pub struct NamedTensor<T = f32> {
     pub name: String,
     pub shape: Vec<usize>,
-    pub values: Vec<f32>,
+    pub values: Vec<T>,
 }
 
 /// Named tensors in a fixed order. Cloning is a deep copy: a snapshot never aliases live weights.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct ParamSet {
-    pub tensors: Vec<NamedTensor>,
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParamSet<T = f32> {
+    pub tensors: Vec<NamedTensor<T>>,
 }
 
-impl ParamSet {
+impl<T> Default for ParamSet<T> {
+    fn default() -> Self {
+        ParamSet { tensors: Vec::new() }
+    }
+}
+
+impl<T: ParamScalar> ParamSet<T> {
     /// Every float parameter of `module`, named by its path (`layer.0.weight`) after `rename`.
     pub fn from_module<M: Module>(module: &M, rename: impl Fn(&str) -> String) -> Self {
-        let mut collector = Collector { path: Vec::new(), out: Vec::new() };
+        let mut collector = Collector::<T> { path: Vec::new(), out: Vec::new() };
         module.visit(&mut collector);
         let tensors = collector
             .out
@@ -35,8 +61,8 @@ impl ParamSet {
     }
 
     /// Gradients of `module`'s parameters in the same order; zeros for parameters the loss did not reach.
-    pub fn gradients<M: Module>(module: &M, grads: &Gradients) -> Vec<Vec<f32>> {
-        let mut collector = GradCollector { grads, out: Vec::new() };
+    pub fn gradients<M: Module>(module: &M, grads: &Gradients) -> Vec<Vec<T>> {
+        let mut collector = GradCollector::<T> { grads, out: Vec::new() };
         module.visit(&mut collector);
         collector.out
     }
@@ -58,7 +84,7 @@ impl ParamSet {
         Ok(module)
     }
 
-    pub fn get(&self, name: &str) -> Option<&NamedTensor> {
+    pub fn get(&self, name: &str) -> Option<&NamedTensor<T>> {
         self.tensors.iter().find(|t| t.name == name)
     }
 
@@ -75,7 +101,7 @@ impl ParamSet {
     }
 
     /// Checks that `other` has the same names and shapes, in order (a checkpoint against a freshly built model).
-    pub fn check_layout(&self, other: &ParamSet, what: &str) -> Result<()> {
+    pub fn check_layout(&self, other: &ParamSet<T>, what: &str) -> Result<()> {
         if self.tensors.len() != other.tensors.len() {
             return Err(Error::config(format!(
                 "{what}: {} tensors, expected {}",
@@ -94,17 +120,17 @@ impl ParamSet {
         Ok(())
     }
 
-    pub fn values_mut(&mut self) -> Vec<&mut Vec<f32>> {
+    pub fn values_mut(&mut self) -> Vec<&mut Vec<T>> {
         self.tensors.iter_mut().map(|t| &mut t.values).collect()
     }
 }
 
-struct Collector {
+struct Collector<T> {
     path: Vec<String>,
-    out: Vec<(String, Vec<usize>, Vec<f32>)>,
+    out: Vec<(String, Vec<usize>, Vec<T>)>,
 }
 
-impl ModuleVisitor for Collector {
+impl<T: ParamScalar> ModuleVisitor for Collector<T> {
     fn enter_module(&mut self, name: &str, _container_type: &str) {
         self.path.push(name.to_string());
     }
@@ -119,28 +145,28 @@ impl ModuleVisitor for Collector {
     }
 }
 
-struct GradCollector<'a> {
+struct GradCollector<'a, T> {
     grads: &'a Gradients,
-    out: Vec<Vec<f32>>,
+    out: Vec<Vec<T>>,
 }
 
-impl ModuleVisitor for GradCollector<'_> {
+impl<T: ParamScalar> ModuleVisitor for GradCollector<'_, T> {
     fn visit_float<const D: usize>(&mut self, param: &Param<Tensor<D>>) {
         let value = param.val();
         let grad = value.grad(self.grads).map(|g| values(&g));
         let n = value.dims().iter().product();
-        self.out.push(grad.unwrap_or_else(|| vec![0.0; n]));
+        self.out.push(grad.unwrap_or_else(|| vec![T::zero(); n]));
     }
 }
 
-struct Loader<'a> {
-    source: &'a [NamedTensor],
+struct Loader<'a, T> {
+    source: &'a [NamedTensor<T>],
     next: usize,
     device: &'a Device,
     error: Option<Error>,
 }
 
-impl ModuleMapper for Loader<'_> {
+impl<T: ParamScalar> ModuleMapper for Loader<'_, T> {
     fn map_float<const D: usize>(&mut self, param: Param<Tensor<D>>) -> Param<Tensor<D>> {
         let index = self.next;
         self.next += 1;

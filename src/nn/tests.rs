@@ -16,7 +16,7 @@ fn gru_cell_follows_torch_equations() {
     let device = inference_device();
     let (i, h) = (3, 4);
     let cell = GruCellConfig::new(i, h).init(&device, &mut ChaCha8Rng::seed_from_u64(1));
-    let p = ParamSet::from_module(&cell, |s| s.to_string());
+    let p = ParamSet::<f32>::from_module(&cell, |s| s.to_string());
     let w_ih = &p.get("weight_ih").unwrap().values;
     let w_hh = &p.get("weight_hh").unwrap().values;
     let b_ih = &p.get("bias_ih").unwrap().values;
@@ -54,7 +54,7 @@ fn set_max_pool_starts_from_zero_and_ignores_padding() {
 fn non_negative_linear_ignores_negative_weights() {
     let device = inference_device();
     let layer = LinearConfig::new(2, 1).init_non_negative(&device, &mut ChaCha8Rng::seed_from_u64(2));
-    let mut p = ParamSet::from_module(&layer, |s| s.to_string());
+    let mut p = ParamSet::<f32>::from_module(&layer, |s| s.to_string());
     p.tensors[0].values = vec![-3.0, 2.0];
     p.tensors[1].values = vec![0.5];
     let layer = p.load_into(layer, &device).unwrap();
@@ -76,15 +76,15 @@ fn log_variance_bounds_hold_at_extremes() {
 fn param_set_round_trips_and_gradients_cover_every_parameter() {
     let device = training_device();
     let mlp = EnsembleMlpConfig::new(2, 3, 2, 1, 4, Activation::Silu).init(&device, &mut ChaCha8Rng::seed_from_u64(3));
-    let p = ParamSet::from_module(&mlp, |s| s.to_string());
+    let p = ParamSet::<f32>::from_module(&mlp, |s| s.to_string());
     let names: Vec<&str> = p.tensors.iter().map(|t| t.name.as_str()).collect();
     assert_eq!(names, ["hidden_layers.0.weight", "hidden_layers.0.bias", "output.weight", "output.bias"]);
     let mut changed = p.clone();
     changed.tensors[2].values[0] += 1.0;
     let mlp = changed.load_into(mlp, &device).unwrap();
-    assert_eq!(ParamSet::from_module(&mlp, |s| s.to_string()), changed);
+    assert_eq!(ParamSet::<f32>::from_module(&mlp, |s| s.to_string()), changed);
     let loss = mlp.forward(tensor(vec![0.5; 2 * 5 * 3], [2, 5, 3], &device)).powi_scalar(2).sum();
-    let grads = ParamSet::gradients(&mlp, &loss.backward());
+    let grads = ParamSet::<f32>::gradients(&mlp, &loss.backward());
     assert_eq!(grads.len(), 4);
     assert!(grads.iter().all(|g| g.iter().any(|v| *v != 0.0)));
 }

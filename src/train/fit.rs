@@ -25,6 +25,11 @@ pub trait TrainingMethod {
     /// Everything else a resumed run needs: live weights, optimizer moments and counters.
     fn state(&self) -> Vec<StoredTensor>;
     fn restore(&mut self, state: &[StoredTensor]) -> Result<()>;
+    /// Files in the method's own formats, derived from the current weights and saved with every checkpoint
+    /// (the ball EKF's `params.json`, which `filter` and `predict` read).
+    fn artifacts(&self) -> Result<Vec<(String, Vec<u8>)>> {
+        Ok(Vec::new())
+    }
 }
 
 #[derive(Clone, Debug)]
@@ -143,6 +148,10 @@ fn save(
     files.insert(CONFIG_FILE.to_string(), config_entry.clone());
     files.insert(MODEL_FILE.to_string(), dir.write_file(MODEL_FILE, &to_bytes(&best.weights)?)?);
     files.insert(STATE_FILE.to_string(), dir.write_file(STATE_FILE, &to_bytes(&method.state())?)?);
+    for (name, bytes) in method.artifacts()? {
+        let entry = dir.write_file(&name, &bytes)?;
+        files.insert(name, entry);
+    }
     let metrics_bytes = metrics.flush_position().map_err(|e| Error::io(&dir.file("metrics.jsonl"), e))?;
     dir.commit(&Manifest {
         format_version: CHECKPOINT_FORMAT,

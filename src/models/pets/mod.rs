@@ -271,5 +271,5 @@ fn layout_of(run: &PetsRun) -> Result<crate::nn::ParamSet> {
     let device = crate::nn::tensor::inference_device();
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0);
     let net = net::PetsNet::init(&run.config, run.model.input_dim, run.model.target_dim, &device, &mut rng);
-    Ok(crate::nn::ParamSet::from_module(&net, net::torch_name))
+    Ok(crate::nn::ParamSet::<f32>::from_module(&net, net::torch_name))
 }

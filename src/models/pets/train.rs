@@ -51,7 +51,7 @@ impl PetsTrainer {
         let device = training_device();
         let mut init_rng = ChaCha8Rng::seed_from_u64(derive_seed(seed, &[INIT_STREAM]));
         let net = PetsNet::init(&config, train.input_dim, train.target_dim, &device, &mut init_rng);
-        let params = ParamSet::from_module(&net, torch_name);
+        let params = ParamSet::<f32>::from_module(&net, torch_name);
         let sizes: Vec<usize> = params.tensors.iter().map(|t| t.values.len()).collect();
         let adam = Adam::new(config.optimizer, &sizes);
         let n = train.len();
@@ -104,7 +104,7 @@ impl TrainingMethod for PetsTrainer {
         if !value.is_finite() {
             return Ok(value);
         }
-        let mut grads = ParamSet::gradients(net, &loss.backward());
+        let mut grads = ParamSet::<f32>::gradients(net, &loss.backward());
         self.adam.update(&mut self.params.values_mut(), &mut grads)?;
         self.load_params()?;
         Ok(value)

@@ -1,0 +1,175 @@
+//! The ball EKF's training as a [`TrainingMethod`] of the shared loop: checkpoints, `--resume`, progress and
+//! divergence handling come from `train::fit`; this file only says how one Adam step on eq. 6.24 goes.
+
+use burn::tensor::Device;
+use rand::seq::SliceRandom;
+
+use super::batch::Batch;
+use super::chunks::{cut_chunks, Chunk};
+use super::device::training_device;
+use super::filter::chunk_loss;
+use super::params::BallParamsModule;
+use super::spin_net::{SpinNet, SpinNetWeights};
+use super::train::TrainSettings;
+use crate::data::ball_io::Recording;
+use crate::error::{Error, Result};
+use crate::models::ball::BallModelParams;
+use crate::nn::params::ParamSet;
+use crate::nn::{Adam, AdamConfig};
+use crate::planning::seeding::rng_for;
+use crate::train::tensors::TensorData;
+use crate::train::{StoredTensor, TrainingMethod};
+
+/// Random streams under the seed: one per epoch's shuffle, one for the spin network's initial weights.
+const SHUFFLE_STREAM: u64 = 0;
+const SPIN_NET_STREAM: u64 = 1;
+
+pub struct BallEkfTrainer {
+    settings: TrainSettings,
+    device: Device,
+    module: Option<BallParamsModule>,
+    params: ParamSet<f64>,
+    adam: Adam<f64>,
+    chunks: Vec<Chunk>,
+}
+
+impl BallEkfTrainer {
+    pub fn new(recordings: &[Recording], settings: &TrainSettings) -> Result<Self> {
+        settings.validate()?;
+        let chunks = cut_chunks(recordings, settings.chunk_len, &settings.initial.physics)?;
+        if chunks.is_empty() {
+            return Err(Error::data(format!(
+                "no training chunks in {} recordings: a chunk needs {} consecutive frames whose first two are measured",
+                recordings.len(),
+                settings.chunk_len
+            )));
+        }
+        let device = training_device();
+        let spin_net =
+            settings.launcher_prior.then(|| SpinNet::init(&mut rng_for(settings.seed, &[SPIN_NET_STREAM]), &device));
+        let module = BallParamsModule::from_params(&settings.initial, spin_net, &device);
+        let params = ParamSet::<f64>::from_module(&module, |p| p.to_string());
+        let sizes: Vec<usize> = params.tensors.iter().map(|t| t.values.len()).collect();
+        let adam = Adam::new(
+            AdamConfig {
+                learning_rate: settings.learning_rate,
+                beta1: settings.beta1,
+                beta2: settings.beta2,
+                epsilon: settings.epsilon,
+                weight_decay: 0.0,
+                clip_grad_norm: None,
+            },
+            &sizes,
+        );
+        Ok(BallEkfTrainer { settings: settings.clone(), device, module: Some(module), params, adam, chunks })
+    }
+
+    pub fn chunk_count(&self) -> usize {
+        self.chunks.len()
+    }
+
+    fn module(&self) -> &BallParamsModule {
+        self.module.as_ref().expect("the module is only taken out while loading new values")
+    }
+
+    /// The current parameters for the nalgebra filter, and the launcher network when it is learned.
+    pub fn current(&self) -> (BallModelParams, Option<SpinNetWeights>) {
+        let module = self.module();
+        (module.to_params(&self.settings.initial.physics), module.spin_net.as_ref().map(SpinNet::weights))
+    }
+
+    /// The chunks of step `step` (from 1): epochs are consecutive slices of a seeded permutation, reshuffled
+    /// each epoch, the last batch of an epoch possibly smaller. A function of the step alone, so a resumed run
+    /// draws the same batches.
+    fn batch(&self, step: u64) -> Vec<usize> {
+        let n = self.chunks.len();
+        let size = self.settings.batch_size;
+        let per_epoch = n.div_ceil(size) as u64;
+        let (epoch, index) = ((step - 1) / per_epoch, ((step - 1) % per_epoch) as usize);
+        let mut order: Vec<usize> = (0..n).collect();
+        order.shuffle(&mut rng_for(self.settings.seed, &[SHUFFLE_STREAM, epoch]));
+        order[index * size..((index + 1) * size).min(n)].to_vec()
+    }
+
+    fn load(&mut self) -> Result<()> {
+        let module = self.module.take().expect("module present");
+        self.module = Some(self.params.load_into(module, &self.device)?);
+        Ok(())
+    }
+}
+
+impl TrainingMethod for BallEkfTrainer {
+    fn step(&mut self, step: u64) -> Result<f64> {
+        let picked: Vec<&Chunk> = self.batch(step).into_iter().map(|i| &self.chunks[i]).collect();
+        let batch = Batch::new(&picked, self.settings.launcher_prior, &self.device)?;
+        let loss = chunk_loss(self.module(), &batch, &self.settings.initial.physics, &self.device)?;
+        let value: f64 = loss.clone().into_scalar();
+        if !value.is_finite() {
+            return Ok(value);
+        }
+        let mut grads = ParamSet::<f64>::gradients(self.module(), &loss.backward());
+        self.adam.update(&mut self.params.values_mut(), &mut grads)?;
+        self.load()?;
+        Ok(value)
+    }
+
+    fn validate(&mut self) -> Result<Option<f64>> {
+        Ok(None)
+    }
+
+    fn weights(&self) -> Vec<StoredTensor> {
+        self.params.tensors.iter().map(|t| StoredTensor::f64(t.name.clone(), t.shape.clone(), t.values.clone())).collect()
+    }
+
+    fn state(&self) -> Vec<StoredTensor> {
+        let mut out = Vec::with_capacity(3 * self.params.len() + 1);
+        for (k, t) in self.params.tensors.iter().enumerate() {
+            out.push(StoredTensor::f64(format!("live.{}", t.name), t.shape.clone(), t.values.clone()));
+            out.push(StoredTensor::f64(format!("adam.exp_avg.{}", t.name), t.shape.clone(), self.adam.exp_avg[k].clone()));
+            out.push(StoredTensor::f64(format!("adam.exp_avg_sq.{}", t.name), t.shape.clone(), self.adam.exp_avg_sq[k].clone()));
+        }
+        out.push(StoredTensor::f64("adam.step", vec![1], vec![self.adam.step as f64]));
+        out
+    }
+
+    fn restore(&mut self, state: &[StoredTensor]) -> Result<()> {
+        let find = |name: &str, n: usize| -> Result<Vec<f64>> {
+            match state.iter().find(|t| t.name == name).map(|t| &t.data) {
+                Some(TensorData::F64(v)) if v.len() == n => Ok(v.clone()),
+                _ => Err(Error::config(format!("training state lacks the f64 tensor '{name}' with {n} values"))),
+            }
+        };
+        for k in 0..self.params.len() {
+            let (name, n) = (self.params.tensors[k].name.clone(), self.params.tensors[k].values.len());
+            self.params.tensors[k].values = find(&format!("live.{name}"), n)?;
+            self.adam.exp_avg[k] = find(&format!("adam.exp_avg.{name}"), n)?;
+            self.adam.exp_avg_sq[k] = find(&format!("adam.exp_avg_sq.{name}"), n)?;
+        }
+        let step = find("adam.step", 1)?[0];
+        if !(step >= 0.0 && step.fract() == 0.0) {
+            return Err(Error::config("training state: 'adam.step' is not a count"));
+        }
+        self.adam.step = step as u64;
+        self.load()
+    }
+
+    fn artifacts(&self) -> Result<Vec<(String, Vec<u8>)>> {
+        let (params, spin_net) = self.current();
+        let json = |value: serde_json::Value| {
+            let mut bytes = serde_json::to_vec_pretty(&value).map_err(|e| Error::config(e.to_string()))?;
+            bytes.push(b'\n');
+            Ok::<_, Error>(bytes)
+        };
+        let mut files = vec![(
+            crate::models::ball::checkpoint::PARAMS_FILE.to_string(),
+            json(serde_json::to_value(&params).map_err(|e| Error::config(e.to_string()))?)?,
+        )];
+        if let Some(net) = spin_net {
+            files.push((
+                crate::models::ball::checkpoint::SPIN_NET_FILE.to_string(),
+                json(serde_json::to_value(&net).map_err(|e| Error::config(e.to_string()))?)?,
+            ));
+        }
+        Ok(files)
+    }
+}
