@@ -6,11 +6,11 @@ use std::path::PathBuf;
 use anyhow::bail;
 use clap::Args;
 use mbrl::data::ball_io::{read_recordings, FRAME_RATE};
-use mbrl::eval::table::write_csv;
 use mbrl::models::ball::checkpoint::load_ball_model;
 use mbrl::models::ball::track::{
     filter_recording, landing, plane_crossing, predict_ahead, prediction_error, protocol_cut,
 };
+use mbrl::util::table::write_csv;
 
 use crate::common::{run_job, GlobalArgs};
 

@@ -5,13 +5,13 @@ use std::path::PathBuf;
 use clap::{Args, ValueEnum};
 use mbrl::data::ball_io::read_recordings;
 use mbrl::eval::plot::{line_plot, Series};
-use mbrl::eval::table::write_csv;
 use mbrl::models::ball::checkpoint::save_ball_params;
 use mbrl::models::ball::learn::{train, TrainSettings};
 use mbrl::models::ball::BallModelParams;
-use mbrl::run::atomic::write_json;
 use mbrl::run::dir::{Provenance, RunDir};
 use mbrl::run::{Event, Monitor, PanelSpec, Tee};
+use mbrl::util::atomic::write_json;
+use mbrl::util::table::write_csv;
 
 use crate::common::{command_line, run_job, GlobalArgs};
 

@@ -10,6 +10,7 @@ pub mod models;
 pub mod planning;
 pub mod run;
 pub mod tui;
+pub mod util;
 
 pub use error::{Error, Result};
 

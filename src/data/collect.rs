@@ -5,8 +5,8 @@ use rand::Rng;
 use super::{Dataset, DatasetMeta, Rollout, FORMAT_VERSION};
 use crate::envs::EnvName;
 use crate::error::{Error, Result};
-use crate::planning::seeding::rng_for;
 use crate::run::Monitor;
+use crate::util::seeding::rng_for;
 
 pub struct CollectSettings {
     pub env: EnvName,

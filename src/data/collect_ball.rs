@@ -7,8 +7,8 @@ use crate::envs::ball::{
     augmentation_pivot, rotate_about_z, simulate, BallTrajectory, CameraModel, LaunchParams, Orientation,
 };
 use crate::error::{Error, Result};
-use crate::planning::seeding::rng_for;
 use crate::run::Monitor;
+use crate::util::seeding::rng_for;
 
 /// Shots tried per kept trajectory before giving up (a shot is kept when it bounces exactly once).
 const MAX_TRIES_PER_SHOT: usize = 50;

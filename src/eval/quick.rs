@@ -15,9 +15,9 @@ use crate::error::{Error, Result};
 use crate::models::ball::checkpoint::{load_ball_model, LoadedBallModel};
 use crate::models::ball::learn::{train, TrainSettings};
 use crate::models::ball::BallModel;
-use crate::run::atomic::write_text;
 use crate::run::dir::Provenance;
 use crate::run::Monitor;
+use crate::util::atomic::write_text;
 
 pub const SWINGUP_EPISODES: usize = 5;
 pub const EMBODIED_BOARDS_PER_DEPTH: usize = 20;

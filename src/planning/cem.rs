@@ -8,9 +8,9 @@ use rustfft::num_complex::Complex;
 use serde::{Deserialize, Serialize};
 
 use super::colored_noise::ColoredNoise;
-use super::seeding::rng_for;
 use super::Objective;
 use crate::error::{Error, Result};
+use crate::util::seeding::rng_for;
 
 /// Candidates that share one random stream. Fixed, so results do not depend on the thread count.
 const CANDIDATES_PER_STREAM: usize = 64;

@@ -5,7 +5,6 @@ pub mod bfs;
 pub mod cem;
 pub mod colored_noise;
 pub mod mpc;
-pub mod seeding;
 pub mod solve_board;
 
 pub use cem::{Cem, CemConfig, CemIteration, NoiseKind};

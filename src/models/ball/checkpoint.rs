@@ -7,7 +7,7 @@ use super::learn::SpinNetWeights;
 use super::{BallModel, BallModelParams, SpinPrior};
 use crate::data::ball_io::Recording;
 use crate::error::{Error, Result};
-use crate::run::atomic::write_json;
+use crate::util::atomic::write_json;
 
 pub const PARAMS_FILE: &str = "params.json";
 pub const SPIN_NET_FILE: &str = "spin_net.json";

@@ -13,8 +13,8 @@ use super::spin_net::{SpinNet, SpinNetWeights};
 use crate::data::ball_io::Recording;
 use crate::error::{Error, Result};
 use crate::models::ball::BallModelParams;
-use crate::planning::seeding::rng_for;
 use crate::run::Monitor;
+use crate::util::seeding::rng_for;
 
 /// Random streams under the seed: one per epoch's shuffle, one for the spin network's initial weights.
 const SHUFFLE_STREAM: u64 = 0;
