@@ -68,7 +68,7 @@ pub fn run(global: &GlobalArgs, args: PredictArgs) -> anyhow::Result<()> {
         let mut summaries = Vec::new();
         for (k, rec) in recordings.iter().enumerate() {
             let cut = args.from_frame.or_else(|| protocol_cut(rec, steps)).ok_or_else(|| {
-                mbrl::Error::InvalidInput(format!("trajectory {}: fewer than ten measurements to filter", rec.id))
+                mbrl::Error::data(format!("trajectory {}: fewer than ten measurements to filter", rec.id))
             })?;
             let track = filter_recording(&model.model, rec, Some(cut), &model.prior(rec))?;
             let (from_frame, belief) =

@@ -20,7 +20,7 @@ pub struct CollectSettings {
 /// parametrized family and a start state from the environment's reset distribution.
 pub fn collect_random(settings: &CollectSettings, monitor: &dyn Monitor) -> Result<Dataset> {
     if settings.rollouts == 0 || settings.steps == 0 {
-        return Err(Error::InvalidInput("--rollouts and --steps must be at least 1".into()));
+        return Err(Error::config("--rollouts and --steps must be at least 1"));
     }
     let mut env = settings.env.build()?;
     let spec = env.spec();

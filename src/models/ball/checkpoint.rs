@@ -65,7 +65,7 @@ fn load_params(spec: &str) -> Result<BallModel> {
                 .map_err(|e| Error::bad_file(&file, format!("not ball-model parameters: {e}")))?
         }
     };
-    BallModel::new(params).map_err(|e| Error::InvalidInput(format!("--model {spec}: {e}")))
+    BallModel::new(params).map_err(|e| Error::config(format!("--model {spec}: {e}")))
 }
 
 pub fn save_ball_params(dir: &Path, params: &BallModelParams) -> Result<()> {

@@ -62,7 +62,7 @@ impl Default for TrainSettings {
 
 impl TrainSettings {
     fn validate(&self) -> Result<()> {
-        let bad = |what: String| Err(Error::InvalidInput(format!("ball EKF training settings: {what}")));
+        let bad = |what: String| Err(Error::config(format!("ball EKF training settings: {what}")));
         if self.batch_size == 0 {
             return bad("batch_size must be at least 1".into());
         }
@@ -77,7 +77,7 @@ impl TrainSettings {
         if !(self.epsilon.is_finite() && self.epsilon > 0.0) {
             return bad(format!("epsilon {} must be finite and > 0", self.epsilon));
         }
-        self.initial.validate().map_err(|e| Error::InvalidInput(format!("initial ball-model parameters: {e}")))
+        self.initial.validate().map_err(|e| Error::config(format!("initial ball-model parameters: {e}")))
     }
 }
 
@@ -96,7 +96,7 @@ pub fn train(recordings: &[Recording], settings: &TrainSettings, monitor: &dyn M
     let physics = &settings.initial.physics;
     let chunks = cut_chunks(recordings, settings.chunk_len, physics)?;
     if chunks.is_empty() {
-        return Err(Error::InvalidInput(format!(
+        return Err(Error::data(format!(
             "no training chunks in {} recordings: a chunk needs {} consecutive frames whose first two are measured",
             recordings.len(),
             settings.chunk_len
@@ -124,7 +124,7 @@ pub fn train(recordings: &[Recording], settings: &TrainSettings, monitor: &dyn M
         let loss = chunk_loss(&model, &batch, physics, &device)?;
         let value: f64 = loss.clone().into_scalar();
         if !value.is_finite() {
-            return Err(Error::InvalidInput(format!(
+            return Err(Error::Diverged(format!(
                 "ball EKF training diverged: loss {value} at step {step} (epoch {}); the filter's covariances broke \
                  down. Lower the learning rate or check the recordings for outliers",
                 batches.epoch
@@ -137,9 +137,7 @@ pub fn train(recordings: &[Recording], settings: &TrainSettings, monitor: &dyn M
         monitor.progress("train", step, settings.steps);
     }
     let params = model.to_params(physics);
-    params
-        .validate()
-        .map_err(|e| Error::InvalidInput(format!("ball EKF training ended with unusable parameters: {e}")))?;
+    params.validate().map_err(|e| Error::Diverged(format!("ball EKF training ended with unusable parameters: {e}")))?;
     Ok(TrainOutcome { params, spin_net: model.spin_net.as_ref().map(SpinNet::weights), losses, chunks: chunks.len() })
 }
 
