@@ -165,7 +165,7 @@ fn records<G: DenseIndex>(
     monitor.message(&format!("building the depth table of {}", game.name()));
     let table = DepthTable::build(game)?;
     if max_depth == 0 || max_depth > table.max_depth() {
-        return Err(mbrl::Error::InvalidInput(format!(
+        return Err(mbrl::Error::config(format!(
             "--max-depth must be between 1 and {} for {}",
             table.max_depth(),
             game.name()

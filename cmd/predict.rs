@@ -6,11 +6,11 @@ use std::path::PathBuf;
 use anyhow::bail;
 use clap::Args;
 use mbrl::data::ball_io::{read_recordings, FRAME_RATE};
-use mbrl::eval::table::write_csv;
 use mbrl::models::ball::checkpoint::load_ball_model;
 use mbrl::models::ball::track::{
     filter_recording, landing, plane_crossing, predict_ahead, prediction_error, protocol_cut,
 };
+use mbrl::util::table::write_csv;
 
 use crate::common::{run_job, GlobalArgs};
 
@@ -68,7 +68,7 @@ pub fn run(global: &GlobalArgs, args: PredictArgs) -> anyhow::Result<()> {
         let mut summaries = Vec::new();
         for (k, rec) in recordings.iter().enumerate() {
             let cut = args.from_frame.or_else(|| protocol_cut(rec, steps)).ok_or_else(|| {
-                mbrl::Error::InvalidInput(format!("trajectory {}: fewer than ten measurements to filter", rec.id))
+                mbrl::Error::data(format!("trajectory {}: fewer than ten measurements to filter", rec.id))
             })?;
             let track = filter_recording(&model.model, rec, Some(cut), &model.prior(rec))?;
             let (from_frame, belief) =

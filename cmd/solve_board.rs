@@ -8,8 +8,8 @@ use mbrl::envs::boards::sets::sample_board;
 use mbrl::envs::boards::{GameSpec, LightsOut, Split, TileSwap};
 use mbrl::envs::embodiments::Embodiment;
 use mbrl::planning::bfs::SearchLimits;
-use mbrl::planning::seeding::rng_for;
 use mbrl::planning::solve_board::{execute_plan, layout, plan_board, SearchKind};
+use mbrl::util::seeding::rng_for;
 
 use crate::common::{run_job, GlobalArgs, ModelChoice};
 

@@ -4,18 +4,15 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context};
 use clap::{Args, ValueEnum};
-use mbrl::data::ball_io::read_recordings;
 use mbrl::eval::plot::{line_plot, Series};
-use mbrl::eval::table::write_csv;
-use mbrl::models::ball::checkpoint::save_ball_params;
-use mbrl::models::ball::learn::{train, TrainSettings};
+use mbrl::models::ball::learn::job::{self as ball_job, BallTrainReport, BallTrainRequest};
+use mbrl::models::ball::learn::TrainSettings;
 use mbrl::models::ball::BallModelParams;
 use mbrl::models::pets::{self, PetsConfig, Preset, RewardSource};
-use mbrl::run::atomic::write_json;
-use mbrl::run::dir::{Provenance, RunDir};
-use mbrl::run::{Event, Monitor, PanelSpec, Tee};
+use mbrl::run::dir::{Provenance, METRICS_FILE};
 use mbrl::train::config::apply_toml_file;
-use mbrl::train::OpenedCheckpoint;
+use mbrl::train::{loss_history, OpenedCheckpoint};
+use mbrl::util::table::write_csv;
 
 use crate::common::{command_line, file_stem, run_job, GlobalArgs};
 
@@ -123,10 +120,18 @@ fn resume(global: &GlobalArgs, dir: &Path) -> anyhow::Result<()> {
     match method.as_str() {
         pets::METHOD => {
             let report = run_job(global, "train pets (resumed)", |monitor| pets::resume(dir, monitor))?;
-            print_pets_report(&report, dir);
-            Ok(())
+            print_pets_report(&report, dir)
         }
-        other => bail!("{}: '{other}' runs cannot be resumed; resumable methods: {}", dir.display(), pets::METHOD),
+        ball_job::METHOD => {
+            let report = run_job(global, "train ball-ekf (resumed)", |monitor| ball_job::resume(dir, monitor))?;
+            finish_ball(&report, dir)
+        }
+        other => bail!(
+            "{}: '{other}' runs cannot be resumed; resumable methods: {}, {}",
+            dir.display(),
+            pets::METHOD,
+            ball_job::METHOD
+        ),
     }
 }
 
@@ -187,11 +192,11 @@ fn train_pets(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
         provenance: Provenance::new(command_line(), global.seed, global.thread_count()),
     };
     let report = run_job(global, "train pets", |monitor| pets::train(&request, false, monitor))?;
-    print_pets_report(&report, &out);
-    Ok(())
+    print_pets_report(&report, &out)
 }
 
-fn print_pets_report(report: &pets::TrainReport, out: &Path) {
+fn print_pets_report(report: &pets::TrainReport, out: &Path) -> anyhow::Result<()> {
+    write_loss_report(out, "PETS training loss (Gaussian NLL summed over members)", "loss")?;
     let run = &report.run;
     let c = &run.config;
     println!(
@@ -218,6 +223,7 @@ fn print_pets_report(report: &pets::TrainReport, out: &Path) {
         println!("best validation MSE {v:.3e} at step {step} (saved as model.safetensors)");
     }
     println!("checkpoint: {}", out.display());
+    Ok(())
 }
 
 fn train_ball(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
@@ -239,7 +245,6 @@ fn train_ball(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
     let steps = args.steps.unwrap_or(1000);
     let batch = args.batch.unwrap_or(64);
     let lr = args.lr.unwrap_or(5e-3);
-    let recordings = read_recordings(data)?;
     let settings = TrainSettings {
         steps,
         batch_size: batch,
@@ -249,54 +254,27 @@ fn train_ball(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
         launcher_prior: args.launcher_prior,
         ..TrainSettings::default()
     };
-    let provenance = Provenance::new(command_line(), global.seed, global.thread_count());
-    let outcome = run_job(global, "train ball-ekf", |monitor| {
-        let run = RunDir::create(&out)?;
-        run.write_config(&serde_json::json!({
-            "job": "train ball-ekf",
-            "data": data.display().to_string(),
-            "recordings": recordings.len(),
-            "settings": settings,
-            "provenance": provenance,
-        }))?;
-        let metrics = run.metrics()?;
-        let monitor = Tee { first: monitor, second: &metrics };
-        monitor.emit(&Event::Layout {
-            title: "train ball EKF (negative log-likelihood per measurement)".into(),
-            panels: vec![PanelSpec {
-                title: "loss".into(),
-                x_label: "step".into(),
-                series: vec!["train/loss".into()],
-                restart_on_rewind: false,
-            }],
-        });
-        let outcome = train(&recordings, &settings, &monitor)?;
-        save_ball_params(run.path(), &outcome.params)?;
-        if let Some(net) = &outcome.spin_net {
-            write_json(&run.file("spin_net.json"), net)?;
-        }
-        let rows: Vec<Vec<String>> =
-            outcome.losses.iter().enumerate().map(|(k, l)| vec![k.to_string(), format!("{l:.6}")]).collect();
-        write_csv(&run.file("losses.csv"), &["step", "loss"], &rows)?;
-        let curve = Series {
-            name: "batch loss".into(),
-            points: outcome.losses.iter().enumerate().map(|(k, l)| (k as f64, *l)).collect(),
-        };
-        line_plot(
-            &run.file("loss.png"),
-            "Training loss (eq. 6.24, per measurement)",
-            "step",
-            "negative log-likelihood",
-            &[curve],
-        )?;
-        metrics.emit(&Event::Finished { ok: true });
-        Ok(outcome)
-    })?;
-    let p = &outcome.params;
+    let request = BallTrainRequest {
+        out: out.clone(),
+        data: data.clone(),
+        settings,
+        provenance: Provenance::new(command_line(), global.seed, global.thread_count()),
+    };
+    let report = run_job(global, "train ball-ekf", |monitor| ball_job::train_checkpointed(&request, false, monitor))?;
+    finish_ball(&report, &out)
+}
+
+fn finish_ball(report: &BallTrainReport, out: &Path) -> anyhow::Result<()> {
+    let losses = write_loss_report(out, "Training loss (eq. 6.24, per measurement)", "negative log-likelihood")?;
+    let p = &report.params;
     let thesis = BallModelParams::thesis_learned();
-    println!("trained on {} chunks of {} frames from {} recordings", outcome.chunks, args.chunk, recordings.len());
-    if let (Some(first), Some(last)) = (outcome.losses.first(), outcome.losses.last()) {
-        println!("loss {first:.3} -> {last:.3}");
+    let run = &report.run;
+    println!(
+        "trained on {} chunks of {} frames from {} recordings",
+        run.chunks, run.settings.chunk_len, run.recordings
+    );
+    if let (Some(first), Some(last)) = (losses.first(), losses.last()) {
+        println!("loss {:.3} -> {:.3}", first.1, last.1);
     }
     println!("learned C (thesis eq. 6.26 in brackets):");
     for (row, thesis_row) in p.c.iter().zip(&thesis.c) {
@@ -312,4 +290,14 @@ fn train_ball(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
     );
     println!("checkpoint: {}", out.display());
     Ok(())
+}
+
+/// losses.csv and loss.png of a finished run, from its metrics log (so a resumed run gets the whole curve).
+fn write_loss_report(out: &Path, title: &str, y_label: &str) -> anyhow::Result<Vec<(u64, f64)>> {
+    let losses = loss_history(&out.join(METRICS_FILE))?;
+    let rows: Vec<Vec<String>> = losses.iter().map(|(k, l)| vec![k.to_string(), format!("{l:.6}")]).collect();
+    write_csv(&out.join("losses.csv"), &["step", "loss"], &rows)?;
+    let curve = Series { name: "batch loss".into(), points: losses.iter().map(|(k, l)| (*k as f64, *l)).collect() };
+    line_plot(&out.join("loss.png"), title, "step", y_label, &[curve])?;
+    Ok(losses)
 }

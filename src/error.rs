@@ -29,10 +29,6 @@ pub enum Error {
     #[error("{0}")]
     Diverged(String),
 
-    /// Deprecated catch-all, being replaced by the kinds above.
-    #[error("{0}")]
-    InvalidInput(String),
-
     #[error("cancelled by the user")]
     Cancelled,
 }

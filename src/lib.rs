@@ -12,6 +12,7 @@ pub mod planning;
 pub mod run;
 pub mod train;
 pub mod tui;
+pub mod util;
 
 pub use error::{Error, Result};
 

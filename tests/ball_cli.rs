@@ -170,3 +170,58 @@ fn hdf5_input_without_the_feature_says_how_to_get_it() {
     let out = mbrl(dir.path()).args(["filter", "--model", "thesis", "--input", "release.hdf5"]).output().unwrap();
     assert_one_line_error(&out, &["release.hdf5", "--features hdf5", "libhdf5-dev"]);
 }
+
+/// Stops a training run after `stop_after` steps, as quitting the live view does.
+struct StopAfter(u64, std::sync::atomic::AtomicU64);
+
+impl mbrl::run::Monitor for StopAfter {
+    fn emit(&self, event: &mbrl::run::Event) {
+        if let mbrl::run::Event::Progress { phase, done, .. } = event {
+            if phase == "train" {
+                self.1.store(*done, std::sync::atomic::Ordering::Relaxed);
+            }
+        }
+    }
+
+    fn is_cancelled(&self) -> bool {
+        self.1.load(std::sync::atomic::Ordering::Relaxed) >= self.0
+    }
+}
+
+#[test]
+fn ball_training_resumes_to_the_same_bytes_and_stopped_runs_are_not_models() {
+    use mbrl::models::ball::learn::job::{train_checkpointed, BallTrainRequest, CHECKPOINT_EVERY};
+    use mbrl::models::ball::learn::TrainSettings;
+    let dir = tempfile::tempdir().unwrap();
+    mbrl(dir.path())
+        .args(["collect", "--env", "ball", "--trajectories", "6", "--out", "t.mcap", "-q"])
+        .assert()
+        .success();
+    let request = |out: &str| BallTrainRequest {
+        out: dir.path().join(out),
+        data: dir.path().join("t.mcap"),
+        settings: TrainSettings { steps: CHECKPOINT_EVERY + 20, batch_size: 8, seed: 3, ..TrainSettings::default() },
+        provenance: mbrl::run::dir::Provenance::new("mbrl train …".into(), 3, 1),
+    };
+    train_checkpointed(&request("whole"), false, &mbrl::run::NullMonitor).unwrap();
+    let stop = StopAfter(CHECKPOINT_EVERY + 10, 0.into());
+    assert!(matches!(train_checkpointed(&request("stopped"), false, &stop), Err(mbrl::Error::Cancelled)));
+    let out = mbrl(dir.path()).args(["predict", "--model", "stopped", "--input", "t.mcap", "-q"]).output().unwrap();
+    assert!(!out.status.success() && stderr_of(&out).contains("--resume"), "{}", stderr_of(&out));
+    let out = mbrl(dir.path()).args(["train", "--resume", "stopped", "-q"]).output().unwrap();
+    assert!(out.status.success(), "{}", stderr_of(&out));
+    for file in
+        ["checkpoint.json", "config.json", "params.json", "model.safetensors", "state.safetensors", "metrics.jsonl"]
+    {
+        let a = std::fs::read(dir.path().join("whole").join(file)).unwrap();
+        let b = std::fs::read(dir.path().join("stopped").join(file)).unwrap();
+        assert!(a == b, "{file} differs after resuming");
+    }
+    // A parameter file edited after training no longer matches the manifest.
+    let params = dir.path().join("stopped/params.json");
+    let mut text = std::fs::read_to_string(&params).unwrap();
+    text.push(' ');
+    std::fs::write(&params, text).unwrap();
+    let out = mbrl(dir.path()).args(["predict", "--model", "stopped", "--input", "t.mcap", "-q"]).output().unwrap();
+    assert!(stderr_of(&out).contains("params.json") && stderr_of(&out).contains("CRC-32"), "{}", stderr_of(&out));
+}

@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 
 use super::mcap_io::{write_messages, Layout};
 use crate::error::Result;
-use crate::eval::table::write_csv;
+use crate::util::table::write_csv;
 
 pub const STATE_NAMES: [&str; 11] = ["px", "py", "pz", "vx", "vy", "vz", "wx", "wy", "wz", "a_d", "a_m"];
 pub const METADATA_NAME: &str = "mbrl.ball_estimates";

@@ -5,8 +5,8 @@ use rand::Rng;
 use super::{Dataset, DatasetMeta, Rollout, FORMAT_VERSION};
 use crate::envs::EnvName;
 use crate::error::{Error, Result};
-use crate::planning::seeding::rng_for;
 use crate::run::Monitor;
+use crate::util::seeding::rng_for;
 
 pub struct CollectSettings {
     pub env: EnvName,
@@ -20,7 +20,7 @@ pub struct CollectSettings {
 /// parametrized family and a start state from the environment's reset distribution.
 pub fn collect_random(settings: &CollectSettings, monitor: &dyn Monitor) -> Result<Dataset> {
     if settings.rollouts == 0 || settings.steps == 0 {
-        return Err(Error::InvalidInput("--rollouts and --steps must be at least 1".into()));
+        return Err(Error::config("--rollouts and --steps must be at least 1"));
     }
     let mut env = settings.env.build()?;
     let spec = env.spec();

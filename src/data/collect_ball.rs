@@ -7,8 +7,8 @@ use crate::envs::ball::{
     augmentation_pivot, rotate_about_z, simulate, BallTrajectory, CameraModel, LaunchParams, Orientation,
 };
 use crate::error::{Error, Result};
-use crate::planning::seeding::rng_for;
 use crate::run::Monitor;
+use crate::util::seeding::rng_for;
 
 /// Shots tried per kept trajectory before giving up (a shot is kept when it bounces exactly once).
 const MAX_TRIES_PER_SHOT: usize = 50;
@@ -42,7 +42,7 @@ fn to_recording(id: u32, t: &BallTrajectory, rotated_from: Option<(u32, f64)>) -
 /// assumes one bounce), only shots with exactly one table impact are kept.
 pub fn collect_ball(settings: &BallCollectSettings, monitor: &dyn Monitor) -> Result<BallDataset> {
     if settings.trajectories == 0 {
-        return Err(Error::InvalidInput("--trajectories must be at least 1".into()));
+        return Err(Error::config("--trajectories must be at least 1"));
     }
     let camera = CameraModel::default();
     let mut originals = Vec::with_capacity(settings.trajectories);
@@ -57,9 +57,7 @@ pub fn collect_ball(settings: &BallCollectSettings, monitor: &dyn Monitor) -> Re
                 simulate(&launch, &camera, &mut rng)
             })
             .find(|t| t.impact_times.len() == 1 && t.positions.iter().filter(|p| p.is_some()).count() >= 2)
-            .ok_or_else(|| {
-                Error::InvalidInput("the launcher produced no single-bounce shot; check its settings".into())
-            })?;
+            .ok_or_else(|| Error::config("the launcher produced no single-bounce shot; check its settings"))?;
         originals.push(shot);
         monitor.progress("simulate shots", k as u64 + 1, settings.trajectories as u64);
     }

@@ -8,7 +8,7 @@ use serde::de::DeserializeOwned;
 use serde::Serialize;
 
 use crate::error::{Error, Result};
-use crate::run::atomic::write_atomic_seekable;
+use crate::util::atomic::write_atomic_seekable;
 
 const PROFILE: &str = "mbrl";
 

@@ -23,7 +23,7 @@ pub fn parse_env(name: &str) -> Result<EnvName> {
         "pendulum" => Ok(EnvName::Pendulum(PendulumVariant::parse(variant)?)),
         "lightsout" | "tileswap" => Ok(EnvName::Board(GameSpec::parse(name)?)),
         "ball" if variant.is_empty() => Ok(EnvName::Ball),
-        _ => Err(Error::InvalidInput(format!("unknown env '{name}'; supported: {KNOWN_ENVS}"))),
+        _ => Err(Error::config(format!("unknown env '{name}'; supported: {KNOWN_ENVS}"))),
     }
 }
 
@@ -33,14 +33,14 @@ impl EnvName {
     pub fn build(&self) -> Result<Box<dyn Env>> {
         match self {
             EnvName::Pendulum(v) => Ok(Box::new(Pendulum::new(v.clone()))),
-            EnvName::Board(g) => Err(Error::InvalidInput(format!(
+            EnvName::Board(g) => Err(Error::config(format!(
                 "'{}' is a board game, not a simulator to roll out; use `mbrl collect --env {} --boards --max-depth D` \
                  for board sets (games: {GAME_HELP})",
                 g.name(),
                 g.name()
             ))),
-            EnvName::Ball => Err(Error::InvalidInput(
-                "'ball' is recorded as camera trajectories: use `mbrl collect --env ball --trajectories N`".into(),
+            EnvName::Ball => Err(Error::config(
+                "'ball' is recorded as camera trajectories: use `mbrl collect --env ball --trajectories N`",
             )),
         }
     }

@@ -9,7 +9,6 @@ use serde::Serialize;
 
 use super::plot::{band_plot, line_plot, Band, Series};
 use super::stats::quantile;
-use super::table::write_csv;
 use crate::data::ball_io::{Recording, FRAME_RATE};
 use crate::data::collect_ball::{collect_ball, BallCollectSettings};
 use crate::envs::ball::Orientation;
@@ -19,10 +18,11 @@ use crate::models::ball::checkpoint::LoadedBallModel;
 use crate::models::ball::learn::SpinNetWeights;
 use crate::models::ball::track::{filter_recording, predict_ahead, prediction_error, protocol_cut, PredictedPoint};
 use crate::models::ball::{BallModel, BallModelParams, SpinPrior};
-use crate::planning::seeding::derive_seed;
-use crate::run::atomic::write_text;
 use crate::run::dir::{Provenance, RunDir};
 use crate::run::{Event, Monitor, Tee};
+use crate::util::atomic::write_text;
+use crate::util::seeding::derive_seed;
+use crate::util::table::write_csv;
 
 #[derive(Clone, Debug, Serialize)]
 pub struct BallEvalSettings {

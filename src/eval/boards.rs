@@ -6,18 +6,18 @@ use std::path::Path;
 use rand::seq::IndexedRandom;
 use serde::Serialize;
 
-use super::table::write_csv;
 use crate::envs::boards::depth::{DenseIndex, DepthTable};
 use crate::envs::boards::sets::boards_at;
 use crate::envs::boards::{split_of, LightsOut, Split, TileSwap};
 use crate::envs::embodiments::Embodiment;
 use crate::error::Result;
 use crate::planning::bfs::SearchLimits;
-use crate::planning::seeding::rng_for;
 use crate::planning::solve_board::{execute_plan, plan_board, SearchKind};
-use crate::run::atomic::write_text;
 use crate::run::dir::{Provenance, RunDir};
 use crate::run::{Event, Monitor, NullMonitor, Tee};
+use crate::util::atomic::write_text;
+use crate::util::seeding::rng_for;
+use crate::util::table::write_csv;
 
 /// Thesis Table 7.1, for the comparison column of the report (depths 0..).
 const THESIS_LIGHTSOUT: [u64; 16] =

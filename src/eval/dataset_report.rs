@@ -6,11 +6,11 @@ use serde::Serialize;
 
 use super::plot::{histogram, line_plot, Series};
 use super::stats::{mean, quantile};
-use super::table::write_csv;
 use crate::data::{read_dataset, Rollout};
 use crate::error::{Error, Result};
-use crate::run::atomic::write_text;
 use crate::run::dir::{Provenance, RunDir};
+use crate::util::atomic::write_text;
+use crate::util::table::write_csv;
 
 /// Rollouts drawn in the state plot; more would be unreadable.
 const PLOTTED_ROLLOUTS: usize = 20;

@@ -7,4 +7,3 @@ pub mod plot;
 pub mod quick;
 pub mod stats;
 pub mod swingup;
-pub mod table;

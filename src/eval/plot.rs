@@ -35,7 +35,7 @@ fn render_atomic(path: &Path, draw: impl FnOnce(&Path) -> Result<()>) -> Result<
     register_font();
     let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
     let tmp =
-        crate::run::atomic::partial_file_builder().suffix(".png").tempfile_in(dir).map_err(|e| Error::io(dir, e))?;
+        crate::util::atomic::partial_file_builder().suffix(".png").tempfile_in(dir).map_err(|e| Error::io(dir, e))?;
     draw(tmp.path())?;
     tmp.persist(path).map_err(|e| Error::io(path, e.error))?;
     Ok(())

@@ -19,9 +19,9 @@ use crate::models::ball::checkpoint::{load_ball_model, LoadedBallModel};
 use crate::models::ball::learn::{train, TrainSettings};
 use crate::models::ball::BallModel;
 use crate::models::pets::{self, PetsConfig, Preset, Propagation};
-use crate::run::atomic::write_text;
 use crate::run::dir::Provenance;
 use crate::run::Monitor;
+use crate::util::atomic::write_text;
 
 pub const SWINGUP_EPISODES: usize = 5;
 pub const EMBODIED_BOARDS_PER_DEPTH: usize = 20;
@@ -155,7 +155,7 @@ fn ball_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) ->
         (
             "trained (quick)".to_string(),
             LoadedBallModel {
-                model: BallModel::new(trained.params).map_err(|e| Error::InvalidInput(e.to_string()))?,
+                model: BallModel::new(trained.params).map_err(|e| Error::Diverged(e.to_string()))?,
                 spin_net: None,
             },
         ),

@@ -7,17 +7,17 @@ use serde::Serialize;
 
 use super::plot::{histogram, line_plot, Series};
 use super::stats::{mean, quantile};
-use super::table::write_csv;
 use crate::data::{write_dataset, Dataset, DatasetMeta, Rollout, FORMAT_VERSION};
 use crate::envs::pendulum::{angle_normalize, Pendulum, PendulumVariant, StartDistribution};
 use crate::envs::{BatchDynamics, Env};
 use crate::error::Result;
 use crate::planning::mpc::run_mpc_episode;
-use crate::planning::seeding::{derive_seed, rng_for};
 use crate::planning::{Cem, CemConfig};
-use crate::run::atomic::write_text;
 use crate::run::dir::{Provenance, RunDir};
 use crate::run::{Event, Monitor, PanelSpec, Tee};
+use crate::util::atomic::write_text;
+use crate::util::seeding::{derive_seed, rng_for};
+use crate::util::table::write_csv;
 
 pub const SUCCESS_WINDOW: usize = 25;
 pub const SUCCESS_MIN_REWARD: f64 = -1.0;

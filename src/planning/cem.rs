@@ -8,9 +8,9 @@ use rustfft::num_complex::Complex;
 use serde::{Deserialize, Serialize};
 
 use super::colored_noise::ColoredNoise;
-use super::seeding::rng_for;
 use super::Objective;
 use crate::error::{Error, Result};
+use crate::util::seeding::rng_for;
 
 /// Candidates that share one random stream. Fixed, so results do not depend on the thread count.
 const CANDIDATES_PER_STREAM: usize = 64;
@@ -62,7 +62,7 @@ impl CemConfig {
     }
 
     pub fn validate(&self) -> Result<()> {
-        let bad = |msg: String| Err(Error::InvalidInput(msg));
+        let bad = |msg: String| Err(Error::Config(msg));
         if self.horizon == 0 || self.candidates == 0 || self.iterations == 0 {
             return bad("CEM: horizon, candidates and iterations must be at least 1".into());
         }

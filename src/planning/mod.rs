@@ -5,7 +5,6 @@ pub mod bfs;
 pub mod cem;
 pub mod colored_noise;
 pub mod mpc;
-pub mod seeding;
 pub mod solve_board;
 
 pub use cem::{Cem, CemConfig, CemIteration, NoiseKind};
@@ -35,7 +34,7 @@ impl<'a> ReturnObjective<'a> {
 impl Objective for ReturnObjective<'_> {
     fn costs(&self, candidates: &[f64], horizon: usize, costs: &mut [f64]) {
         let call = self.calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        let seed = crate::planning::seeding::derive_seed(self.seed, &[call]);
+        let seed = crate::util::seeding::derive_seed(self.seed, &[call]);
         self.dynamics.rollout(self.init, candidates, horizon, seed, costs, None);
         for c in costs.iter_mut() {
             *c = -*c;

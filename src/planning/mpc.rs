@@ -1,12 +1,12 @@
 //! Receding-horizon control: plan with CEM on a model, apply the first action to the real environment,
 //! replan.
 
-use super::seeding::derive_seed;
 use super::{Cem, CemIteration, ReturnObjective};
 use crate::data::Rollout;
 use crate::envs::{BatchDynamics, Env};
 use crate::error::{Error, Result};
 use crate::run::Monitor;
+use crate::util::seeding::derive_seed;
 
 /// One executed MPC step, with what the model expected of it.
 pub struct MpcStep<'a> {

@@ -62,7 +62,7 @@ pub fn plan_board<G: BoardGame>(
     monitor: &dyn Monitor,
 ) -> Result<SearchResult> {
     if !game.is_solvable(board) {
-        return Err(Error::InvalidInput(format!(
+        return Err(Error::data(format!(
             "board {} of {} cannot be solved: no sequence of moves reaches the goal (on 5x5 LightsOut only a quarter of all boards can)",
             game.canonical_string(board),
             game.name()
@@ -82,7 +82,7 @@ pub fn plan_board<G: BoardGame>(
     };
     monitor.emit(&Event::text("search", stats_text(&result.stats)));
     let plan = result.plan.as_ref().ok_or_else(|| {
-        Error::InvalidInput(format!("no plan of at most {} moves exists; raise --max-depth", limits.max_depth))
+        Error::Budget(format!("no plan of at most {} moves exists; raise --max-depth", limits.max_depth))
     })?;
     let names: Vec<String> = plan.iter().map(|&m| game.move_name(m)).collect();
     monitor.emit(&Event::text("plan", format!("{} moves\n{}", plan.len(), names.join("\n"))));

@@ -5,9 +5,9 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use super::atomic::write_json;
 use super::monitor::JsonlMonitor;
 use crate::error::{Error, Result};
+use crate::util::atomic::write_json;
 
 pub const CONFIG_FILE: &str = "config.json";
 pub const METRICS_FILE: &str = "metrics.jsonl";

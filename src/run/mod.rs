@@ -1,6 +1,5 @@
 //! A run: its directory on disk, its configuration and its stream of events.
 
-pub mod atomic;
 pub mod dir;
 pub mod event;
 pub mod follow;

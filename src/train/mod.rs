@@ -3,11 +3,13 @@
 
 pub mod checkpoint;
 pub mod config;
+pub mod data_file;
 pub mod fit;
 pub mod job;
 pub mod tensors;
 
 pub use checkpoint::{CheckpointDir, Manifest};
+pub use data_file::{loss_history, DataFile};
 pub use fit::{fit, FitOutcome, FitSettings, ResumePoint, TrainingMethod, CONFIG_FILE, MODEL_FILE, STATE_FILE};
 pub use job::{run_training, training_layout};
 pub use tensors::StoredTensor;
@@ -57,6 +59,14 @@ impl OpenedCheckpoint {
             ));
         }
         Ok(())
+    }
+
+    /// The verified bytes of a listed file; `None` when the checkpoint does not list it.
+    pub fn file_bytes(&self, name: &str) -> Result<Option<Vec<u8>>> {
+        match self.manifest.files.get(name) {
+            Some(entry) => Ok(Some(self.dir.read_verified(name, entry)?)),
+            None => Ok(None),
+        }
     }
 
     /// The tensors of one listed file.

@@ -78,7 +78,7 @@ impl Orientation {
                 .map(Orientation::Unseen),
         };
         parsed.ok_or_else(|| {
-            Error::InvalidInput(format!("unknown launcher orientation {name:?}; expected one of: {VALID_NAMES}"))
+            Error::config(format!("unknown launcher orientation {name:?}; expected one of: {VALID_NAMES}"))
         })
     }
 

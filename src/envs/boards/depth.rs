@@ -68,7 +68,7 @@ impl DepthTable {
     pub fn build<G: DenseIndex>(game: &G) -> Result<Self> {
         let count = game.state_count();
         if count > 1 << 25 {
-            return Err(Error::InvalidInput(format!(
+            return Err(Error::config(format!(
                 "a full depth table of {} needs {count} entries; supported: lightsout up to 5x5 and tileswap-3x3",
                 game.name()
             )));

@@ -49,9 +49,7 @@ pub struct LightsOut {
 impl LightsOut {
     pub fn new(n: usize) -> Result<Self> {
         if !(2..=MAX_SIDE).contains(&n) {
-            return Err(Error::InvalidInput(format!(
-                "LightsOut board size {n} is not supported; expected 2 to {MAX_SIDE}"
-            )));
+            return Err(Error::config(format!("LightsOut board size {n} is not supported; expected 2 to {MAX_SIDE}")));
         }
         let masks = (0..n * n)
             .map(|field| {
@@ -131,7 +129,7 @@ impl BoardGame for LightsOut {
     fn parse(&self, text: &str) -> Result<LightsOutState> {
         let values: Vec<&str> = text.split(',').map(str::trim).collect();
         if values.len() != self.fields() {
-            return Err(Error::InvalidInput(format!(
+            return Err(Error::config(format!(
                 "board for {}: expected {} comma-separated values (0 or 1, row-major), got {}",
                 self.name(),
                 self.fields(),
@@ -144,7 +142,7 @@ impl BoardGame for LightsOut {
                 "0" => {}
                 "1" => state.set(field, true),
                 other => {
-                    return Err(Error::InvalidInput(format!(
+                    return Err(Error::config(format!(
                         "board for {}: field {field} is '{other}'; expected 0 or 1",
                         self.name()
                     )))

@@ -57,7 +57,7 @@ pub fn sample_board<G: DenseIndex>(
 ) -> Result<G::State> {
     let candidates = boards_at(game, table, depth, split);
     candidates.choose(rng).copied().ok_or_else(|| {
-        Error::InvalidInput(format!(
+        Error::config(format!(
             "{} has no boards of depth {depth}{}; depths go up to {}",
             game.name(),
             split.map(|s| format!(" in the {} split", s.as_str())).unwrap_or_default(),

@@ -13,7 +13,7 @@ pub enum GameSpec {
 
 impl GameSpec {
     pub fn parse(name: &str) -> Result<Self> {
-        let bad = || Error::InvalidInput(format!("unknown board game '{name}'; supported: {GAME_HELP}"));
+        let bad = || Error::config(format!("unknown board game '{name}'; supported: {GAME_HELP}"));
         let (family, size) = name.split_once(':').unwrap_or((name, ""));
         match family {
             "lightsout" if size.is_empty() => Ok(GameSpec::LightsOut(5)),

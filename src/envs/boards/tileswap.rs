@@ -122,7 +122,7 @@ impl BoardGame for TileSwap {
         let name = self.name();
         let values: Vec<&str> = text.split(',').map(str::trim).collect();
         if values.len() != FIELDS {
-            return Err(Error::InvalidInput(format!(
+            return Err(Error::config(format!(
                 "board for {name}: expected {FIELDS} comma-separated chip numbers (0-8, one per field, row-major), got {}",
                 values.len()
             )));
@@ -131,10 +131,10 @@ impl BoardGame for TileSwap {
         let mut field_of_chip = [None; FIELDS];
         for (field, v) in values.iter().enumerate() {
             let chip: usize = v.parse().ok().filter(|c| *c < FIELDS).ok_or_else(|| {
-                Error::InvalidInput(format!("board for {name}: field {field} is '{v}'; expected a chip number 0-8"))
+                Error::config(format!("board for {name}: field {field} is '{v}'; expected a chip number 0-8"))
             })?;
             if let Some(first) = field_of_chip[chip] {
-                return Err(Error::InvalidInput(format!(
+                return Err(Error::config(format!(
                     "board for {name}: chip {chip} appears on fields {first} and {field}; each chip 0-8 must appear once"
                 )));
             }

@@ -25,7 +25,7 @@ impl Embodiment {
         match name {
             "cursor" => Ok(Embodiment::Cursor),
             "reacher" => Ok(Embodiment::Reacher),
-            other => Err(Error::InvalidInput(format!("unknown embodiment '{other}'; supported: {EMBODIMENT_HELP}"))),
+            other => Err(Error::config(format!("unknown embodiment '{other}'; supported: {EMBODIMENT_HELP}"))),
         }
     }
 

@@ -22,7 +22,7 @@ pub const VARIANT_HELP: &str = "light (m=0.2), heavy (m=1.5), mass=<m>, inverted
 
 impl PendulumVariant {
     pub fn parse(text: &str) -> Result<Self> {
-        let bad = || Error::InvalidInput(format!("unknown pendulum variant '{text}'; expected one of: {VARIANT_HELP}"));
+        let bad = || Error::config(format!("unknown pendulum variant '{text}'; expected one of: {VARIANT_HELP}"));
         match text {
             "" | "standard" => Ok(PendulumVariant::Standard),
             "light" => Ok(PendulumVariant::Mass(0.2)),
@@ -32,10 +32,10 @@ impl PendulumVariant {
             other => {
                 let value = other.strip_prefix("mass=").ok_or_else(bad)?;
                 let mass: f64 = value.parse().map_err(|_| {
-                    Error::InvalidInput(format!("pendulum variant 'mass={value}': expected a positive number"))
+                    Error::config(format!("pendulum variant 'mass={value}': expected a positive number"))
                 })?;
                 if !mass.is_finite() || mass <= 0.0 {
-                    return Err(Error::InvalidInput(format!(
+                    return Err(Error::config(format!(
                         "pendulum variant 'mass={value}': expected a positive finite mass"
                     )));
                 }

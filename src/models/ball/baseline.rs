@@ -54,8 +54,12 @@ pub struct RidgeBaseline {
     samples: Vec<usize>,
 }
 
-fn invalid(what: impl std::fmt::Display) -> Error {
-    Error::InvalidInput(format!("ridge baseline: {what}"))
+fn bad_settings(what: impl std::fmt::Display) -> Error {
+    Error::config(format!("ridge baseline: {what}"))
+}
+
+fn unusable_data(what: impl std::fmt::Display) -> Error {
+    Error::data(format!("ridge baseline: {what}"))
 }
 
 /// One slot per camera frame between a recording's first and last frame, since frames absent from the
@@ -149,13 +153,13 @@ fn features(
 
 fn check_settings(s: &BaselineSettings) -> Result<()> {
     if s.window < 2 {
-        return Err(invalid(format!("window {} frames; it needs at least 2 to see a velocity", s.window)));
+        return Err(bad_settings(format!("window {} frames; it needs at least 2 to see a velocity", s.window)));
     }
     if s.horizon_frames == 0 {
-        return Err(invalid("horizon_frames must be at least 1"));
+        return Err(bad_settings("horizon_frames must be at least 1"));
     }
     if !(s.ridge.is_finite() && s.ridge >= 0.0) {
-        return Err(invalid(format!("ridge {} must be a finite non-negative number", s.ridge)));
+        return Err(bad_settings(format!("ridge {} must be a finite non-negative number", s.ridge)));
     }
     Ok(())
 }
@@ -170,7 +174,7 @@ fn training_samples(recordings: &[Recording], settings: &BaselineSettings) -> Re
     let mut samples = Vec::new();
     for rec in recordings {
         if settings.use_launcher_info && rec.info.side_info.is_none() {
-            return Err(invalid(format!(
+            return Err(unusable_data(format!(
                 "trajectory {} has no launcher side information, which use_launcher_info needs",
                 rec.id
             )));
@@ -246,7 +250,7 @@ impl RidgeBaseline {
             }
             count += by_reach[h].len();
             if count < needed {
-                return Err(invalid(format!(
+                return Err(unusable_data(format!(
                     "{count} training cuts reach {h} frames ahead, fewer than the {needed} its {} weights need; \
                      give more (or longer) recordings or a shorter horizon_frames",
                     dim + 1
@@ -257,7 +261,7 @@ impl RidgeBaseline {
                 a[(j, j)] += settings.ridge * count as f64;
             }
             let chol = a.cholesky().ok_or_else(|| {
-                invalid(format!(
+                unusable_data(format!(
                     "the normal equations of horizon {h} are not positive definite (constant or collinear \
                      features, such as the side information of a single launcher orientation, need ridge > 0)"
                 ))

@@ -3,11 +3,13 @@
 
 use std::path::Path;
 
+use super::learn::job::METHOD;
 use super::learn::SpinNetWeights;
 use super::{BallModel, BallModelParams, SpinPrior};
 use crate::data::ball_io::Recording;
 use crate::error::{Error, Result};
-use crate::run::atomic::write_json;
+use crate::train::checkpoint::read_bounded;
+use crate::train::OpenedCheckpoint;
 
 pub const PARAMS_FILE: &str = "params.json";
 pub const SPIN_NET_FILE: &str = "spin_net.json";
@@ -34,40 +36,45 @@ impl LoadedBallModel {
 
 /// Parses `--model`: a built-in name or a directory written by `mbrl train --method ball-ekf`.
 pub fn load_ball_model(spec: &str) -> Result<LoadedBallModel> {
-    let spin_net_file = Path::new(spec).join(SPIN_NET_FILE);
-    let spin_net = if Path::new(spec).is_dir() && spin_net_file.is_file() {
-        let text = std::fs::read_to_string(&spin_net_file).map_err(|e| Error::io(&spin_net_file, e))?;
-        Some(
-            serde_json::from_str(&text)
-                .map_err(|e| Error::bad_file(&spin_net_file, format!("not spin-network weights: {e}")))?,
-        )
-    } else {
-        None
-    };
-    Ok(LoadedBallModel { model: load_params(spec)?, spin_net })
-}
-
-fn load_params(spec: &str) -> Result<BallModel> {
-    let params = match spec {
-        "thesis" => BallModelParams::thesis_learned(),
-        "initial" => BallModelParams::initial(),
+    let (params, spin_net) = match spec {
+        "thesis" => (BallModelParams::thesis_learned(), None),
+        "initial" => (BallModelParams::initial(), None),
+        path if Path::new(path).is_dir() => load_checkpoint(Path::new(path))?,
         path => {
-            let dir = Path::new(path);
-            let file = if dir.is_dir() { dir.join(PARAMS_FILE) } else { dir.to_path_buf() };
+            let file = Path::new(path);
             if !file.is_file() {
-                return Err(Error::bad_file(
-                    &file,
-                    format!("no ball model here; --model takes {BUILTIN_HELP} holding {PARAMS_FILE}"),
-                ));
+                return Err(Error::bad_file(file, format!("no ball model here; --model takes {BUILTIN_HELP}")));
             }
-            let text = std::fs::read_to_string(&file).map_err(|e| Error::io(&file, e))?;
-            serde_json::from_str(&text)
-                .map_err(|e| Error::bad_file(&file, format!("not ball-model parameters: {e}")))?
+            (parse_params(file, &read_bounded(file, MAX_JSON_BYTES)?)?, None)
         }
     };
-    BallModel::new(params).map_err(|e| Error::InvalidInput(format!("--model {spec}: {e}")))
+    let model = BallModel::new(params).map_err(|e| Error::config(format!("--model {spec}: {e}")))?;
+    Ok(LoadedBallModel { model, spin_net })
 }
 
-pub fn save_ball_params(dir: &Path, params: &BallModelParams) -> Result<()> {
-    write_json(&dir.join(PARAMS_FILE), params)
+const MAX_JSON_BYTES: u64 = 16 << 20;
+
+/// A directory written by `mbrl train --method ball-ekf`: every file checked against the manifest.
+fn load_checkpoint(dir: &Path) -> Result<(BallModelParams, Option<SpinNetWeights>)> {
+    let opened = OpenedCheckpoint::open(dir)?;
+    opened.expect_finished(METHOD)?;
+    let params_bytes = opened
+        .file_bytes(PARAMS_FILE)?
+        .ok_or_else(|| Error::bad_file(dir, format!("the checkpoint lists no {PARAMS_FILE}")))?;
+    let params = parse_params(&dir.join(PARAMS_FILE), &params_bytes)?;
+    let spin_net = match opened.file_bytes(SPIN_NET_FILE)? {
+        None => None,
+        Some(bytes) => {
+            let path = dir.join(SPIN_NET_FILE);
+            let net: SpinNetWeights = serde_json::from_slice(&bytes)
+                .map_err(|e| Error::bad_file(&path, format!("not spin-network weights: {e}")))?;
+            net.check().map_err(|e| Error::bad_file(&path, e.to_string()))?;
+            Some(net)
+        }
+    };
+    Ok((params, spin_net))
+}
+
+fn parse_params(path: &Path, bytes: &[u8]) -> Result<BallModelParams> {
+    serde_json::from_slice(bytes).map_err(|e| Error::bad_file(path, format!("not ball-model parameters: {e}")))
 }

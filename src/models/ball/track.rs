@@ -18,7 +18,7 @@ pub struct Track {
 }
 
 fn model_error(what: impl std::fmt::Display) -> Error {
-    Error::InvalidInput(format!("ball model: {what}"))
+    Error::data(format!("ball model: {what}"))
 }
 
 /// Filters `recording` up to and including frame `until` (all frames when `None`), starting with the given
@@ -32,13 +32,13 @@ pub fn filter_recording(
     let measured: Vec<(usize, [f64; 3])> =
         recording.positions.iter().enumerate().filter_map(|(i, p)| p.map(|p| (i, p))).take(2).collect();
     let [(i1, m1), (i2, m2)] = measured[..] else {
-        return Err(Error::InvalidInput(format!(
+        return Err(Error::data(format!(
             "trajectory {}: needs two measured positions to start the filter",
             recording.id
         )));
     };
     let gap = u32::try_from(recording.frames[i2] - recording.frames[i1])
-        .map_err(|_| Error::InvalidInput(format!("trajectory {}: first measurements too far apart", recording.id)))?;
+        .map_err(|_| Error::data(format!("trajectory {}: first measurements too far apart", recording.id)))?;
     let start = initial_belief(model.params(), m1, m2, gap, false, prior).map_err(model_error)?;
     let last = until.unwrap_or(u64::MAX);
     // One slot per camera frame after the second measurement; frames missing from the recording are
@@ -60,7 +60,7 @@ pub fn filter_recording(
         next = frame + 1;
     }
     let out = filter_belief(model, &start, &slots)
-        .map_err(|e| Error::InvalidInput(format!("trajectory {}: filter failed: {e}", recording.id)))?;
+        .map_err(|e| Error::Diverged(format!("trajectory {}: filter failed: {e}", recording.id)))?;
     let mut beliefs = vec![start];
     beliefs.extend(out.states.iter().zip(&out.covariances).zip(&out.modes).map(|((m, c), p)| BallBelief {
         mean: *m,

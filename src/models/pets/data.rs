@@ -6,7 +6,7 @@ use rand::seq::SliceRandom;
 use super::config::RewardSource;
 use crate::data::Dataset;
 use crate::error::{Error, Result};
-use crate::planning::seeding::rng_for;
+use crate::util::seeding::rng_for;
 
 /// Input features of one (state, action) pair.
 pub fn features(state: &[f64], action: &[f64], angular: &[bool], out: &mut Vec<f32>) {

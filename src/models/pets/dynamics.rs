@@ -13,7 +13,7 @@ use crate::error::{Error, Result};
 use crate::nn::activation::{fast_exp, fast_softplus};
 use crate::nn::fast::{FastEnsembleMlp, Scratch};
 use crate::nn::{Normalizer, ParamSet};
-use crate::planning::seeding::rng_for;
+use crate::util::seeding::rng_for;
 
 /// Candidates whose particles one task propagates; fixed, so the random streams (one per block) and hence the
 /// plans do not depend on the thread count.

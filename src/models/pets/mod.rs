@@ -22,22 +22,10 @@ use crate::error::{Error, Result};
 use crate::nn::Normalizer;
 use crate::run::dir::Provenance;
 use crate::run::Monitor;
-use crate::train::checkpoint::read_bounded;
 use crate::train::tensors::{to_params, TensorData};
-use crate::train::{run_training, training_layout, FitOutcome, FitSettings, OpenedCheckpoint, MODEL_FILE};
+use crate::train::{run_training, training_layout, DataFile, FitOutcome, FitSettings, OpenedCheckpoint, MODEL_FILE};
 
 pub const METHOD: &str = "pets";
-/// Datasets larger than this are refused before reading (≈ 20 M transitions of a small env).
-const MAX_DATASET_BYTES: u64 = 4 << 30;
-
-/// A dataset file as the run saw it, so `--resume` can tell when the data changed underneath.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct DataFile {
-    pub path: PathBuf,
-    pub bytes: u64,
-    pub crc32: u32,
-}
 
 /// What the model is a model of: enough to rebuild features and check an env at planning time.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -94,8 +82,7 @@ pub fn load_datasets(paths: &[PathBuf]) -> Result<(Dataset, Vec<DataFile>)> {
     let mut merged: Option<Dataset> = None;
     let mut files = Vec::new();
     for path in paths {
-        let bytes = read_bounded(path, MAX_DATASET_BYTES)?;
-        files.push(DataFile { path: path.clone(), bytes: bytes.len() as u64, crc32: crc32fast::hash(&bytes) });
+        files.push(DataFile::fingerprint(path)?);
         let mut dataset = read_dataset(path)?;
         match &mut merged {
             None => merged = Some(dataset),
@@ -201,13 +188,7 @@ pub fn resume(dir: &Path, monitor: &dyn Monitor) -> Result<TrainReport> {
     let run: PetsRun = serde_json::from_value(opened.config.clone())
         .map_err(|e| Error::bad_file(&opened.dir.file("config.json"), format!("not a PETS run config: {e}")))?;
     for file in &run.data {
-        let bytes = read_bounded(&file.path, MAX_DATASET_BYTES)?;
-        if bytes.len() as u64 != file.bytes || crc32fast::hash(&bytes) != file.crc32 {
-            return Err(Error::bad_file(
-                &file.path,
-                "changed since the run started; resuming would not continue the same run",
-            ));
-        }
+        file.verify_unchanged()?;
     }
     let request = TrainRequest {
         out: dir.to_path_buf(),

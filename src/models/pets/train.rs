@@ -11,9 +11,9 @@ use super::net::{torch_name, PetsNet, INPUT_MEAN, INPUT_STD};
 use crate::error::{Error, Result};
 use crate::nn::tensor::{scalar, tensor, training_device};
 use crate::nn::{gaussian_nll, Adam, Normalizer, ParamSet};
-use crate::planning::seeding::{derive_seed, rng_for};
 use crate::train::tensors::TensorData;
 use crate::train::{StoredTensor, TrainingMethod};
+use crate::util::seeding::{derive_seed, rng_for};
 
 const INIT_STREAM: u64 = 1;
 const BOOTSTRAP_STREAM: u64 = 2;

@@ -14,8 +14,8 @@ pub fn bidirectional<M: SuccessorModel>(
     mut on_layer: impl FnMut(&SearchStats),
 ) -> Result<SearchResult> {
     if !model.self_inverse() {
-        return Err(Error::InvalidInput(
-            "bidirectional search needs a model whose actions undo themselves; use breadth-first search".into(),
+        return Err(Error::config(
+            "bidirectional search needs a model whose actions undo themselves; use breadth-first search",
         ));
     }
     let mut stats = SearchStats { stored: 1, ..SearchStats::default() };

@@ -93,13 +93,13 @@ pub struct SearchResult {
 
 fn budget_error(stats: &SearchStats, limits: &SearchLimits) -> Option<Error> {
     if stats.stored as usize > limits.max_nodes {
-        return Some(Error::InvalidInput(format!(
+        return Some(Error::Budget(format!(
             "search stopped at depth {} after storing {} states, over the node budget of {}; raise --max-nodes",
             stats.depth, stats.stored, limits.max_nodes
         )));
     }
     if stats.peak_memory_bytes > limits.max_memory_bytes {
-        return Some(Error::InvalidInput(format!(
+        return Some(Error::Budget(format!(
             "search stopped at depth {} using about {} MiB, over the memory budget of {} MiB; raise --max-memory-mib",
             stats.depth,
             stats.peak_memory_bytes >> 20,

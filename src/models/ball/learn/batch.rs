@@ -37,7 +37,7 @@ impl Batch {
         let b = chunks.len();
         let steps = chunks.first().map_or(0, |c| c.slots.len());
         if b == 0 || chunks.iter().any(|c| c.slots.len() != steps) {
-            return Err(Error::InvalidInput("a batch needs at least one chunk, all of one length".into()));
+            return Err(Error::data("a batch needs at least one chunk, all of one length"));
         }
         let rows = |f: &dyn Fn(&Chunk) -> [f64; 3]| tensor(chunks.iter().flat_map(|c| f(c)).collect(), [b, 3], device);
         let measured: Vec<Vec<bool>> =
@@ -68,7 +68,7 @@ fn launcher_inputs(chunks: &[&Chunk], device: &Device) -> Result<LauncherInputs>
     let mut rotation = Vec::with_capacity(9 * chunks.len());
     for c in chunks {
         let side = c.side_info.ok_or_else(|| {
-            Error::InvalidInput(format!(
+            Error::data(format!(
                 "recording {} has no launcher side information; the launcher spin prior needs it on every recording",
                 c.recording
             ))

@@ -45,7 +45,7 @@ impl Chunk {
 /// All chunks of `len` frames in `recordings`, in recording and frame order.
 pub fn cut_chunks(recordings: &[Recording], len: usize, physics: &BallPhysics) -> Result<Vec<Chunk>> {
     if len < 3 {
-        return Err(Error::InvalidInput(format!("chunk length {len}: needs two frames to start and one to score")));
+        return Err(Error::config(format!("chunk length {len}: needs two frames to start and one to score")));
     }
     let mut chunks = Vec::new();
     for rec in recordings {
@@ -78,7 +78,7 @@ pub fn cut_chunks(recordings: &[Recording], len: usize, physics: &BallPhysics) -
 
 /// One entry per camera frame from the recording's first to its last frame.
 fn dense_positions(rec: &Recording) -> Result<Vec<Option<[f64; 3]>>> {
-    let bad = |message: String| Err(Error::InvalidInput(format!("recording {}: {message}", rec.id)));
+    let bad = |message: String| Err(Error::data(format!("recording {}: {message}", rec.id)));
     if rec.frames.len() != rec.positions.len() {
         return bad(format!("{} frame indices but {} positions", rec.frames.len(), rec.positions.len()));
     }

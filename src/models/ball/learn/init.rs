@@ -50,7 +50,7 @@ pub fn initial_belief(
             (mean, diag_embed(per_sample(vars)) + padded)
         }
         (Some(_), None) => {
-            return Err(Error::InvalidInput("the launcher spin prior needs a batch built with side information".into()))
+            return Err(Error::data("the launcher spin prior needs a batch built with side information"))
         }
     };
     let mean = Tensor::cat(vec![batch.m2.clone(), velocity, spin_mean, coefficients], 1);

@@ -21,6 +21,7 @@ mod filter;
 mod flight;
 mod impact;
 mod init;
+pub mod job;
 mod linalg;
 mod params;
 mod positive;
@@ -29,6 +30,7 @@ mod reference;
 mod rotation;
 mod spin_net;
 mod train;
+mod trainer;
 mod update;
 
 pub use batch::Batch;
@@ -41,6 +43,7 @@ pub use reference::{chunk_nll, reference_loss};
 pub use rotation::launch_rotation;
 pub use spin_net::{SpinNet, SpinNetWeights};
 pub use train::{train, TrainOutcome, TrainSettings};
+pub use trainer::BallEkfTrainer;
 
 #[cfg(test)]
 mod tests;

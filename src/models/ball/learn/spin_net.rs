@@ -79,9 +79,9 @@ pub struct SpinNetWeights {
 }
 
 impl SpinNetWeights {
-    fn check(&self) -> Result<()> {
+    pub fn check(&self) -> Result<()> {
         if self.w1.len() != 3 * HIDDEN || self.w2.len() != 6 * HIDDEN {
-            return Err(Error::InvalidInput(format!(
+            return Err(Error::data(format!(
                 "spin network weights: w1 has {} and w2 {} values; expected {} and {}",
                 self.w1.len(),
                 self.w2.len(),
@@ -90,7 +90,7 @@ impl SpinNetWeights {
             )));
         }
         if self.w1.iter().chain(&self.w2).any(|x| !x.is_finite()) {
-            return Err(Error::InvalidInput("spin network weights must be finite".into()));
+            return Err(Error::data("spin network weights must be finite"));
         }
         Ok(())
     }

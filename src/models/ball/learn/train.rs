@@ -1,24 +1,14 @@
 //! Fitting Ψ by maximizing log p(m_3:N | m_1, m_2) over chunks (eq. 6.24) with Adam.
 
-use burn::optim::{AdamConfig, GradientsParams};
-use rand::seq::SliceRandom;
 use serde::{Deserialize, Serialize};
 
-use super::batch::Batch;
-use super::chunks::{cut_chunks, Chunk};
-use super::device::training_device;
-use super::filter::chunk_loss;
-use super::params::BallParamsModule;
-use super::spin_net::{SpinNet, SpinNetWeights};
+use super::spin_net::SpinNetWeights;
+use super::trainer::BallEkfTrainer;
 use crate::data::ball_io::Recording;
 use crate::error::{Error, Result};
 use crate::models::ball::BallModelParams;
-use crate::planning::seeding::rng_for;
 use crate::run::Monitor;
-
-/// Random streams under the seed: one per epoch's shuffle, one for the spin network's initial weights.
-const SHUFFLE_STREAM: u64 = 0;
-const SPIN_NET_STREAM: u64 = 1;
+use crate::train::TrainingMethod;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -61,8 +51,8 @@ impl Default for TrainSettings {
 }
 
 impl TrainSettings {
-    fn validate(&self) -> Result<()> {
-        let bad = |what: String| Err(Error::InvalidInput(format!("ball EKF training settings: {what}")));
+    pub fn validate(&self) -> Result<()> {
+        let bad = |what: String| Err(Error::config(format!("ball EKF training settings: {what}")));
         if self.batch_size == 0 {
             return bad("batch_size must be at least 1".into());
         }
@@ -77,7 +67,7 @@ impl TrainSettings {
         if !(self.epsilon.is_finite() && self.epsilon > 0.0) {
             return bad(format!("epsilon {} must be finite and > 0", self.epsilon));
         }
-        self.initial.validate().map_err(|e| Error::InvalidInput(format!("initial ball-model parameters: {e}")))
+        self.initial.validate().map_err(|e| Error::config(format!("initial ball-model parameters: {e}")))
     }
 }
 
@@ -91,81 +81,27 @@ pub struct TrainOutcome {
     pub chunks: usize,
 }
 
+/// Trains in memory (no checkpoint directory): for `eval quick` and tests. `mbrl train` runs the same trainer
+/// through the shared loop with checkpoints and `--resume` ([`super::job`]).
 pub fn train(recordings: &[Recording], settings: &TrainSettings, monitor: &dyn Monitor) -> Result<TrainOutcome> {
-    settings.validate()?;
-    let physics = &settings.initial.physics;
-    let chunks = cut_chunks(recordings, settings.chunk_len, physics)?;
-    if chunks.is_empty() {
-        return Err(Error::InvalidInput(format!(
-            "no training chunks in {} recordings: a chunk needs {} consecutive frames whose first two are measured",
-            recordings.len(),
-            settings.chunk_len
-        )));
-    }
-    let device = training_device();
-    let spin_net =
-        settings.launcher_prior.then(|| SpinNet::init(&mut rng_for(settings.seed, &[SPIN_NET_STREAM]), &device));
-    let mut model = BallParamsModule::from_params(&settings.initial, spin_net, &device);
-    // burn keeps these as f32; 0.999 and 1e-8 round by less than 1e-7 relative.
-    let mut optimizer = AdamConfig::new()
-        .with_beta_1(settings.beta1 as f32)
-        .with_beta_2(settings.beta2 as f32)
-        .with_epsilon(settings.epsilon as f32)
-        .init();
-
-    let mut batches = Batches::new(chunks.len(), settings.batch_size, settings.seed);
+    let mut trainer = BallEkfTrainer::new(recordings, settings)?;
     let mut losses = Vec::with_capacity(settings.steps as usize);
     for step in 1..=settings.steps {
         if monitor.is_cancelled() {
             return Err(Error::Cancelled);
         }
-        let picked: Vec<&Chunk> = batches.next().iter().map(|&i| &chunks[i]).collect();
-        let batch = Batch::new(&picked, settings.launcher_prior, &device)?;
-        let loss = chunk_loss(&model, &batch, physics, &device)?;
-        let value: f64 = loss.clone().into_scalar();
+        let value = trainer.step(step)?;
         if !value.is_finite() {
-            return Err(Error::InvalidInput(format!(
-                "ball EKF training diverged: loss {value} at step {step} (epoch {}); the filter's covariances broke \
-                 down. Lower the learning rate or check the recordings for outliers",
-                batches.epoch
+            return Err(Error::Diverged(format!(
+                "ball EKF training diverged: loss {value} at step {step}; the filter's covariances broke down. \
+                 Lower the learning rate or check the recordings for outliers"
             )));
         }
-        let grads = GradientsParams::from_grads(loss.backward(), &model);
-        model = optimizer.step(settings.learning_rate, model, grads);
         losses.push(value);
         monitor.scalar("train/loss", step, value);
         monitor.progress("train", step, settings.steps);
     }
-    let params = model.to_params(physics);
-    params
-        .validate()
-        .map_err(|e| Error::InvalidInput(format!("ball EKF training ended with unusable parameters: {e}")))?;
-    Ok(TrainOutcome { params, spin_net: model.spin_net.as_ref().map(SpinNet::weights), losses, chunks: chunks.len() })
-}
-
-/// Consecutive slices of a seeded permutation of the chunk indices, reshuffled every epoch.
-struct Batches {
-    order: Vec<usize>,
-    cursor: usize,
-    batch_size: usize,
-    seed: u64,
-    epoch: u64,
-}
-
-impl Batches {
-    fn new(n: usize, batch_size: usize, seed: u64) -> Self {
-        Batches { order: (0..n).collect(), cursor: n, batch_size, seed, epoch: 0 }
-    }
-
-    fn next(&mut self) -> &[usize] {
-        if self.cursor >= self.order.len() {
-            self.order.sort_unstable();
-            self.order.shuffle(&mut rng_for(self.seed, &[SHUFFLE_STREAM, self.epoch]));
-            self.epoch += 1;
-            self.cursor = 0;
-        }
-        let start = self.cursor;
-        self.cursor = (start + self.batch_size).min(self.order.len());
-        &self.order[start..self.cursor]
-    }
+    let (params, spin_net) = trainer.current();
+    params.validate().map_err(|e| Error::Diverged(format!("ball EKF training ended with unusable parameters: {e}")))?;
+    Ok(TrainOutcome { params, spin_net, losses, chunks: trainer.chunk_count() })
 }

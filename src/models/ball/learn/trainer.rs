@@ -16,9 +16,9 @@ use crate::error::{Error, Result};
 use crate::models::ball::BallModelParams;
 use crate::nn::params::ParamSet;
 use crate::nn::{Adam, AdamConfig};
-use crate::planning::seeding::rng_for;
 use crate::train::tensors::TensorData;
 use crate::train::{StoredTensor, TrainingMethod};
+use crate::util::seeding::rng_for;
 
 /// Random streams under the seed: one per epoch's shuffle, one for the spin network's initial weights.
 const SHUFFLE_STREAM: u64 = 0;
@@ -118,15 +118,27 @@ impl TrainingMethod for BallEkfTrainer {
     }
 
     fn weights(&self) -> Vec<StoredTensor> {
-        self.params.tensors.iter().map(|t| StoredTensor::f64(t.name.clone(), t.shape.clone(), t.values.clone())).collect()
+        self.params
+            .tensors
+            .iter()
+            .map(|t| StoredTensor::f64(t.name.clone(), t.shape.clone(), t.values.clone()))
+            .collect()
     }
 
     fn state(&self) -> Vec<StoredTensor> {
         let mut out = Vec::with_capacity(3 * self.params.len() + 1);
         for (k, t) in self.params.tensors.iter().enumerate() {
             out.push(StoredTensor::f64(format!("live.{}", t.name), t.shape.clone(), t.values.clone()));
-            out.push(StoredTensor::f64(format!("adam.exp_avg.{}", t.name), t.shape.clone(), self.adam.exp_avg[k].clone()));
-            out.push(StoredTensor::f64(format!("adam.exp_avg_sq.{}", t.name), t.shape.clone(), self.adam.exp_avg_sq[k].clone()));
+            out.push(StoredTensor::f64(
+                format!("adam.exp_avg.{}", t.name),
+                t.shape.clone(),
+                self.adam.exp_avg[k].clone(),
+            ));
+            out.push(StoredTensor::f64(
+                format!("adam.exp_avg_sq.{}", t.name),
+                t.shape.clone(),
+                self.adam.exp_avg_sq[k].clone(),
+            ));
         }
         out.push(StoredTensor::f64("adam.step", vec![1], vec![self.adam.step as f64]));
         out

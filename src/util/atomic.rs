@@ -77,7 +77,7 @@ mod tests {
         let target = dir.path().join("out.txt");
         let result = write_atomic(&target, |w| {
             w.write_all(b"half").unwrap();
-            Err(Error::InvalidInput("stop".into()))
+            Err(Error::data("stop"))
         });
         assert!(result.is_err());
         assert!(!target.exists());

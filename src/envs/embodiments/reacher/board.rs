@@ -1,0 +1,104 @@
+//! The arm as a board manipulator: the board frame in the arm's plane, observations, the reset distribution,
+//! action repeat and the push rule of the authors' SEADS environment.
+
+use std::f64::consts::TAU;
+
+use rand::Rng;
+use rand_chacha::ChaCha8Rng;
+
+use super::{Reacher, ACTION_REPEAT, BOARD_HALF_EXTENT, PUSH_THRESHOLD, SKILL_STEP_LIMIT, TIMESTEP, WRIST_LIMIT};
+use crate::envs::embodiments::manipulator::{BoardPoint, Manipulator};
+
+/// Arm plane → board coordinates. Arm +x is board x (columns); arm +y is board *up*, so rows (board y)
+/// count downwards. (The authors' code uses (y + 0.15)/0.3 for rows, the mirror image; the arm is
+/// mirror-symmetric and its reset distribution too, so this only relabels the board.)
+pub fn arm_to_board(p: [f64; 2]) -> BoardPoint {
+    let extent = 2.0 * BOARD_HALF_EXTENT;
+    [(p[0] + BOARD_HALF_EXTENT) / extent, (BOARD_HALF_EXTENT - p[1]) / extent]
+}
+
+/// Inverse of [`arm_to_board`].
+pub fn board_to_arm(b: BoardPoint) -> [f64; 2] {
+    let extent = 2.0 * BOARD_HALF_EXTENT;
+    [b[0] * extent - BOARD_HALF_EXTENT, BOARD_HALF_EXTENT - b[1] * extent]
+}
+
+impl Manipulator for Reacher {
+    fn name(&self) -> &'static str {
+        "reacher"
+    }
+
+    fn action_low(&self) -> Vec<f64> {
+        vec![-1.0; 3]
+    }
+
+    fn action_high(&self) -> Vec<f64> {
+        vec![1.0; 3]
+    }
+
+    /// dm_control's reacher observes the joint positions and velocities (and the vector to its target);
+    /// here the angles are given as cos/sin (the shoulder is unbounded), followed by the velocities and
+    /// the finger's board position, which takes the target's place.
+    fn obs_names(&self) -> Vec<&'static str> {
+        vec![
+            "shoulder_cos",
+            "shoulder_sin",
+            "wrist_cos",
+            "wrist_sin",
+            "shoulder_velocity",
+            "wrist_velocity",
+            "finger_x",
+            "finger_y",
+        ]
+    }
+
+    fn observe(&self) -> Vec<f64> {
+        let (s1, c1) = self.q[0].sin_cos();
+        let (s2, c2) = self.q[1].sin_cos();
+        let f = self.effector();
+        vec![c1, s1, c2, s2, self.v[0], self.v[1], f[0], f[1]]
+    }
+
+    /// [shoulder angle, wrist angle, shoulder velocity, wrist velocity].
+    fn state(&self) -> Vec<f64> {
+        vec![self.q[0], self.q[1], self.v[0], self.v[1]]
+    }
+
+    fn set_state(&mut self, state: &[f64]) {
+        self.q = [state[0], state[1]];
+        self.v = [state[2], state[3]];
+    }
+
+    /// Both angles U(0, 2π), zero velocity (authors' code). MuJoCo keeps the raw wrist sample and its
+    /// soft limit then drives a wrist beyond +160° (56 % of the draws, the raw value lies in (160°, 360°))
+    /// back to +160° within the first few physics steps; we clamp right away, which ends in the same
+    /// place without the transient.
+    fn reset(&mut self, rng: &mut ChaCha8Rng) {
+        let shoulder = rng.random_range(0.0..TAU);
+        let wrist: f64 = rng.random_range(0.0..TAU);
+        self.q = [shoulder, wrist.min(WRIST_LIMIT)];
+        self.v = [0.0, 0.0];
+    }
+
+    fn step(&mut self, action: &[f64]) -> Option<BoardPoint> {
+        for _ in 0..ACTION_REPEAT {
+            self.physics_step([action[0], action[1]]);
+        }
+        let finger = self.effector();
+        let on_board = finger.iter().all(|c| (0.0..=1.0).contains(c));
+        (action[2] > PUSH_THRESHOLD && on_board).then_some(finger)
+    }
+
+    /// The finger in board coordinates.
+    fn effector(&self) -> BoardPoint {
+        arm_to_board(self.finger())
+    }
+
+    fn skill_step_limit(&self) -> usize {
+        SKILL_STEP_LIMIT
+    }
+
+    fn dt(&self) -> f64 {
+        TIMESTEP * ACTION_REPEAT as f64
+    }
+}
