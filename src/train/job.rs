@@ -67,15 +67,18 @@ fn config_bytes(config: &serde_json::Value) -> Result<Vec<u8>> {
     Ok(bytes)
 }
 
-/// The live-view layout of a training run: loss curves, train and validation together.
-pub fn training_layout(title: &str) -> Event {
-    Event::Layout {
-        title: title.to_string(),
-        panels: vec![crate::run::PanelSpec {
-            title: "loss".into(),
-            x_label: "step".into(),
-            series: vec!["train/loss".into(), "valid/loss".into()],
-            restart_on_rewind: false,
-        }],
+/// The live-view layout of a training run. The view always charts one picked metric (train/loss first);
+/// `panels` adds what belongs beside it, such as the validation loss on its own scale.
+pub fn training_layout(title: &str, panels: Vec<crate::run::PanelSpec>) -> Event {
+    Event::Layout { title: title.to_string(), panels }
+}
+
+/// The validation panel of methods that hold data back.
+pub fn validation_panel(title: &str) -> crate::run::PanelSpec {
+    crate::run::PanelSpec {
+        title: title.into(),
+        x_label: "step".into(),
+        series: vec!["valid/loss".into()],
+        restart_on_rewind: false,
     }
 }

@@ -65,7 +65,7 @@ pub fn train_checkpointed(request: &BallTrainRequest, resume: bool, monitor: &dy
         checkpoint_every: CHECKPOINT_EVERY,
     };
     let config = serde_json::to_value(&run).map_err(|e| Error::config(e.to_string()))?;
-    let layout = training_layout("train ball EKF (negative log-likelihood per measurement)");
+    let layout = training_layout("train ball EKF (negative log-likelihood per measurement)", Vec::new());
     let outcome = run_training(&request.out, &config, &settings, &mut trainer, resume, &layout, monitor)?;
     let (params, spin_net) = trainer.current();
     params.validate().map_err(|e| Error::Diverged(format!("ball EKF training ended with unusable parameters: {e}")))?;
