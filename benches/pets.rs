@@ -29,7 +29,7 @@ fn transitions(n: usize) -> Transitions {
     let mut rng = ChaCha8Rng::seed_from_u64(1);
     let mut t = Transitions { input_dim: feature_dim(&ANGULAR, 1), target_dim: 2, ..Default::default() };
     for _ in 0..n {
-        let s = [rng.random_range(-3.14..3.14), rng.random_range(-8.0..8.0)];
+        let s = [rng.random_range(-std::f64::consts::PI..std::f64::consts::PI), rng.random_range(-8.0..8.0)];
         features(&s, &[rng.random_range(-2.0..2.0)], &ANGULAR, &mut t.inputs);
         t.targets.extend([rng.random_range(-0.4f32..0.4), rng.random_range(-1.0f32..1.0)]);
     }

@@ -21,7 +21,7 @@ impl Normalizer {
 
     /// Fits on `rows` (each `dim` long, row-major), in f64 so large datasets do not lose precision.
     pub fn fit(rows: &[f32], dim: usize) -> Result<Self> {
-        if dim == 0 || rows.is_empty() || rows.len() % dim != 0 {
+        if dim == 0 || rows.is_empty() || !rows.len().is_multiple_of(dim) {
             return Err(Error::data(format!("normalizer: {} values do not form rows of {dim}", rows.len())));
         }
         let n = (rows.len() / dim) as f64;

@@ -36,11 +36,7 @@ pub struct Transitions {
 
 impl Transitions {
     pub fn len(&self) -> usize {
-        if self.input_dim == 0 {
-            0
-        } else {
-            self.inputs.len() / self.input_dim
-        }
+        self.inputs.len().checked_div(self.input_dim).unwrap_or(0)
     }
 
     pub fn is_empty(&self) -> bool {

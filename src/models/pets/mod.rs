@@ -23,7 +23,9 @@ use crate::nn::Normalizer;
 use crate::run::dir::Provenance;
 use crate::run::Monitor;
 use crate::train::tensors::{to_params, TensorData};
-use crate::train::{run_training, training_layout, validation_panel, DataFile, FitOutcome, FitSettings, OpenedCheckpoint, MODEL_FILE};
+use crate::train::{
+    run_training, training_layout, validation_panel, DataFile, FitOutcome, FitSettings, OpenedCheckpoint, MODEL_FILE,
+};
 
 pub const METHOD: &str = "pets";
 
@@ -177,8 +179,15 @@ pub fn train(request: &TrainRequest, resume: bool, monitor: &dyn Monitor) -> Res
         "train PETS on {} ({} transitions, ensemble of {})",
         run.env, run.transitions.train, request.config.ensemble
     );
-    let outcome =
-        run_training(&request.out, &config, &settings, &mut trainer, resume, &training_layout(&title, vec![validation_panel("validation MSE of the mean prediction (held-out rollouts)")]), monitor)?;
+    let outcome = run_training(
+        &request.out,
+        &config,
+        &settings,
+        &mut trainer,
+        resume,
+        &training_layout(&title, vec![validation_panel("validation MSE of the mean prediction (held-out rollouts)")]),
+        monitor,
+    )?;
     Ok(TrainReport { run, outcome, parameters })
 }
 
