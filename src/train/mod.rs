@@ -6,6 +6,7 @@ pub mod config;
 pub mod data_file;
 pub mod fit;
 pub mod job;
+pub mod state;
 pub mod tensors;
 
 pub use checkpoint::{CheckpointDir, Manifest};

@@ -48,10 +48,6 @@ impl StoredTensor {
     }
 }
 
-pub fn from_params(params: &ParamSet) -> Vec<StoredTensor> {
-    params.tensors.iter().map(|t| StoredTensor::f32(t.name.clone(), t.shape.clone(), t.values.clone())).collect()
-}
-
 /// Serializes tensors (names must be unique) to safetensors bytes.
 pub fn to_bytes(tensors: &[StoredTensor]) -> Result<Vec<u8>> {
     let raw: Vec<(String, Dtype, Vec<usize>, Vec<u8>)> = tensors

@@ -11,8 +11,7 @@ use super::net::{torch_name, PetsNet, INPUT_MEAN, INPUT_STD};
 use crate::error::{Error, Result};
 use crate::nn::tensor::{scalar, tensor, training_device};
 use crate::nn::{gaussian_nll, Adam, Normalizer, ParamSet};
-use crate::train::tensors::TensorData;
-use crate::train::{StoredTensor, TrainingMethod};
+use crate::train::{state, StoredTensor, TrainingMethod};
 use crate::util::seeding::{derive_seed, rng_for};
 
 const INIT_STREAM: u64 = 1;
@@ -124,7 +123,7 @@ impl TrainingMethod for PetsTrainer {
     }
 
     fn weights(&self) -> Vec<StoredTensor> {
-        let mut out = crate::train::tensors::from_params(&self.params);
+        let mut out = state::weights(&self.params);
         let d = self.normalizer.dim();
         out.push(StoredTensor::f32(INPUT_MEAN, vec![d], self.normalizer.mean.clone()));
         out.push(StoredTensor::f32(INPUT_STD, vec![d], self.normalizer.std.clone()));
@@ -132,51 +131,11 @@ impl TrainingMethod for PetsTrainer {
     }
 
     fn state(&self) -> Vec<StoredTensor> {
-        let mut out = Vec::with_capacity(3 * self.params.len() + 1);
-        for (k, t) in self.params.tensors.iter().enumerate() {
-            out.push(StoredTensor::f32(format!("live.{}", t.name), t.shape.clone(), t.values.clone()));
-            out.push(StoredTensor::f32(
-                format!("adam.exp_avg.{}", t.name),
-                t.shape.clone(),
-                self.adam.exp_avg[k].clone(),
-            ));
-            out.push(StoredTensor::f32(
-                format!("adam.exp_avg_sq.{}", t.name),
-                t.shape.clone(),
-                self.adam.exp_avg_sq[k].clone(),
-            ));
-        }
-        out.push(StoredTensor::f64("adam.step", vec![1], vec![self.adam.step as f64]));
-        out
+        state::save(&self.params, &self.adam)
     }
 
-    fn restore(&mut self, state: &[StoredTensor]) -> Result<()> {
-        let find = |name: &str| -> Result<&Vec<f32>> {
-            match state.iter().find(|t| t.name == name).map(|t| &t.data) {
-                Some(TensorData::F32(v)) => Ok(v),
-                _ => Err(Error::config(format!("training state lacks the f32 tensor '{name}'"))),
-            }
-        };
-        for k in 0..self.params.len() {
-            let name = self.params.tensors[k].name.clone();
-            let n = self.params.tensors[k].values.len();
-            let (live, m, v) = (
-                find(&format!("live.{name}"))?,
-                find(&format!("adam.exp_avg.{name}"))?,
-                find(&format!("adam.exp_avg_sq.{name}"))?,
-            );
-            if live.len() != n || m.len() != n || v.len() != n {
-                return Err(Error::config(format!("training state: '{name}' has the wrong size")));
-            }
-            self.params.tensors[k].values = live.clone();
-            self.adam.exp_avg[k] = m.clone();
-            self.adam.exp_avg_sq[k] = v.clone();
-        }
-        let step = match state.iter().find(|t| t.name == "adam.step").map(|t| &t.data) {
-            Some(TensorData::F64(v)) if v.len() == 1 && v[0] >= 0.0 && v[0].fract() == 0.0 => v[0] as u64,
-            _ => return Err(Error::config("training state lacks a valid 'adam.step'")),
-        };
-        self.adam.step = step;
+    fn restore(&mut self, saved: &[StoredTensor]) -> Result<()> {
+        state::restore(saved, &mut self.params, &mut self.adam)?;
         self.load_params()
     }
 }

@@ -16,8 +16,7 @@ use crate::error::{Error, Result};
 use crate::models::ball::BallModelParams;
 use crate::nn::params::ParamSet;
 use crate::nn::{Adam, AdamConfig};
-use crate::train::tensors::TensorData;
-use crate::train::{StoredTensor, TrainingMethod};
+use crate::train::{state, StoredTensor, TrainingMethod};
 use crate::util::seeding::rng_for;
 
 /// Random streams under the seed: one per epoch's shuffle, one for the spin network's initial weights.
@@ -118,50 +117,15 @@ impl TrainingMethod for BallEkfTrainer {
     }
 
     fn weights(&self) -> Vec<StoredTensor> {
-        self.params
-            .tensors
-            .iter()
-            .map(|t| StoredTensor::f64(t.name.clone(), t.shape.clone(), t.values.clone()))
-            .collect()
+        state::weights(&self.params)
     }
 
     fn state(&self) -> Vec<StoredTensor> {
-        let mut out = Vec::with_capacity(3 * self.params.len() + 1);
-        for (k, t) in self.params.tensors.iter().enumerate() {
-            out.push(StoredTensor::f64(format!("live.{}", t.name), t.shape.clone(), t.values.clone()));
-            out.push(StoredTensor::f64(
-                format!("adam.exp_avg.{}", t.name),
-                t.shape.clone(),
-                self.adam.exp_avg[k].clone(),
-            ));
-            out.push(StoredTensor::f64(
-                format!("adam.exp_avg_sq.{}", t.name),
-                t.shape.clone(),
-                self.adam.exp_avg_sq[k].clone(),
-            ));
-        }
-        out.push(StoredTensor::f64("adam.step", vec![1], vec![self.adam.step as f64]));
-        out
+        state::save(&self.params, &self.adam)
     }
 
-    fn restore(&mut self, state: &[StoredTensor]) -> Result<()> {
-        let find = |name: &str, n: usize| -> Result<Vec<f64>> {
-            match state.iter().find(|t| t.name == name).map(|t| &t.data) {
-                Some(TensorData::F64(v)) if v.len() == n => Ok(v.clone()),
-                _ => Err(Error::config(format!("training state lacks the f64 tensor '{name}' with {n} values"))),
-            }
-        };
-        for k in 0..self.params.len() {
-            let (name, n) = (self.params.tensors[k].name.clone(), self.params.tensors[k].values.len());
-            self.params.tensors[k].values = find(&format!("live.{name}"), n)?;
-            self.adam.exp_avg[k] = find(&format!("adam.exp_avg.{name}"), n)?;
-            self.adam.exp_avg_sq[k] = find(&format!("adam.exp_avg_sq.{name}"), n)?;
-        }
-        let step = find("adam.step", 1)?[0];
-        if !(step >= 0.0 && step.fract() == 0.0) {
-            return Err(Error::config("training state: 'adam.step' is not a count"));
-        }
-        self.adam.step = step as u64;
+    fn restore(&mut self, saved: &[StoredTensor]) -> Result<()> {
+        state::restore(saved, &mut self.params, &mut self.adam)?;
         self.load()
     }
 
