@@ -172,17 +172,15 @@ fn pets_config(args: &TrainArgs) -> anyhow::Result<PetsConfig> {
 fn train_pets(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
     let mut config = pets_config(&args)?;
     let first = args.data.first().context("--data is required")?;
-    if args.reward.is_none() && args.config.is_none() {
-        // Default to the closed form where the env has one: peek at the dataset's env.
-        let env = args.env.clone().map(Ok).unwrap_or_else(|| mbrl::data::read_dataset(first).map(|d| d.meta.env))?;
-        if mbrl::envs::parse_env(&env)?.known_reward().is_none() {
-            config.reward = RewardSource::Learned;
-        }
+    // The env names the default output and decides the default reward; without --env it is the dataset's.
+    let env = match &args.env {
+        Some(env) => env.clone(),
+        None => mbrl::data::read_dataset(first)?.meta.env,
+    };
+    if args.reward.is_none() && args.config.is_none() && mbrl::envs::parse_env(&env)?.known_reward().is_none() {
+        config.reward = RewardSource::Learned;
     }
-    let out = args.out.clone().unwrap_or_else(|| {
-        let env = args.env.as_deref().map(file_stem).unwrap_or_else(|| "model".into());
-        PathBuf::from(format!("models/pets-{env}"))
-    });
+    let out = args.out.clone().unwrap_or_else(|| PathBuf::from(format!("models/pets-{}", file_stem(&env))));
     let request = pets::TrainRequest {
         out: out.clone(),
         data: args.data.clone(),

@@ -166,3 +166,72 @@ fn save(
         files,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::run::NullMonitor;
+    use crate::train::tensors::{parse, TensorData};
+
+    /// One weight that counts the steps; validation loss |w − 3|, NaN training loss from `nan_at` on.
+    struct Counter {
+        w: f32,
+        nan_at: u64,
+    }
+
+    impl TrainingMethod for Counter {
+        fn step(&mut self, step: u64) -> Result<f64> {
+            self.w += 1.0;
+            Ok(if step >= self.nan_at { f64::NAN } else { 1.0 / step as f64 })
+        }
+
+        fn validate(&mut self) -> Result<Option<f64>> {
+            Ok(Some((self.w as f64 - 3.0).abs()))
+        }
+
+        fn weights(&self) -> Vec<StoredTensor> {
+            vec![StoredTensor::f32("w", vec![1], vec![self.w])]
+        }
+
+        fn state(&self) -> Vec<StoredTensor> {
+            self.weights()
+        }
+
+        fn restore(&mut self, state: &[StoredTensor]) -> Result<()> {
+            if let TensorData::F32(v) = &state[0].data {
+                self.w = v[0];
+            }
+            Ok(())
+        }
+    }
+
+    fn run(nan_at: u64, dir: &std::path::Path) -> Result<FitOutcome> {
+        let settings =
+            FitSettings { method: "counter".into(), env: None, total_steps: 8, validate_every: 1, checkpoint_every: 2 };
+        let ckpt = CheckpointDir::start(dir)?;
+        let entry = ckpt.write_file(CONFIG_FILE, b"{}")?;
+        let metrics = JsonlMonitor::create(&dir.join("metrics.jsonl")).unwrap();
+        fit(&mut Counter { w: 0.0, nan_at }, &settings, &ckpt, &entry, None, &metrics, &NullMonitor)
+    }
+
+    #[test]
+    fn the_saved_model_is_the_best_validation_snapshot_not_the_live_weights() {
+        let dir = tempfile::tempdir().unwrap();
+        let outcome = run(u64::MAX, dir.path()).unwrap();
+        assert_eq!((outcome.best_step, outcome.best_valid_loss), (Some(3), Some(0.0)));
+        let saved = parse(&dir.path().join(MODEL_FILE), &std::fs::read(dir.path().join(MODEL_FILE)).unwrap()).unwrap();
+        assert_eq!(saved[0].data, TensorData::F32(vec![3.0]), "live weights ended at 8");
+    }
+
+    #[test]
+    fn divergence_is_a_typed_error_that_names_the_intact_checkpoint() {
+        let dir = tempfile::tempdir().unwrap();
+        let err = run(5, dir.path()).err().unwrap();
+        let text = err.to_string();
+        assert!(matches!(err, Error::Diverged(_)), "{text}");
+        assert!(text.contains("step 5") && text.contains("step 4"), "{text}");
+        let manifest: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(dir.path().join("checkpoint.json")).unwrap()).unwrap();
+        assert_eq!((manifest["step"].as_u64(), manifest["complete"].as_bool()), (Some(4), Some(false)));
+    }
+}
