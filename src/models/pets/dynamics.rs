@@ -295,3 +295,66 @@ impl BatchDynamics for PetsDynamics {
         self.label.clone()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use rand::SeedableRng;
+    use rand_chacha::ChaCha8Rng;
+
+    use super::*;
+    use crate::envs::pendulum::dynamics::PendulumReward;
+    use crate::models::pets::config::Preset;
+    use crate::models::pets::net::{torch_name, PetsNet};
+    use crate::nn::tensor::inference_device;
+
+    fn model(propagation: Propagation) -> PetsDynamics {
+        let mut config = PetsConfig::preset(Preset::Small);
+        config.hidden_units = 8;
+        let net = PetsNet::init(&config, 4, 2, &inference_device(), &mut ChaCha8Rng::seed_from_u64(1));
+        let weights = ParamSet::<f32>::from_module(&net, torch_name);
+        let reward = Box::new(PendulumReward { max_torque: 2.0 });
+        PetsDynamics::new(
+            &config,
+            &weights,
+            Normalizer::identity(4),
+            vec![true, false],
+            1,
+            Some(reward),
+            propagation,
+            6,
+        )
+        .unwrap()
+    }
+
+    fn returns(m: &PetsDynamics, seed: u64, threads: usize) -> Vec<f64> {
+        let actions: Vec<f64> = (0..100 * 7).map(|k| ((k as f64) * 0.37).sin() * 2.0).collect();
+        let mut out = vec![0.0; 100];
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| m.rollout(&[3.0, 0.1], &actions, 7, seed, &mut out, None));
+        out
+    }
+
+    #[test]
+    fn rollouts_depend_on_the_seed_and_not_on_the_thread_count() {
+        for propagation in [Propagation::Ts1, Propagation::TsInf] {
+            let m = model(propagation);
+            assert_eq!(returns(&m, 4, 1), returns(&m, 4, 3), "{propagation:?}");
+            assert_ne!(returns(&m, 4, 2), returns(&m, 5, 2), "{propagation:?}: particles must be sampled");
+        }
+        let mean = model(Propagation::Expectation);
+        assert_eq!(returns(&mean, 4, 2), returns(&mean, 5, 2), "expectation draws nothing");
+    }
+
+    #[test]
+    fn predicted_states_average_the_particles_and_returns_match_without_them() {
+        let m = model(Propagation::TsInf);
+        let actions = vec![0.5; 3 * 4];
+        let (mut a, mut b) = (vec![0.0; 3], vec![0.0; 3]);
+        let mut states = vec![0.0; 3 * 4 * 2];
+        m.rollout(&[1.0, 0.0], &actions, 4, 9, &mut a, Some(&mut states));
+        m.rollout(&[1.0, 0.0], &actions, 4, 9, &mut b, None);
+        assert_eq!(a, b);
+        assert!(states.iter().all(|x| x.is_finite()) && states[0] != 1.0);
+        assert!(a.iter().all(|r| r.is_finite() && *r < 0.0));
+    }
+}
