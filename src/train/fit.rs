@@ -81,7 +81,7 @@ pub fn fit(
     let every = |n: u64| n.max(1);
     let (start, mut best) = match resume {
         Some(r) => (r.step, Best { step: r.best_step, loss: r.best_valid_loss, weights: r.best_weights }),
-        None => (0, Best { step: None, loss: None, weights: method.weights() }),
+        None => (0, Best { step: None, loss: None, weights: Vec::new() }),
     };
     let mut last_checkpoint = start;
     let mut last_loss = None;
@@ -105,8 +105,6 @@ pub fn fit(
                 if best.loss.is_none_or(|b| valid < b) {
                     best = Best { step: Some(step), loss: Some(valid), weights: method.weights() };
                 }
-            } else {
-                best.weights = method.weights();
             }
         }
         monitor.progress("train", step, settings.total_steps);
@@ -146,7 +144,9 @@ fn save(
 ) -> Result<()> {
     let mut files = BTreeMap::new();
     files.insert(CONFIG_FILE.to_string(), config_entry.clone());
-    files.insert(MODEL_FILE.to_string(), dir.write_file(MODEL_FILE, &to_bytes(&best.weights)?)?);
+    // A method that has not validated yet (or never does) saves its live weights.
+    let weights = if best.step.is_some() { to_bytes(&best.weights)? } else { to_bytes(&method.weights())? };
+    files.insert(MODEL_FILE.to_string(), dir.write_file(MODEL_FILE, &weights)?);
     files.insert(STATE_FILE.to_string(), dir.write_file(STATE_FILE, &to_bytes(&method.state())?)?);
     for (name, bytes) in method.artifacts()? {
         let entry = dir.write_file(&name, &bytes)?;
