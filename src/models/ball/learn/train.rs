@@ -7,6 +7,7 @@ use super::trainer::BallEkfTrainer;
 use crate::data::ball_io::Recording;
 use crate::error::{Error, Result};
 use crate::models::ball::BallModelParams;
+use crate::nn::AdamConfig;
 use crate::run::Monitor;
 use crate::train::TrainingMethod;
 
@@ -51,22 +52,24 @@ impl Default for TrainSettings {
 }
 
 impl TrainSettings {
+    /// The thesis' Adam: no weight decay, no clipping.
+    pub fn optimizer(&self) -> AdamConfig {
+        AdamConfig {
+            learning_rate: self.learning_rate,
+            beta1: self.beta1,
+            beta2: self.beta2,
+            epsilon: self.epsilon,
+            weight_decay: 0.0,
+            clip_grad_norm: None,
+        }
+    }
+
     pub fn validate(&self) -> Result<()> {
         let bad = |what: String| Err(Error::config(format!("ball EKF training settings: {what}")));
         if self.batch_size == 0 {
             return bad("batch_size must be at least 1".into());
         }
-        if !(self.learning_rate.is_finite() && self.learning_rate > 0.0) {
-            return bad(format!("learning_rate {} must be finite and > 0", self.learning_rate));
-        }
-        for (name, beta) in [("beta1", self.beta1), ("beta2", self.beta2)] {
-            if !(0.0..1.0).contains(&beta) {
-                return bad(format!("{name} {beta} must lie in [0, 1)"));
-            }
-        }
-        if !(self.epsilon.is_finite() && self.epsilon > 0.0) {
-            return bad(format!("epsilon {} must be finite and > 0", self.epsilon));
-        }
+        self.optimizer().validate().map_err(|e| Error::config(format!("ball EKF training settings: {e}")))?;
         self.initial.validate().map_err(|e| Error::config(format!("initial ball-model parameters: {e}")))
     }
 }

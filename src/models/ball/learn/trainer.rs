@@ -15,7 +15,7 @@ use crate::data::ball_io::Recording;
 use crate::error::{Error, Result};
 use crate::models::ball::BallModelParams;
 use crate::nn::params::ParamSet;
-use crate::nn::{Adam, AdamConfig};
+use crate::nn::Adam;
 use crate::train::{state, StoredTensor, TrainingMethod};
 use crate::util::seeding::rng_for;
 
@@ -49,17 +49,7 @@ impl BallEkfTrainer {
         let module = BallParamsModule::from_params(&settings.initial, spin_net, &device);
         let params = ParamSet::<f64>::from_module(&module, |p| p.to_string());
         let sizes: Vec<usize> = params.tensors.iter().map(|t| t.values.len()).collect();
-        let adam = Adam::new(
-            AdamConfig {
-                learning_rate: settings.learning_rate,
-                beta1: settings.beta1,
-                beta2: settings.beta2,
-                epsilon: settings.epsilon,
-                weight_decay: 0.0,
-                clip_grad_norm: None,
-            },
-            &sizes,
-        );
+        let adam = Adam::new(settings.optimizer(), &sizes);
         Ok(BallEkfTrainer { settings: settings.clone(), device, module: Some(module), params, adam, chunks })
     }
 
