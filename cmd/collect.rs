@@ -1,14 +1,17 @@
 //! `mbrl collect`: roll out a behaviour policy in a simulator and save the dataset as MCAP.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::bail;
 use clap::{Args, ValueEnum};
+use mbrl::data::actions_csv::read_actions;
 use mbrl::data::ball_io::write_ball_dataset;
 use mbrl::data::boardset::{write_board_set, BoardSet};
-use mbrl::data::collect::{collect_random, CollectSettings};
+use mbrl::data::collect::{
+    collect_instance_pairs, collect_random, parse_state, replay, CollectSettings, InstancePairSettings, ReplaySettings,
+};
 use mbrl::data::collect_ball::{collect_ball, BallCollectSettings};
-use mbrl::data::write_dataset;
+use mbrl::data::{write_dataset, Dataset};
 use mbrl::envs::ball::Orientation;
 use mbrl::envs::boards::depth::{DenseIndex, DepthTable};
 use mbrl::envs::boards::sets::board_set;
@@ -29,28 +32,52 @@ pub enum Policy {
 Examples:
   mbrl collect --env pendulum --rollouts 500 --steps 30 --out datasets/pendulum.mcap
   mbrl collect --env pendulum:quadrant --rollouts 100 --steps 50 --seed 3
+  mbrl collect --env toy:inner --instances 5000 --steps 100 --out datasets/toy-inner-train.mcap
+  mbrl collect --env mountaincar --instances 1000 --steps 100 --seed 1
+  mbrl collect --env pendulum --actions actions.csv --init-state 3.14,0 --out datasets/replay.mcap
+  mbrl collect --env mountaincar --actions actions.csv --instance-seed 7 --seed 2
   mbrl collect --env lightsout --boards --max-depth 5 --split test --out datasets/lightsout-test.mcap
   mbrl collect --env ball --trajectories 100 --augment-rotations 19 --out datasets/ball-train.mcap
   mbrl collect --env ball --trajectories 30 --orientation unseen-3 --out datasets/ball-unseen-3.mcap
 
-Start states: θ ~ U[-π, π], θ̇ ~ U[-8, 8]; actions ~ U[-2, 2]. Parametrized variants
-(pendulum:quadrant) draw a new instance per rollout; its parameters go into the metadata.
+Start states: θ ~ U[-π, π], θ̇ ~ U[-8, 8] (pendulum); s ~ N(0, I) (toy); x ~ U[-0.8, 0.8],
+ẋ ~ U[-2, 2] (mountaincar). Actions uniform in the env's bounds. Parametrized envs (pendulum:quadrant,
+toy:*, mountaincar) draw a new instance per rollout, or per pair with --instances (rollouts 2k and 2k+1
+share instance k); the parameters go into the metadata.
+--actions replays a CSV (one row per step, one column per action dimension, optional header) from
+--init-state or a reset state drawn from --seed, in the instance --instance-seed names (default: --seed);
+actions beyond the bounds are clipped by the env.
 Board sets (lightsout 5x5, tileswap) hold every board of depth 1..D with its train/test split.
 Ball shots: launcher settings drawn as in thesis 6.5.1, 180 Hz camera with ~1 mm noise and dropouts.")]
 pub struct CollectArgs {
-    /// Environment: pendulum[:light|heavy|mass=<m>|inverted|quadrant].
+    /// Environment: pendulum[:light|heavy|mass=<m>|inverted|quadrant], toy:inner|outer, mountaincar, lightsout,
+    /// tileswap, ball.
     #[arg(long)]
     env: String,
-    /// Number of rollouts.
+    /// Number of rollouts, each in its own instance of a parametrized env.
     #[arg(long, default_value_t = 100)]
     rollouts: usize,
+    /// Instead of --rollouts: N instances with two rollouts each (ids 2k, 2k+1), for context models.
+    #[arg(long, value_name = "N", conflicts_with = "rollouts")]
+    instances: Option<usize>,
+    /// Replay these actions (CSV: one row per step, one column per action dimension) instead of random ones.
+    #[arg(long, value_name = "CSV", conflicts_with_all = ["rollouts", "instances", "steps", "trajectories", "boards"])]
+    actions: Option<PathBuf>,
+    /// With --actions: the start state, comma-separated (pendulum: θ,θ̇; toy: s1,s2; mountaincar: x,ẋ).
+    #[arg(long, value_name = "X1,X2,…", requires = "actions", allow_hyphen_values = true)]
+    init_state: Option<String>,
+    /// With --actions: which instance of a parametrized env (default: --seed); the same seed names the same
+    /// instance in every subcommand.
+    #[arg(long, value_name = "S", requires = "actions")]
+    instance_seed: Option<u64>,
     /// Steps per rollout.
     #[arg(long, default_value_t = 30)]
     steps: usize,
     /// Behaviour policy.
     #[arg(long, value_enum, default_value_t = Policy::Random)]
     policy: Policy,
-    /// Output file (default: datasets/<env>-random.mcap, or datasets/<game>-boards-d<D>.mcap).
+    /// Output file (default: datasets/<env>-random.mcap, <env>-pairs.mcap, <env>-replay.mcap, or
+    /// <game>-boards-d<D>.mcap).
     #[arg(long)]
     out: Option<PathBuf>,
     /// For the ball: number of simulated shots (each with exactly one table bounce).
@@ -93,29 +120,68 @@ pub fn run(global: &GlobalArgs, args: CollectArgs) -> anyhow::Result<()> {
     if args.boards {
         bail!("--boards is for board games (lightsout, tileswap), not '{}'", env.canonical());
     }
-    let out =
-        args.out.unwrap_or_else(|| PathBuf::from(format!("datasets/{}-random.mcap", file_stem(&env.canonical()))));
-    let settings = CollectSettings {
-        env,
-        rollouts: args.rollouts,
-        steps: args.steps,
-        seed: global.seed,
-        command_line: command_line(),
-    };
+    if let Some(actions) = &args.actions {
+        return replay_actions(global, env, actions, &args);
+    }
+    let mode = if args.instances.is_some() { "pairs" } else { "random" };
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(format!("datasets/{}-{mode}.mcap", file_stem(&env.canonical()))));
     let dataset = run_job(global, "collect", |monitor| {
-        let data = match args.policy {
-            Policy::Random => collect_random(&settings, monitor)?,
+        let data = match (args.instances, args.policy) {
+            (Some(instances), Policy::Random) => {
+                let settings = InstancePairSettings {
+                    env,
+                    instances,
+                    steps: args.steps,
+                    seed: global.seed,
+                    command_line: command_line(),
+                };
+                collect_instance_pairs(&settings, monitor)?
+            }
+            (None, Policy::Random) => {
+                let settings = CollectSettings {
+                    env,
+                    rollouts: args.rollouts,
+                    steps: args.steps,
+                    seed: global.seed,
+                    command_line: command_line(),
+                };
+                collect_random(&settings, monitor)?
+            }
         };
         write_dataset(&out, &data)?;
         Ok(data)
     })?;
-    println!(
-        "wrote {} transitions in {} rollouts of {} to {}",
-        dataset.steps.len(),
-        args.rollouts,
-        dataset.meta.env,
-        out.display()
-    );
+    let rollouts = dataset.meta.instances.len();
+    let grouping = match args.instances {
+        Some(n) => format!("{rollouts} rollouts ({n} instance pairs)"),
+        None => format!("{rollouts} rollouts"),
+    };
+    println!("wrote {} transitions in {grouping} of {} to {}", dataset.steps.len(), dataset.meta.env, out.display());
+    Ok(())
+}
+
+fn replay_actions(global: &GlobalArgs, env: EnvName, actions: &Path, args: &CollectArgs) -> anyhow::Result<()> {
+    let spec = env.build()?.spec();
+    let init_state = args.init_state.as_deref().map(|text| parse_state(text, &spec)).transpose()?;
+    let actions = read_actions(actions, spec.action_dim())?;
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(format!("datasets/{}-replay.mcap", file_stem(&env.canonical()))));
+    let settings = ReplaySettings {
+        env,
+        actions,
+        init_state,
+        instance_seed: args.instance_seed,
+        seed: global.seed,
+        command_line: command_line(),
+    };
+    let data: Dataset = replay(&settings)?;
+    write_dataset(&out, &data)?;
+    println!("wrote a replay of {} actions in {} to {}", data.steps.len(), data.meta.env, out.display());
     Ok(())
 }
 

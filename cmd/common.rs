@@ -128,10 +128,24 @@ pub fn pendulum_variant(name: &str) -> anyhow::Result<mbrl::envs::pendulum::Pend
                 "'ball' has no control task; use `mbrl filter` / `mbrl predict`; CEM planning supports pendulum envs"
             )
         }
+        env @ (mbrl::envs::EnvName::Toy(_) | mbrl::envs::EnvName::MountainCar) => {
+            anyhow::bail!("'{}' has no MPC task here yet; CEM planning supports pendulum envs", env.canonical())
+        }
         mbrl::envs::EnvName::Board(g) => anyhow::bail!(
             "'{}' is a board game: solve it with `mbrl solve-board --game {}`; CEM planning supports pendulum envs",
             g.name(),
             g.name()
         ),
     }
+}
+
+/// A comma-separated list of finite numbers (`--init-state 0.5,-1`), or an error naming the flag.
+pub fn parse_floats(flag: &str, text: &str) -> anyhow::Result<Vec<f64>> {
+    text.split(',')
+        .enumerate()
+        .map(|(i, part)| match part.trim().parse::<f64>() {
+            Ok(x) if x.is_finite() => Ok(x),
+            _ => anyhow::bail!("{flag} '{text}': value {} ('{}') is not a finite number", i + 1, part.trim()),
+        })
+        .collect()
 }

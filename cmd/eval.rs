@@ -73,6 +73,12 @@ enum Protocol {
     #[command(after_help = "Examples:\n  mbrl eval ball --model thesis --model initial\n  \
                             mbrl eval ball --model models/ball-ekf --train-shots 108 --test-shots 163 --unseen-shots 30")]
     Ball(BallArgs),
+    /// Explore the Context (thesis 4.5): calibration strategies compared by prediction error after calibration.
+    #[command(
+        after_help = "Examples:\n  mbrl eval context --model models/context-toy-inner --env toy:inner --transitions 1\n  \
+                            mbrl eval context --model models/context-pendulum-quadrant --env pendulum:quadrant --contexts 50 --transitions 30 --horizon 20"
+    )]
+    Context(ContextArgs),
     /// Pendulum swing-up with MPC: success rate, returns, angle plots.
     #[command(
         after_help = "Example:\n  mbrl eval pendulum-swingup --model true --episodes 10 --out reports/swingup\n  \
@@ -155,6 +161,7 @@ pub fn run(global: &GlobalArgs, args: EvalArgs) -> anyhow::Result<()> {
             }
             println!("report: {}", out.join("report.md").display());
         }
+        Protocol::Context(a) => eval_context(global, &provenance, a)?,
         Protocol::Boards { out } => {
             let rows = run_job(global, "eval boards", |monitor| boards::depth_report(&provenance, &out, monitor))?;
             println!("game        depth   boards    train     test   thesis");
@@ -257,6 +264,96 @@ pub fn run(global: &GlobalArgs, args: EvalArgs) -> anyhow::Result<()> {
             );
         }
     }
+    Ok(())
+}
+
+#[derive(Args, Debug)]
+struct ContextArgs {
+    /// A context-model checkpoint (`mbrl train --method context`).
+    #[arg(long)]
+    model: PathBuf,
+    /// The env the model was trained on.
+    #[arg(long)]
+    env: String,
+    /// Unseen contexts (instances) to calibrate in (thesis: 50).
+    #[arg(long, default_value_t = 20)]
+    contexts: usize,
+    /// Random validation rollouts per context (thesis: 20).
+    #[arg(long, default_value_t = 20)]
+    validation_rollouts: usize,
+    /// Steps per validation rollout (thesis: 50).
+    #[arg(long, default_value_t = 50)]
+    validation_steps: usize,
+    /// Calibration transitions N (toy 1–3, pendulum 30, MountainCar 50).
+    #[arg(long, default_value_t = 30)]
+    transitions: usize,
+    /// H_max of MPC calibration (pendulum 20, MountainCar 30).
+    #[arg(long, default_value_t = 20)]
+    horizon: usize,
+    /// Strategies to compare (repeatable; default: all three).
+    #[arg(long, value_enum)]
+    strategy: Vec<crate::calibrate::StrategyChoice>,
+    /// CEM candidates per iteration (thesis 1000).
+    #[arg(long, default_value_t = 1000)]
+    candidates: usize,
+    /// CEM elites (thesis 100).
+    #[arg(long, default_value_t = 100)]
+    elites: usize,
+    /// CEM iterations (thesis 10).
+    #[arg(long, default_value_t = 10)]
+    iters: usize,
+    /// β samples of the information gain (thesis 20).
+    #[arg(long, default_value_t = 20)]
+    beta_samples: usize,
+    /// Report directory.
+    #[arg(long, default_value = "reports/context")]
+    out: PathBuf,
+}
+
+fn eval_context(global: &GlobalArgs, provenance: &Provenance, a: ContextArgs) -> anyhow::Result<()> {
+    use mbrl::models::context::calibration::{CalibrationSettings, Strategy};
+    let env = mbrl::envs::parse_env(&a.env)?;
+    if !a.model.is_dir() {
+        bail!("--model {}: no such checkpoint directory", a.model.display());
+    }
+    let strategies: Vec<Strategy> =
+        if a.strategy.is_empty() { Strategy::ALL.to_vec() } else { a.strategy.iter().map(|s| s.strategy()).collect() };
+    let settings = mbrl::eval::context::ContextEvalSettings {
+        contexts: a.contexts,
+        validation_rollouts: a.validation_rollouts,
+        validation_steps: a.validation_steps,
+        strategies: strategies.clone(),
+        calibration: CalibrationSettings {
+            strategy: Strategy::Random,
+            transitions: a.transitions,
+            horizon_max: a.horizon,
+            candidates: a.candidates,
+            elites: a.elites,
+            iterations: a.iters,
+            beta_samples: a.beta_samples,
+        },
+    };
+    settings.calibration.validate()?;
+    if !(2..=100_000).contains(&a.contexts)
+        || !(1..=10_000).contains(&a.validation_rollouts)
+        || !(1..=10_000).contains(&a.validation_steps)
+    {
+        bail!("--contexts must be 2..=100000, --validation-rollouts and --validation-steps 1..=10000");
+    }
+    let model = mbrl::models::context::load(&a.model, &env)?;
+    let summary = run_job(global, "eval context", |monitor| {
+        mbrl::eval::context::evaluate(&model, &env, &settings, provenance, &a.out, monitor)
+    })?;
+    for (s, m) in strategies.iter().zip(&summary.mean_mse) {
+        println!("{:<10} mean prediction MSE {m:.4e}", s.name());
+    }
+    for (better, worse, p) in &summary.tests {
+        println!("Wilcoxon: {} lower than {}: p = {p:.3e}", better.name(), worse.name());
+    }
+    if let Some((informative, non_informative)) = summary.toy_entropy {
+        println!("entropy after one transition: informative actions {informative:.3}, non-informative {non_informative:.3} nats");
+    }
+    println!("report: {}", a.out.join("report.md").display());
     Ok(())
 }
 

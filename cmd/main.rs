@@ -1,5 +1,6 @@
 //! The `mbrl` command line: parses flags and hands each subcommand to the library.
 
+mod calibrate;
 mod cem_args;
 mod collect;
 mod common;
@@ -43,6 +44,7 @@ enum Command {
     Collect(collect::CollectArgs),
     Plan(plan::PlanArgs),
     Train(train::TrainArgs),
+    Calibrate(calibrate::CalibrateArgs),
     Filter(filter::FilterArgs),
     Predict(predict::PredictArgs),
     SolveBoard(solve_board::SolveBoardArgs),
@@ -57,6 +59,7 @@ fn main() {
         Command::Collect(args) => collect::run(&cli.global, args),
         Command::Plan(args) => plan::run(&cli.global, args),
         Command::Train(args) => train::run(&cli.global, args),
+        Command::Calibrate(args) => calibrate::run(&cli.global, args),
         Command::Filter(args) => filter::run(&cli.global, args),
         Command::Predict(args) => predict::run(&cli.global, args),
         Command::SolveBoard(args) => solve_board::run(&cli.global, args),

@@ -31,12 +31,19 @@ pub struct ModelArgs {
     /// How particles use the ensemble members.
     #[arg(long, value_enum, default_value_t = PropagationChoice::Tsinf)]
     pub propagation: PropagationChoice,
+    /// Calibration transitions (`mbrl calibrate --out`) a context model is conditioned on; without it the
+    /// model plans with its prior mean context.
+    #[arg(long)]
+    pub context: Option<PathBuf>,
 }
 
 impl ModelArgs {
     /// `None` for the ground truth.
     pub fn load(&self, env: &EnvName) -> anyhow::Result<Option<Box<dyn BatchDynamics>>> {
         if self.model == "true" {
+            if self.context.is_some() {
+                bail!("--context conditions a learned context model; `--model true` plans with the simulator itself");
+            }
             return Ok(None);
         }
         if !(1..=10_000).contains(&self.particles) {
@@ -54,6 +61,10 @@ impl ModelArgs {
                 self.model
             );
         }
-        Ok(Some(load_planning_model(&dir, env, RolloutOptions { propagation, particles: self.particles })?))
+        Ok(Some(load_planning_model(
+            &dir,
+            env,
+            RolloutOptions { propagation, particles: self.particles, context: self.context.clone() },
+        )?))
     }
 }

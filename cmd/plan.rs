@@ -18,6 +18,7 @@ Examples:
   mbrl plan --env pendulum --model true --horizon 20 --candidates 1000 --elites 100 --iters 10 --steps 150
   mbrl plan --env pendulum:heavy --model true --noise colored --beta 0.5 --out datasets/heavy-plan.mcap
   mbrl plan --env pendulum --model models/pets-pendulum --particles 20 --propagation tsinf
+  mbrl plan --env pendulum:quadrant --model models/context-pendulum-quadrant --context calib.mcap --instance-seed 3
 
 The pendulum starts hanging (θ ~ U[π-0.05, π+0.05], θ̇ ~ U[-0.05, 0.05]); success means each of the
 last 25 rewards is above -1 (thesis 3.5.2).")]
@@ -32,6 +33,9 @@ pub struct PlanArgs {
     steps: usize,
     #[command(flatten)]
     cem: CemArgs,
+    /// Plan in the instance (hidden parameters) this seed names, as `calibrate --instance-seed` does.
+    #[arg(long)]
+    instance_seed: Option<u64>,
     /// Where to save the executed rollout (default: datasets/plan-<env>.mcap).
     #[arg(long)]
     out: Option<PathBuf>,
@@ -44,6 +48,7 @@ pub fn run(global: &GlobalArgs, args: PlanArgs) -> anyhow::Result<()> {
     }
     let mut settings = SwingupSettings::thesis(variant);
     settings.steps = args.steps;
+    settings.instance_seed = args.instance_seed;
     settings.cem = args.cem.config(&settings.cem.action_low, &settings.cem.action_high);
     settings.cem.validate()?;
     let out = args

@@ -8,6 +8,7 @@ use mbrl::eval::plot::{line_plot, Series};
 use mbrl::models::ball::learn::job::{self as ball_job, BallTrainReport, BallTrainRequest};
 use mbrl::models::ball::learn::TrainSettings;
 use mbrl::models::ball::BallModelParams;
+use mbrl::models::context::{self, ContextConfig};
 use mbrl::models::pets::{self, PetsConfig, Preset, RewardSource};
 use mbrl::run::dir::{Provenance, METRICS_FILE};
 use mbrl::train::config::apply_toml_file;
@@ -24,6 +25,9 @@ pub enum Method {
     /// Gray-box table-tennis ball EKF: learn the impact matrix, noise levels and initial values by
     /// maximizing the filter's marginal likelihood (thesis 6.4.4, eq. 6.24).
     BallEkf,
+    /// Context-conditional GRU dynamics with a context encoder (Explore the Context, thesis ch. 4), trained
+    /// on instance-pair datasets (`collect --instances N`); calibrate with `mbrl calibrate`.
+    Context,
 }
 
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
@@ -32,6 +36,8 @@ pub enum PresetChoice {
     Small,
     /// 4 × 200 SiLU units, 5000 steps: mbrl-lib's PETS pendulum network.
     Medium,
+    /// Context model only: Table B.1 (toy 50k steps, pendulum and MountainCar 100k at batch 512).
+    Paper,
 }
 
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
@@ -52,6 +58,8 @@ Examples:
   mbrl train --resume models/pets-big
   mbrl collect --env ball --trajectories 108 --augment-rotations 19 --out datasets/ball-train.mcap
   mbrl train --method ball-ekf --data datasets/ball-train.mcap --out models/ball-ekf --steps 2000
+  mbrl collect --env toy:inner --instances 1000 --steps 100 --out datasets/toy-inner.mcap
+  mbrl train --method context --data datasets/toy-inner.mcap --preset small --out models/context-toy-inner
 
 A config file (TOML) sets any key of the method's config.json `config` table; unknown keys are errors.
 Flags given explicitly override the file. `--resume DIR` continues a stopped run from its last checkpoint
@@ -73,10 +81,10 @@ pub struct TrainArgs {
     /// Continue the stopped run in this checkpoint directory.
     #[arg(long, conflicts_with_all = ["method", "data", "env", "out", "config", "preset", "ensemble", "steps", "batch", "lr", "reward", "launcher_prior"])]
     resume: Option<PathBuf>,
-    /// Hyperparameters from a TOML file (pets), over the preset's.
+    /// Hyperparameters from a TOML file (pets, context), over the preset's.
     #[arg(long)]
     config: Option<PathBuf>,
-    /// Network size and training length (pets).
+    /// Network size and training length (pets: small, medium; context: small, medium, paper).
     #[arg(long, value_enum)]
     preset: Option<PresetChoice>,
     /// Ensemble members (pets; default 5).
@@ -112,6 +120,7 @@ pub fn run(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
     match args.method.expect("clap requires --method without --resume") {
         Method::Pets => train_pets(global, args),
         Method::BallEkf => train_ball(global, args),
+        Method::Context => train_context(global, args),
     }
 }
 
@@ -126,11 +135,16 @@ fn resume(global: &GlobalArgs, dir: &Path) -> anyhow::Result<()> {
             let report = run_job(global, "train ball-ekf (resumed)", |monitor| ball_job::resume(dir, monitor))?;
             finish_ball(&report, dir)
         }
+        context::METHOD => {
+            let report = run_job(global, "train context (resumed)", |monitor| context::resume(dir, monitor))?;
+            print_context_report(&report, dir)
+        }
         other => bail!(
-            "{}: '{other}' runs cannot be resumed; resumable methods: {}, {}",
+            "{}: '{other}' runs cannot be resumed; resumable methods: {}, {}, {}",
             dir.display(),
             pets::METHOD,
-            ball_job::METHOD
+            ball_job::METHOD,
+            context::METHOD
         ),
     }
 }
@@ -139,6 +153,7 @@ fn pets_config(args: &TrainArgs) -> anyhow::Result<PetsConfig> {
     let preset = match args.preset.unwrap_or(PresetChoice::Small) {
         PresetChoice::Small => Preset::Small,
         PresetChoice::Medium => Preset::Medium,
+        PresetChoice::Paper => bail!("--preset paper is a context-model preset; pets takes small or medium"),
     };
     let mut config = PetsConfig::preset(preset);
     if let Some(path) = &args.config {
@@ -219,6 +234,89 @@ fn print_pets_report(report: &pets::TrainReport, out: &Path) -> anyhow::Result<(
     }
     if let (Some(step), Some(v)) = (o.best_step, o.best_valid_loss) {
         println!("best validation MSE {v:.3e} at step {step} (saved as model.safetensors)");
+    }
+    println!("checkpoint: {}", out.display());
+    Ok(())
+}
+
+fn context_config(args: &TrainArgs, env: &mbrl::envs::EnvName) -> anyhow::Result<ContextConfig> {
+    for (flag, given) in [("--ensemble", args.ensemble.is_some()), ("--reward", args.reward.is_some())] {
+        if given {
+            bail!(
+                "{flag} is a pets flag; context takes --data, --env, --out, --preset, --config, --steps, --batch, --lr"
+            );
+        }
+    }
+    if args.launcher_prior {
+        bail!("--launcher-prior is a ball-ekf flag; the context model has no launcher");
+    }
+    let preset = match args.preset.unwrap_or(PresetChoice::Small) {
+        PresetChoice::Small => context::Preset::Small,
+        PresetChoice::Medium => context::Preset::Medium,
+        PresetChoice::Paper => context::Preset::Paper,
+    };
+    let mut config = ContextConfig::preset(preset, context::family_of(env));
+    if let Some(path) = &args.config {
+        config = apply_toml_file(&config, path)?;
+    }
+    if let Some(n) = args.steps {
+        config.steps = n;
+    }
+    if let Some(n) = args.batch {
+        config.batch_size = n;
+    }
+    if let Some(lr) = args.lr {
+        config.optimizer.learning_rate = lr;
+    }
+    config.validate()?;
+    Ok(config)
+}
+
+fn train_context(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
+    let [data] = args.data.as_slice() else {
+        bail!("context trains on one --data file (a `collect --instances N` dataset), got {}", args.data.len());
+    };
+    let env_name = match &args.env {
+        Some(env) => env.clone(),
+        None => mbrl::data::read_dataset(data)?.meta.env,
+    };
+    let env = mbrl::envs::parse_env(&env_name)?;
+    let config = context_config(&args, &env)?;
+    let out = args.out.clone().unwrap_or_else(|| PathBuf::from(format!("models/context-{}", file_stem(&env_name))));
+    let request = context::TrainRequest {
+        out: out.clone(),
+        data: data.clone(),
+        env: args.env.clone(),
+        config,
+        seed: global.seed,
+        provenance: Provenance::new(command_line(), global.seed, global.thread_count()),
+    };
+    let report = run_job(global, "train context", |monitor| context::train(&request, false, monitor))?;
+    print_context_report(&report, &out)
+}
+
+fn print_context_report(report: &context::TrainReport, out: &Path) -> anyhow::Result<()> {
+    write_loss_report(out, "Context-model training loss (eq. 4.32)", "loss")?;
+    let run = &report.run;
+    let c = &run.config;
+    println!(
+        "trained a context model (embedding {}, D_F {}, D_β {}, {} parameters) on {} instances of {} ({} held out), batch {} × {} states",
+        c.embedding,
+        c.transition_features,
+        c.latent_dim,
+        report.parameters,
+        run.instances.train,
+        run.env,
+        run.instances.valid,
+        c.batch_size,
+        run.chunk_states
+    );
+    let o = &report.outcome;
+    if let Some(loss) = o.last_train_loss {
+        println!("final training loss {loss:.4} after {} steps", o.steps);
+    }
+    if let (Some(step), Some(v)) = (o.best_step, o.best_valid_loss) {
+        println!("best validation loss {v:.4} at step {step} (saved as model.safetensors)");
     }
     println!("checkpoint: {}", out.display());
     Ok(())

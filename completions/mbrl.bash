@@ -16,6 +16,9 @@ _mbrl() {
             ",$1")
                 cmd="mbrl"
                 ;;
+            mbrl,calibrate)
+                cmd="mbrl__subcmd__calibrate"
+                ;;
             mbrl,collect)
                 cmd="mbrl__subcmd__collect"
                 ;;
@@ -52,6 +55,9 @@ _mbrl() {
             mbrl__subcmd__eval,boards)
                 cmd="mbrl__subcmd__eval__subcmd__boards"
                 ;;
+            mbrl__subcmd__eval,context)
+                cmd="mbrl__subcmd__eval__subcmd__context"
+                ;;
             mbrl__subcmd__eval,dataset)
                 cmd="mbrl__subcmd__eval__subcmd__dataset"
                 ;;
@@ -73,6 +79,9 @@ _mbrl() {
             mbrl__subcmd__eval__subcmd__help,boards)
                 cmd="mbrl__subcmd__eval__subcmd__help__subcmd__boards"
                 ;;
+            mbrl__subcmd__eval__subcmd__help,context)
+                cmd="mbrl__subcmd__eval__subcmd__help__subcmd__context"
+                ;;
             mbrl__subcmd__eval__subcmd__help,dataset)
                 cmd="mbrl__subcmd__eval__subcmd__help__subcmd__dataset"
                 ;;
@@ -87,6 +96,9 @@ _mbrl() {
                 ;;
             mbrl__subcmd__eval__subcmd__help,quick)
                 cmd="mbrl__subcmd__eval__subcmd__help__subcmd__quick"
+                ;;
+            mbrl__subcmd__help,calibrate)
+                cmd="mbrl__subcmd__help__subcmd__calibrate"
                 ;;
             mbrl__subcmd__help,collect)
                 cmd="mbrl__subcmd__help__subcmd__collect"
@@ -124,6 +136,9 @@ _mbrl() {
             mbrl__subcmd__help__subcmd__eval,boards)
                 cmd="mbrl__subcmd__help__subcmd__eval__subcmd__boards"
                 ;;
+            mbrl__subcmd__help__subcmd__eval,context)
+                cmd="mbrl__subcmd__help__subcmd__eval__subcmd__context"
+                ;;
             mbrl__subcmd__help__subcmd__eval,dataset)
                 cmd="mbrl__subcmd__help__subcmd__eval__subcmd__dataset"
                 ;;
@@ -143,7 +158,7 @@ _mbrl() {
 
     case "${cmd}" in
         mbrl)
-            opts="-q -h -V --seed --threads --tui --no-tui --quiet --help --version collect plan train filter predict solve-board eval watch completions help"
+            opts="-q -h -V --seed --threads --tui --no-tui --quiet --help --version collect plan train calibrate filter predict solve-board eval watch completions help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 1 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -164,8 +179,78 @@ _mbrl() {
             COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
             return 0
             ;;
+        mbrl__subcmd__calibrate)
+            opts="-q -h -V --model --env --instance-seed --strategy --transitions --horizon --candidates --elites --iters --beta-samples --init-state --out --seed --threads --tui --no-tui --quiet --help --version"
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                --model)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --env)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --instance-seed)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --strategy)
+                    COMPREPLY=($(compgen -W "random open-loop mpc" -- "${cur}"))
+                    return 0
+                    ;;
+                --transitions)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --horizon)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --candidates)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --elites)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --iters)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --beta-samples)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --init-state)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --out)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --seed)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
         mbrl__subcmd__collect)
-            opts="-q -h -V --env --rollouts --steps --policy --out --trajectories --orientation --augment-rotations --boards --max-depth --split --seed --threads --tui --no-tui --quiet --help --version"
+            opts="-q -h -V --env --rollouts --instances --actions --init-state --instance-seed --steps --policy --out --trajectories --orientation --augment-rotations --boards --max-depth --split --seed --threads --tui --no-tui --quiet --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -176,6 +261,22 @@ _mbrl() {
                     return 0
                     ;;
                 --rollouts)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --instances)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --actions)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --init-state)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --instance-seed)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
@@ -249,7 +350,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval)
-            opts="-q -h -V --seed --threads --tui --no-tui --quiet --help --version quick dataset boards embodied ball pendulum-swingup help"
+            opts="-q -h -V --seed --threads --tui --no-tui --quiet --help --version quick dataset boards embodied ball context pendulum-swingup help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -323,6 +424,80 @@ _mbrl() {
                 return 0
             fi
             case "${prev}" in
+                --out)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --seed)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mbrl__subcmd__eval__subcmd__context)
+            opts="-q -h -V --model --env --contexts --validation-rollouts --validation-steps --transitions --horizon --strategy --candidates --elites --iters --beta-samples --out --seed --threads --tui --no-tui --quiet --help --version"
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                --model)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --env)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --contexts)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --validation-rollouts)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --validation-steps)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --transitions)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --horizon)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --strategy)
+                    COMPREPLY=($(compgen -W "random open-loop mpc" -- "${cur}"))
+                    return 0
+                    ;;
+                --candidates)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --elites)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --iters)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --beta-samples)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 --out)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
@@ -419,7 +594,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__help)
-            opts="quick dataset boards embodied ball pendulum-swingup help"
+            opts="quick dataset boards embodied ball context pendulum-swingup help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -447,6 +622,20 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__help__subcmd__boards)
+            opts=""
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 4 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mbrl__subcmd__eval__subcmd__help__subcmd__context)
             opts=""
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 4 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
@@ -531,7 +720,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__pendulum__subcmd__swingup)
-            opts="-q -h -V --model --particles --propagation --episodes --env --steps --horizon --candidates --elites --iters --noise --beta --no-warm-start --out --seed --threads --tui --no-tui --quiet --help --version"
+            opts="-q -h -V --model --particles --propagation --context --episodes --env --steps --horizon --candidates --elites --iters --noise --beta --no-warm-start --out --seed --threads --tui --no-tui --quiet --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -547,6 +736,10 @@ _mbrl() {
                     ;;
                 --propagation)
                     COMPREPLY=($(compgen -W "ts1 tsinf expectation" -- "${cur}"))
+                    return 0
+                    ;;
+                --context)
+                    COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
                 --episodes)
@@ -669,8 +862,22 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__help)
-            opts="collect plan train filter predict solve-board eval watch completions help"
+            opts="collect plan train calibrate filter predict solve-board eval watch completions help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mbrl__subcmd__help__subcmd__calibrate)
+            opts=""
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
             fi
@@ -711,7 +918,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__help__subcmd__eval)
-            opts="quick dataset boards embodied ball pendulum-swingup"
+            opts="quick dataset boards embodied ball context pendulum-swingup"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -739,6 +946,20 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__help__subcmd__eval__subcmd__boards)
+            opts=""
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 4 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mbrl__subcmd__help__subcmd__eval__subcmd__context)
             opts=""
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 4 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
@@ -907,7 +1128,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__plan)
-            opts="-q -h -V --env --model --particles --propagation --steps --horizon --candidates --elites --iters --noise --beta --no-warm-start --out --seed --threads --tui --no-tui --quiet --help --version"
+            opts="-q -h -V --env --model --particles --propagation --context --steps --horizon --candidates --elites --iters --noise --beta --no-warm-start --instance-seed --out --seed --threads --tui --no-tui --quiet --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -927,6 +1148,10 @@ _mbrl() {
                     ;;
                 --propagation)
                     COMPREPLY=($(compgen -W "ts1 tsinf expectation" -- "${cur}"))
+                    return 0
+                    ;;
+                --context)
+                    COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
                 --steps)
@@ -954,6 +1179,10 @@ _mbrl() {
                     return 0
                     ;;
                 --beta)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --instance-seed)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
@@ -1092,7 +1321,7 @@ _mbrl() {
             fi
             case "${prev}" in
                 --method)
-                    COMPREPLY=($(compgen -W "pets ball-ekf" -- "${cur}"))
+                    COMPREPLY=($(compgen -W "pets ball-ekf context" -- "${cur}"))
                     return 0
                     ;;
                 --data)
@@ -1116,7 +1345,7 @@ _mbrl() {
                     return 0
                     ;;
                 --preset)
-                    COMPREPLY=($(compgen -W "small medium" -- "${cur}"))
+                    COMPREPLY=($(compgen -W "small medium paper" -- "${cur}"))
                     return 0
                     ;;
                 --ensemble)

@@ -34,6 +34,7 @@ complete -c mbrl -n "__fish_mbrl_needs_command" -s V -l version -d 'Print versio
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "collect" -d 'Collect rollouts from a simulator into an MCAP dataset'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "plan" -d 'Plan with CEM on a model and execute the plan in the simulator (MPC)'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "train" -d 'Train a model and write it to a checkpoint directory (config.json, weights, metrics.jsonl)'
+complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "calibrate" -d 'Calibrate a context model in an instance of its env by expected information gain'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "filter" -d 'Filter table-tennis ball recordings with the gray-box EKF (thesis chapter 6)'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "predict" -d 'Predict table-tennis ball trajectories: filter until a horizon before the end, then predict ahead'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "solve-board" -d 'Find a shortest solution of a LightsOut or TileSwap board and optionally play it with a manipulator'
@@ -41,11 +42,15 @@ complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "eval" -d 'Run an evaluati
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "watch" -d 'Follow a running or finished run (training or eval) in the live view'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "completions" -d 'Print a shell completion script'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l env -d 'Environment: pendulum[:light|heavy|mass=<m>|inverted|quadrant]' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l rollouts -d 'Number of rollouts' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l env -d 'Environment: pendulum[:light|heavy|mass=<m>|inverted|quadrant], toy:inner|outer, mountaincar, lightsout, tileswap, ball' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l rollouts -d 'Number of rollouts, each in its own instance of a parametrized env' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l instances -d 'Instead of --rollouts: N instances with two rollouts each (ids 2k, 2k+1), for context models' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l actions -d 'Replay these actions (CSV: one row per step, one column per action dimension) instead of random ones' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l init-state -d 'With --actions: the start state, comma-separated (pendulum: θ,θ̇; toy: s1,s2; mountaincar: x,ẋ)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l instance-seed -d 'With --actions: which instance of a parametrized env (default: --seed); the same seed names the same instance in every subcommand' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l steps -d 'Steps per rollout' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l policy -d 'Behaviour policy' -r -f -a "random\t'Uniformly random actions within the action bounds'"
-complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l out -d 'Output file (default: datasets/<env>-random.mcap, or datasets/<game>-boards-d<D>.mcap)' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l out -d 'Output file (default: datasets/<env>-random.mcap, <env>-pairs.mcap, <env>-replay.mcap, or <game>-boards-d<D>.mcap)' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l trajectories -d 'For the ball: number of simulated shots (each with exactly one table bounce)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l orientation -d 'For the ball: launcher pose, default or unseen-1..unseen-5 (thesis 6.5.1)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l augment-rotations -d 'For the ball: rotated copies added per shot, about z through its lowest point (19 in the thesis)' -r
@@ -66,6 +71,7 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l particles -d 'Particl
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l propagation -d 'How particles use the ensemble members' -r -f -a "ts1\t'TS-1: each particle draws an ensemble member anew at every step'
 tsinf\t'TS-∞: each particle keeps one member for the whole horizon'
 expectation\t'Each member\'s mean prediction, no sampling'"
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l context -d 'Calibration transitions (`mbrl calibrate --out`) a context model is conditioned on; without it the model plans with its prior mean context' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l steps -d 'Steps to execute' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l horizon -d 'Planning horizon in steps' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l candidates -d 'Candidate action sequences per iteration' -r
@@ -74,6 +80,7 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l iters -d 'CEM iterati
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l noise -d 'Sampling noise' -r -f -a "white\t'Independent Gaussian samples (thesis Algorithm 1)'
 colored\t'Power spectral density ∝ 1/f^β along time (iCEM)'"
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l beta -d 'Exponent β of colored noise (used with --noise colored)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l instance-seed -d 'Plan in the instance (hidden parameters) this seed names, as `calibrate --instance-seed` does' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l out -d 'Where to save the executed rollout (default: datasets/plan-<env>.mcap)' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l threads -d 'Worker threads (0 = one per core)' -r
@@ -84,14 +91,16 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -s q -l quiet -d 'Print 
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -s V -l version -d 'Print version'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l method -d 'What to train' -r -f -a "pets\t'Probabilistic ensemble of MLPs on (state, action) → state change (PETS, Chua et al. 2018), for any env that `collect` rolls out; plan with it via `mbrl plan --model DIR`'
-ball-ekf\t'Gray-box table-tennis ball EKF: learn the impact matrix, noise levels and initial values by maximizing the filter\'s marginal likelihood (thesis 6.4.4, eq. 6.24)'"
+ball-ekf\t'Gray-box table-tennis ball EKF: learn the impact matrix, noise levels and initial values by maximizing the filter\'s marginal likelihood (thesis 6.4.4, eq. 6.24)'
+context\t'Context-conditional GRU dynamics with a context encoder (Explore the Context, thesis ch. 4), trained on instance-pair datasets (`collect --instances N`); calibrate with `mbrl calibrate`'"
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l data -d 'Training data (repeatable). pets: rollout datasets (.mcap) of one env; ball-ekf: a ball dataset (.mcap) or a .csv recording' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l env -d 'The env the data must come from (pets; default: the dataset\'s env)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l out -d 'Checkpoint directory (default: models/<method>-<env>, models/ball-ekf)' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l resume -d 'Continue the stopped run in this checkpoint directory' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l config -d 'Hyperparameters from a TOML file (pets), over the preset\'s' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l preset -d 'Network size and training length (pets)' -r -f -a "small\t'3 hidden layers × 64 SiLU units, 2000 steps (≈ 10 s on 2 cores)'
-medium\t'4 × 200 SiLU units, 5000 steps: mbrl-lib\'s PETS pendulum network'"
+complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l config -d 'Hyperparameters from a TOML file (pets, context), over the preset\'s' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l preset -d 'Network size and training length (pets: small, medium; context: small, medium, paper)' -r -f -a "small\t'3 hidden layers × 64 SiLU units, 2000 steps (≈ 10 s on 2 cores)'
+medium\t'4 × 200 SiLU units, 5000 steps: mbrl-lib\'s PETS pendulum network'
+paper\t'Context model only: Table B.1 (toy 50k steps, pendulum and MountainCar 100k at batch 512)'"
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l ensemble -d 'Ensemble members (pets; default 5)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l steps -d 'Optimizer steps (pets: preset\'s; ball-ekf: 1000)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l batch -d 'Batch size: transitions per member (pets, 256) or chunks (ball-ekf, thesis 64)' -r
@@ -107,6 +116,27 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l no-tui -d 'Print pla
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -s V -l version -d 'Print version'
+complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l model -d 'A context-model checkpoint (`mbrl train --method context`)' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l env -d 'Environment the model was trained on, e.g. toy:inner, pendulum:quadrant, mountaincar' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l instance-seed -d 'Which instance (hidden parameters) to calibrate in' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l strategy -r -f -a "random\t'Uniformly random actions (the baseline)'
+open-loop\t'One action sequence maximizing the expected information gain, planned at the start (eq. 4.36)'
+mpc\t'Replan the EIG-optimal sequence after every transition, horizon min(H_max, N − n) (eq. 4.37)'"
+complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l transitions -d 'Calibration transitions N' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l horizon -d 'H_max: the longest planning horizon of MPC calibration' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l candidates -d 'CEM candidates per iteration' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l elites -d 'CEM elites' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l iters -d 'CEM iterations' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l beta-samples -d 'β samples of the Monte Carlo information gain' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l init-state -d 'Start state, comma-separated in the env\'s state order (pendulum: θ,θ̇)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l out -d 'Where to write the calibration transitions (default: datasets/calib-<env>-<strategy>-i<S>.mcap)' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l threads -d 'Worker threads (0 = one per core)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -s q -l quiet -d 'Print only results and errors'
+complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -s h -l help -d 'Print help (see more with \'--help\')'
+complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -s V -l version -d 'Print version'
 complete -c mbrl -n "__fish_mbrl_using_subcommand filter" -l model -d 'Ball model: thesis, initial, or a checkpoint directory' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand filter" -l input -d 'Recordings: a .mcap ball dataset or a .csv recording' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand filter" -l out -d 'CSV output: per frame the measurement, the state mean and its standard deviations' -r -F
@@ -151,20 +181,21 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l no-tui -d 'Pri
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -s V -l version -d 'Print version'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball pendulum-swingup help" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball pendulum-swingup help" -l threads -d 'Worker threads (0 = one per core)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball pendulum-swingup help" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball pendulum-swingup help" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball pendulum-swingup help" -s q -l quiet -d 'Print only results and errors'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball pendulum-swingup help" -s h -l help -d 'Print help'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball pendulum-swingup help" -s V -l version -d 'Print version'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball pendulum-swingup help" -f -a "quick" -d 'Small reproduction of every implemented method (about a minute)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball pendulum-swingup help" -f -a "dataset" -d 'Summarise a dataset: rollouts, returns, state ranges, plots'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball pendulum-swingup help" -f -a "boards" -d 'Depth and train/test split tables of LightsOut 5x5 and TileSwap (thesis Tables 7.1, 7.2)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball pendulum-swingup help" -f -a "embodied" -d 'A manipulator\'s scripted controller plays optimal plans of boards of depth 1..D'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball pendulum-swingup help" -f -a "ball" -d 'Ball prediction error vs horizon on simulated shots, default and unseen launcher poses (thesis 6.5)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball pendulum-swingup help" -f -a "pendulum-swingup" -d 'Pendulum swing-up with MPC: success rate, returns, angle plots'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball pendulum-swingup help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context pendulum-swingup help" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context pendulum-swingup help" -l threads -d 'Worker threads (0 = one per core)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context pendulum-swingup help" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context pendulum-swingup help" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context pendulum-swingup help" -s q -l quiet -d 'Print only results and errors'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context pendulum-swingup help" -s h -l help -d 'Print help'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context pendulum-swingup help" -s V -l version -d 'Print version'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context pendulum-swingup help" -f -a "quick" -d 'Small reproduction of every implemented method (about a minute)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context pendulum-swingup help" -f -a "dataset" -d 'Summarise a dataset: rollouts, returns, state ranges, plots'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context pendulum-swingup help" -f -a "boards" -d 'Depth and train/test split tables of LightsOut 5x5 and TileSwap (thesis Tables 7.1, 7.2)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context pendulum-swingup help" -f -a "embodied" -d 'A manipulator\'s scripted controller plays optimal plans of boards of depth 1..D'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context pendulum-swingup help" -f -a "ball" -d 'Ball prediction error vs horizon on simulated shots, default and unseen launcher poses (thesis 6.5)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context pendulum-swingup help" -f -a "context" -d 'Explore the Context (thesis 4.5): calibration strategies compared by prediction error after calibration'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context pendulum-swingup help" -f -a "pendulum-swingup" -d 'Pendulum swing-up with MPC: success rate, returns, angle plots'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context pendulum-swingup help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from quick" -l out -d 'Report directory' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from quick" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from quick" -l threads -d 'Worker threads (0 = one per core)' -r
@@ -218,11 +249,34 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -s V -l version -d 'Print version'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l model -d 'A context-model checkpoint (`mbrl train --method context`)' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l env -d 'The env the model was trained on' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l contexts -d 'Unseen contexts (instances) to calibrate in (thesis: 50)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l validation-rollouts -d 'Random validation rollouts per context (thesis: 20)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l validation-steps -d 'Steps per validation rollout (thesis: 50)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l transitions -d 'Calibration transitions N (toy 1–3, pendulum 30, MountainCar 50)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l horizon -d 'H_max of MPC calibration (pendulum 20, MountainCar 30)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l strategy -d 'Strategies to compare (repeatable; default: all three)' -r -f -a "random\t'Uniformly random actions (the baseline)'
+open-loop\t'One action sequence maximizing the expected information gain, planned at the start (eq. 4.36)'
+mpc\t'Replan the EIG-optimal sequence after every transition, horizon min(H_max, N − n) (eq. 4.37)'"
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l candidates -d 'CEM candidates per iteration (thesis 1000)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l elites -d 'CEM elites (thesis 100)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l iters -d 'CEM iterations (thesis 10)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l beta-samples -d 'β samples of the information gain (thesis 20)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l out -d 'Report directory' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l threads -d 'Worker threads (0 = one per core)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -s q -l quiet -d 'Print only results and errors'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -s h -l help -d 'Print help (see more with \'--help\')'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -s V -l version -d 'Print version'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l model -d 'Dynamics the planner uses: `true` (the simulator\'s equations) or a checkpoint directory written by `mbrl train` (e.g. models/pets-pendulum)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l particles -d 'Particles per candidate for stochastic learned models (PETS: trajectory sampling)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l propagation -d 'How particles use the ensemble members' -r -f -a "ts1\t'TS-1: each particle draws an ensemble member anew at every step'
 tsinf\t'TS-∞: each particle keeps one member for the whole horizon'
 expectation\t'Each member\'s mean prediction, no sampling'"
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l context -d 'Calibration transitions (`mbrl calibrate --out`) a context model is conditioned on; without it the model plans with its prior mean context' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l episodes -d 'Number of episodes (each with its own start state)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l env -d 'Environment variant: pendulum[:light|heavy|mass=<m>|inverted|quadrant]' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l steps -d 'Steps per episode' -r
@@ -247,6 +301,7 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from help" -f -a "boards" -d 'Depth and train/test split tables of LightsOut 5x5 and TileSwap (thesis Tables 7.1, 7.2)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from help" -f -a "embodied" -d 'A manipulator\'s scripted controller plays optimal plans of boards of depth 1..D'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from help" -f -a "ball" -d 'Ball prediction error vs horizon on simulated shots, default and unseen launcher poses (thesis 6.5)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from help" -f -a "context" -d 'Explore the Context (thesis 4.5): calibration strategies compared by prediction error after calibration'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from help" -f -a "pendulum-swingup" -d 'Pendulum swing-up with MPC: success rate, returns, angle plots'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
@@ -263,19 +318,21 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -l no-tui -d 'Pri
 complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -s V -l version -d 'Print version'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train filter predict solve-board eval watch completions help" -f -a "collect" -d 'Collect rollouts from a simulator into an MCAP dataset'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train filter predict solve-board eval watch completions help" -f -a "plan" -d 'Plan with CEM on a model and execute the plan in the simulator (MPC)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train filter predict solve-board eval watch completions help" -f -a "train" -d 'Train a model and write it to a checkpoint directory (config.json, weights, metrics.jsonl)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train filter predict solve-board eval watch completions help" -f -a "filter" -d 'Filter table-tennis ball recordings with the gray-box EKF (thesis chapter 6)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train filter predict solve-board eval watch completions help" -f -a "predict" -d 'Predict table-tennis ball trajectories: filter until a horizon before the end, then predict ahead'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train filter predict solve-board eval watch completions help" -f -a "solve-board" -d 'Find a shortest solution of a LightsOut or TileSwap board and optionally play it with a manipulator'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train filter predict solve-board eval watch completions help" -f -a "eval" -d 'Run an evaluation protocol and write a report directory (report.md, CSV, PNG)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train filter predict solve-board eval watch completions help" -f -a "watch" -d 'Follow a running or finished run (training or eval) in the live view'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train filter predict solve-board eval watch completions help" -f -a "completions" -d 'Print a shell completion script'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train filter predict solve-board eval watch completions help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch completions help" -f -a "collect" -d 'Collect rollouts from a simulator into an MCAP dataset'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch completions help" -f -a "plan" -d 'Plan with CEM on a model and execute the plan in the simulator (MPC)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch completions help" -f -a "train" -d 'Train a model and write it to a checkpoint directory (config.json, weights, metrics.jsonl)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch completions help" -f -a "calibrate" -d 'Calibrate a context model in an instance of its env by expected information gain'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch completions help" -f -a "filter" -d 'Filter table-tennis ball recordings with the gray-box EKF (thesis chapter 6)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch completions help" -f -a "predict" -d 'Predict table-tennis ball trajectories: filter until a horizon before the end, then predict ahead'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch completions help" -f -a "solve-board" -d 'Find a shortest solution of a LightsOut or TileSwap board and optionally play it with a manipulator'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch completions help" -f -a "eval" -d 'Run an evaluation protocol and write a report directory (report.md, CSV, PNG)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch completions help" -f -a "watch" -d 'Follow a running or finished run (training or eval) in the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch completions help" -f -a "completions" -d 'Print a shell completion script'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch completions help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from eval" -f -a "quick" -d 'Small reproduction of every implemented method (about a minute)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from eval" -f -a "dataset" -d 'Summarise a dataset: rollouts, returns, state ranges, plots'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from eval" -f -a "boards" -d 'Depth and train/test split tables of LightsOut 5x5 and TileSwap (thesis Tables 7.1, 7.2)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from eval" -f -a "embodied" -d 'A manipulator\'s scripted controller plays optimal plans of boards of depth 1..D'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from eval" -f -a "ball" -d 'Ball prediction error vs horizon on simulated shots, default and unseen launcher poses (thesis 6.5)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from eval" -f -a "context" -d 'Explore the Context (thesis 4.5): calibration strategies compared by prediction error after calibration'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from eval" -f -a "pendulum-swingup" -d 'Pendulum swing-up with MPC: success rate, returns, angle plots'

@@ -15,6 +15,8 @@ const SUBCOMMANDS: &[&[&str]] = &[
     &["eval", "boards"],
     &["eval", "embodied"],
     &["eval", "ball"],
+    &["eval", "context"],
+    &["calibrate"],
     &["solve-board"],
     &["filter"],
     &["train"],

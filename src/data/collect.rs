@@ -1,12 +1,20 @@
-//! Rollouts of a behaviour policy in a simulator, packed as a dataset.
+//! Rollouts in a simulator, packed as a dataset: random rollouts, instance pairs for context models, and
+//! replays of given action sequences.
 
 use rand::Rng;
+use rand_chacha::ChaCha8Rng;
 
-use super::{Dataset, DatasetMeta, Rollout, FORMAT_VERSION};
-use crate::envs::EnvName;
+use super::{Dataset, DatasetLayout, DatasetMeta, Rollout, Timestep, FORMAT_VERSION};
+use crate::envs::{instance_env, Env, EnvName, EnvSpec};
 use crate::error::{Error, Result};
 use crate::run::Monitor;
-use crate::util::seeding::rng_for;
+use crate::util::seeding::{derive_seed, rng_for};
+
+/// The random stream under `--seed` that a replay's reset state (and toy noise) come from.
+const REPLAY_STREAM: u64 = u64::from_be_bytes(*b"replay\0\0");
+
+/// Refuse before allocating: a dataset is built in memory before it is written.
+const MAX_DATASET_BYTES: f64 = 16.0 * (1u64 << 30) as f64;
 
 pub struct CollectSettings {
     pub env: EnvName,
@@ -24,48 +32,208 @@ pub fn collect_random(settings: &CollectSettings, monitor: &dyn Monitor) -> Resu
     }
     let mut env = settings.env.build()?;
     let spec = env.spec();
+    check_size(&spec, settings.rollouts, settings.steps, "--rollouts × --steps")?;
     let mut instances = Vec::with_capacity(settings.rollouts);
-    let mut steps = Vec::with_capacity(settings.rollouts * settings.steps);
+    let mut steps = Vec::new();
     for k in 0..settings.rollouts {
         if monitor.is_cancelled() {
             return Err(Error::Cancelled);
         }
         let mut rng = rng_for(settings.seed, &[k as u64]);
         env.sample_instance(&mut rng);
-        let obs = env.reset(&mut rng);
-        let mut rollout = Rollout::start(env.state(), obs);
-        for _ in 0..settings.steps {
-            let action: Vec<f64> =
-                spec.action_low.iter().zip(&spec.action_high).map(|(&lo, &hi)| rng.random_range(lo..=hi)).collect();
-            let step = env.step(&action);
-            rollout.push(action, step.reward, env.state(), step.obs);
-            if step.done {
-                break;
-            }
-        }
+        let rollout = random_rollout(env.as_mut(), &spec, &mut rng, settings.steps);
         instances.push(env.params());
-        steps.extend(rollout.timesteps(k as u32));
+        steps.extend(timesteps(&spec, &rollout, k as u32));
         monitor.progress("collect rollouts", k as u64 + 1, settings.rollouts as u64);
     }
+    Ok(Dataset { meta: meta(&spec, settings.seed, &settings.command_line, instances, DatasetLayout::Rollouts), steps })
+}
+
+pub struct InstancePairSettings {
+    pub env: EnvName,
+    pub instances: usize,
+    pub steps: usize,
+    pub seed: u64,
+    pub command_line: String,
+}
+
+/// The instance seed of instance `k` in an instance-pair dataset made with `seed`: `mbrl collect --actions …
+/// --instance-seed <this>` replays in the same instance.
+pub fn pair_instance_seed(seed: u64, k: u64) -> u64 {
+    derive_seed(seed, &[k])
+}
+
+/// What a context model trains on (thesis B.2.1): per instance k, a target rollout (id 2k) and a context-source
+/// rollout (id 2k+1) of the same hidden parameters, each with its own start state and random actions.
+pub fn collect_instance_pairs(settings: &InstancePairSettings, monitor: &dyn Monitor) -> Result<Dataset> {
+    if settings.instances == 0 || settings.steps == 0 {
+        return Err(Error::config("--instances and --steps must be at least 1"));
+    }
+    let spec = settings.env.build()?.spec();
+    let rollouts = settings.instances.checked_mul(2).ok_or_else(|| Error::config("--instances is too large"))?;
+    check_size(&spec, rollouts, settings.steps, "2 × --instances × --steps")?;
+    let mut instances = Vec::with_capacity(rollouts);
+    let mut steps = Vec::new();
+    for k in 0..settings.instances as u64 {
+        if monitor.is_cancelled() {
+            return Err(Error::Cancelled);
+        }
+        let mut env = instance_env(&settings.env, pair_instance_seed(settings.seed, k))?;
+        for role in 0..2 {
+            let mut rng = rng_for(settings.seed, &[k, role]);
+            let rollout = random_rollout(env.as_mut(), &spec, &mut rng, settings.steps);
+            steps.extend(timesteps(&spec, &rollout, (2 * k + role) as u32));
+            instances.push(env.params());
+        }
+        monitor.progress("collect instance pairs", k + 1, settings.instances as u64);
+    }
+    let layout = DatasetLayout::InstancePairs;
+    Ok(Dataset { meta: meta(&spec, settings.seed, &settings.command_line, instances, layout), steps })
+}
+
+pub struct ReplaySettings {
+    pub env: EnvName,
+    /// One action per step. Values outside the action bounds are clipped by the env, as in any step.
+    pub actions: Vec<Vec<f64>>,
+    /// The start state; `None` draws one from the env's reset distribution under `seed`.
+    pub init_state: Option<Vec<f64>>,
+    /// Which instance of a parametrized family (see [`instance_env`]); `None` uses `seed`.
+    pub instance_seed: Option<u64>,
+    /// Keys the reset state and the transition noise of noisy envs (toy).
+    pub seed: u64,
+    pub command_line: String,
+}
+
+/// Steps the env through the given actions and records the single rollout with its instance's parameters.
+pub fn replay(settings: &ReplaySettings) -> Result<Dataset> {
+    let mut env = instance_env(&settings.env, settings.instance_seed.unwrap_or(settings.seed))?;
+    let spec = env.spec();
+    if let Some((t, a)) = settings.actions.iter().enumerate().find(|(_, a)| a.len() != spec.action_dim()) {
+        return Err(Error::data(format!(
+            "action {t} has {} value(s); {} takes {}",
+            a.len(),
+            spec.name,
+            spec.action_dim()
+        )));
+    }
+    if settings.actions.is_empty() {
+        return Err(Error::data("no actions to replay"));
+    }
+    // Reset even when the start is given: it also seeds the noise of noisy envs from `seed`.
+    env.reset(&mut rng_for(settings.seed, &[REPLAY_STREAM]));
+    if let Some(state) = &settings.init_state {
+        check_state(&spec, state)?;
+        env.set_state(state);
+    }
+    let mut rollout = Rollout::start(env.state(), env.observe());
+    for action in &settings.actions {
+        let step = env.step(action);
+        rollout.push(action.clone(), step.reward, env.state(), step.obs);
+    }
+    let steps = timesteps(&spec, &rollout, 0).collect();
     Ok(Dataset {
-        meta: DatasetMeta {
-            format_version: FORMAT_VERSION,
-            env: spec.name.clone(),
-            seed: settings.seed,
-            mbrl_version: crate::VERSION.to_string(),
-            command_line: settings.command_line.clone(),
-            instances,
-            state_names: spec.state_names.clone(),
-            action_dim: spec.action_dim(),
-            dt: spec.dt,
-        },
+        meta: meta(&spec, settings.seed, &settings.command_line, vec![env.params()], DatasetLayout::Rollouts),
         steps,
     })
+}
+
+/// Parses `--init-state`: comma-separated finite numbers, one per state dimension.
+pub fn parse_state(text: &str, spec: &EnvSpec) -> Result<Vec<f64>> {
+    let state = text
+        .split(',')
+        .map(|field| {
+            let field = field.trim();
+            field.parse::<f64>().map_err(|_| {
+                Error::config(format!(
+                    "--init-state: '{field}' is not a number; expected {} for {}",
+                    spec.state_names.join(","),
+                    spec.name
+                ))
+            })
+        })
+        .collect::<Result<Vec<f64>>>()?;
+    check_state(spec, &state)?;
+    Ok(state)
+}
+
+fn check_state(spec: &EnvSpec, state: &[f64]) -> Result<()> {
+    let expected =
+        || format!("expected {} finite numbers ({}) for {}", spec.state_dim(), spec.state_names.join(","), spec.name);
+    if state.len() != spec.state_dim() {
+        return Err(Error::config(format!("--init-state has {} value(s); {}", state.len(), expected())));
+    }
+    if let Some(bad) = state.iter().find(|x| !x.is_finite()) {
+        return Err(Error::config(format!("--init-state: {bad} is not finite; {}", expected())));
+    }
+    Ok(())
+}
+
+fn random_rollout(env: &mut dyn Env, spec: &EnvSpec, rng: &mut ChaCha8Rng, steps: usize) -> Rollout {
+    let obs = env.reset(rng);
+    let mut rollout = Rollout::start(env.state(), obs);
+    for _ in 0..steps {
+        let action: Vec<f64> =
+            spec.action_low.iter().zip(&spec.action_high).map(|(&lo, &hi)| rng.random_range(lo..=hi)).collect();
+        let step = env.step(&action);
+        rollout.push(action, step.reward, env.state(), step.obs);
+        if step.done {
+            break;
+        }
+    }
+    rollout
+}
+
+/// Observations are stored only where they differ from the state (see datasets/README.md).
+fn timesteps<'a>(spec: &EnvSpec, rollout: &'a Rollout, id: u32) -> impl Iterator<Item = Timestep> + 'a {
+    let keep_obs = spec.obs_names != spec.state_names;
+    rollout.timesteps(id).map(move |mut step| {
+        if !keep_obs {
+            (step.obs, step.next_obs) = (None, None);
+        }
+        step
+    })
+}
+
+fn meta(
+    spec: &EnvSpec,
+    seed: u64,
+    command_line: &str,
+    instances: Vec<serde_json::Value>,
+    layout: DatasetLayout,
+) -> DatasetMeta {
+    DatasetMeta {
+        format_version: FORMAT_VERSION,
+        env: spec.name.clone(),
+        seed,
+        mbrl_version: crate::VERSION.to_string(),
+        command_line: command_line.to_string(),
+        instances,
+        state_names: spec.state_names.clone(),
+        action_dim: spec.action_dim(),
+        dt: spec.dt,
+        layout,
+    }
+}
+
+/// A transition in memory: the struct, its vectors' heap blocks, and the f64s in them.
+fn check_size(spec: &EnvSpec, rollouts: usize, steps: usize, flags: &str) -> Result<()> {
+    let values = 2 * spec.state_dim() + spec.action_dim() + 2 * spec.obs_names.len();
+    let per_step = (std::mem::size_of::<Timestep>() + 5 * 16 + 8 * values) as f64;
+    let bytes = rollouts as f64 * steps as f64 * per_step;
+    if bytes > MAX_DATASET_BYTES {
+        return Err(Error::Budget(format!(
+            "{flags} would hold about {:.0} GiB in memory; the limit is {:.0} GiB: collect in several files",
+            bytes / (1u64 << 30) as f64,
+            MAX_DATASET_BYTES / (1u64 << 30) as f64
+        )));
+    }
+    Ok(())
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::data::instance_pairs;
     use crate::envs::parse_env;
     use crate::run::NullMonitor;
 
@@ -84,5 +252,114 @@ mod tests {
         assert_ne!(a.meta.instances[0], a.meta.instances[1], "each rollout draws its own instance");
         assert!(a.steps.iter().all(|s| s.action[0].abs() <= 2.0 && s.state[1].abs() <= 8.0));
         assert_eq!(a, collect_random(&settings, &NullMonitor).unwrap());
+    }
+
+    fn collect_pairs(env: &str, instances: usize, seed: u64) -> Dataset {
+        let settings = InstancePairSettings {
+            env: parse_env(env).unwrap(),
+            instances,
+            steps: 15,
+            seed,
+            command_line: "test".into(),
+        };
+        collect_instance_pairs(&settings, &NullMonitor).unwrap()
+    }
+
+    #[test]
+    fn instance_pairs_share_parameters_but_not_starts_or_actions() {
+        for env in ["toy:outer", "mountaincar", "pendulum:quadrant"] {
+            let data = collect_pairs(env, 3, 2);
+            assert_eq!(data.meta.layout, DatasetLayout::InstancePairs);
+            assert_eq!(data.meta.instances.len(), 6);
+            assert_ne!(data.meta.instances[0], data.meta.instances[2], "{env}: instances differ");
+            let pairs = instance_pairs(&data).unwrap();
+            for (k, (a, b)) in pairs.iter().enumerate() {
+                assert_eq!(data.meta.instances[2 * k], data.meta.instances[2 * k + 1]);
+                assert_eq!((a.len(), b.len()), (15, 15));
+                assert_ne!(a.states[0], b.states[0], "{env}: own start states");
+                assert_ne!(a.actions, b.actions, "{env}: own actions");
+            }
+            assert_eq!(data, collect_pairs(env, 3, 2), "{env}: seeded");
+        }
+    }
+
+    #[test]
+    fn pair_instances_are_the_ones_their_instance_seed_names() {
+        let data = collect_pairs("toy:inner", 2, 9);
+        let env = parse_env("toy:inner").unwrap();
+        let replayed = instance_env(&env, pair_instance_seed(9, 1)).unwrap().params();
+        assert_eq!(data.meta.instances[2], replayed);
+    }
+
+    #[test]
+    fn state_only_envs_store_no_duplicate_observations() {
+        let data = collect_pairs("mountaincar", 1, 0);
+        assert!(data.steps.iter().all(|s| s.obs.is_none() && s.next_obs.is_none()));
+        let data = collect_pairs("pendulum", 1, 0);
+        assert!(data.steps.iter().all(|s| s.obs.as_ref().is_some_and(|o| o.len() == 3)));
+    }
+
+    fn replay_settings(env: &str, actions: Vec<Vec<f64>>, init_state: Option<Vec<f64>>) -> ReplaySettings {
+        ReplaySettings {
+            env: parse_env(env).unwrap(),
+            actions,
+            init_state,
+            instance_seed: Some(4),
+            seed: 1,
+            command_line: "test".into(),
+        }
+    }
+
+    #[test]
+    fn replay_follows_the_given_actions_from_the_given_state() {
+        let actions: Vec<Vec<f64>> = (0..10).map(|t| vec![(t as f64 - 4.5) * 0.5]).collect();
+        let data = replay(&replay_settings("mountaincar", actions.clone(), Some(vec![0.1, -0.5]))).unwrap();
+        assert_eq!(data.steps.iter().map(|s| s.action.clone()).collect::<Vec<_>>(), actions);
+        assert_eq!(data.steps[0].state, vec![0.1, -0.5]);
+        let mut env = instance_env(&parse_env("mountaincar").unwrap(), 4).unwrap();
+        assert_eq!(data.meta.instances, vec![env.params()]);
+        env.set_state(&[0.1, -0.5]);
+        for step in &data.steps {
+            assert_eq!(env.step(&step.action).obs, step.next_state);
+        }
+    }
+
+    #[test]
+    fn replay_noise_follows_the_seed() {
+        let actions = vec![vec![1.5]; 5];
+        let run = |seed| {
+            replay(&ReplaySettings { seed, ..replay_settings("toy:outer", actions.clone(), Some(vec![0.0, 0.0])) })
+        };
+        assert_eq!(run(1).unwrap(), run(1).unwrap());
+        assert_ne!(run(1).unwrap().steps, run(2).unwrap().steps);
+    }
+
+    #[test]
+    fn bad_start_states_are_explained() {
+        let spec = parse_env("pendulum").unwrap().build().unwrap().spec();
+        assert_eq!(parse_state("3.1, -0.5", &spec).unwrap(), vec![3.1, -0.5]);
+        let err = parse_state("1,2,3", &spec).unwrap_err().to_string();
+        assert!(err.contains("3 value(s)") && err.contains("theta,theta_dot"), "{err}");
+        let err = parse_state("1,nan", &spec).unwrap_err().to_string();
+        assert!(err.contains("NaN is not finite"), "{err}");
+        let err = parse_state("1,x", &spec).unwrap_err().to_string();
+        assert!(err.contains("'x' is not a number"), "{err}");
+        let err = replay(&replay_settings("pendulum", vec![vec![0.0]], Some(vec![1.0]))).unwrap_err().to_string();
+        assert!(err.contains("--init-state has 1 value(s)"), "{err}");
+        let err = replay(&replay_settings("pendulum", vec![vec![0.0, 1.0]], None)).unwrap_err().to_string();
+        assert!(err.contains("action 0 has 2 value(s)"), "{err}");
+    }
+
+    #[test]
+    fn oversized_collections_are_refused_before_allocating() {
+        let settings = InstancePairSettings {
+            env: parse_env("toy:inner").unwrap(),
+            instances: 1 << 40,
+            steps: 100,
+            seed: 0,
+            command_line: "test".into(),
+        };
+        let err = collect_instance_pairs(&settings, &NullMonitor).unwrap_err();
+        assert!(matches!(err, Error::Budget(_)) && err.to_string().contains("--instances"), "{err}");
     }
 }

@@ -7,13 +7,47 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use super::mcap_io::{check_version, read_messages, write_messages, Layout};
-use super::rollout::Timestep;
+use super::rollout::{Rollout, Timestep};
 use super::schema::{TIMESTEP_SCHEMA, TIMESTEP_SCHEMA_NAME, TIMESTEP_TOPIC};
 use crate::error::{Error, Result};
 
 /// Version of the on-disk layout; readers reject any other.
 pub const FORMAT_VERSION: u32 = 1;
 pub const METADATA_NAME: &str = "mbrl.dataset";
+
+/// How a dataset's rollouts relate to each other.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum DatasetLayout {
+    /// Independent rollouts (metadata `layout` = `rollouts`, or no `layout` key: files made before it existed).
+    #[default]
+    Rollouts,
+    /// Two rollouts per hidden-parameter instance k: id 2k is the target rollout, id 2k+1 the context source,
+    /// both of the same instance with their own start states and actions (metadata `layout` = `instance-pairs`).
+    InstancePairs,
+}
+
+impl DatasetLayout {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            DatasetLayout::Rollouts => "rollouts",
+            DatasetLayout::InstancePairs => "instance-pairs",
+        }
+    }
+
+    fn parse(path: &Path, text: &str) -> Result<Self> {
+        match text {
+            "rollouts" => Ok(DatasetLayout::Rollouts),
+            "instance-pairs" => Ok(DatasetLayout::InstancePairs),
+            other => Err(Error::bad_file(
+                path,
+                format!(
+                    "metadata field 'layout': '{other}' is not a known layout; expected rollouts or instance-pairs"
+                ),
+            )),
+        }
+    }
+}
 
 /// What the metadata record says about a dataset.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -29,6 +63,8 @@ pub struct DatasetMeta {
     pub action_dim: usize,
     /// Simulated seconds between timesteps.
     pub dt: f64,
+    #[serde(default)]
+    pub layout: DatasetLayout,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -49,6 +85,7 @@ impl DatasetMeta {
             ("state_names".to_string(), to_json(&self.state_names)),
             ("action_dim".to_string(), self.action_dim.to_string()),
             ("dt".to_string(), format!("{:?}", self.dt)),
+            ("layout".to_string(), self.layout.as_str().to_string()),
         ])
     }
 
@@ -72,6 +109,10 @@ impl DatasetMeta {
                 .map_err(|_| parse_err("state_names", "a JSON array of strings"))?,
             action_dim: field("action_dim")?.parse().map_err(|_| parse_err("action_dim", "an integer"))?,
             dt: field("dt")?.parse().map_err(|_| parse_err("dt", "a number"))?,
+            layout: match record.get("layout") {
+                Some(text) => DatasetLayout::parse(path, text)?,
+                None => DatasetLayout::Rollouts,
+            },
         })
     }
 }
@@ -104,7 +145,69 @@ pub fn read_dataset(path: &Path) -> Result<Dataset> {
         validate_step(path, &meta, &step, sequence)?;
         steps.push(step);
     }
-    Ok(Dataset { meta, steps })
+    let data = Dataset { meta, steps };
+    if data.meta.layout == DatasetLayout::InstancePairs {
+        pair_up(&data).map_err(|e| Error::bad_file(path, e))?;
+    }
+    Ok(data)
+}
+
+/// The (target, context-source) rollouts of each instance of an `instance-pairs` dataset, by instance.
+pub fn instance_pairs(data: &Dataset) -> Result<Vec<(Rollout, Rollout)>> {
+    if data.meta.layout != DatasetLayout::InstancePairs {
+        return Err(Error::data(format!(
+            "dataset of {} has layout '{}', not instance pairs; collect one with `mbrl collect --instances N`",
+            data.meta.env,
+            data.meta.layout.as_str()
+        )));
+    }
+    pair_up(data).map_err(Error::data)
+}
+
+/// Checks the pairing rules and groups the rollouts; the error says what is wrong, the caller adds where.
+fn pair_up(data: &Dataset) -> std::result::Result<Vec<(Rollout, Rollout)>, String> {
+    let rule = "layout 'instance-pairs'";
+    let grouped = Rollout::group(&data.steps).map_err(|i| {
+        let s = &data.steps[i];
+        format!("{rule}: message {i} (rollout {}, t {}) does not continue its rollout", s.rollout, s.t)
+    })?;
+    let expected_rollouts = data.meta.instances.len();
+    if !expected_rollouts.is_multiple_of(2) {
+        return Err(format!(
+            "{rule}: 'instances' has {expected_rollouts} entries; expected two (equal) entries per instance"
+        ));
+    }
+    for (position, (id, _)) in grouped.iter().enumerate() {
+        if *id as usize != position {
+            return Err(format!(
+                "{rule}: rollout {position} (instance {}) is missing or out of order (found rollout {id} there)",
+                position / 2
+            ));
+        }
+    }
+    if grouped.len() != expected_rollouts {
+        let missing = grouped.len();
+        return Err(format!(
+            "{rule}: instance {} lacks its {} rollout {missing}; expected {expected_rollouts} rollouts for {} instances",
+            missing / 2,
+            if missing % 2 == 0 { "target" } else { "context-source" },
+            expected_rollouts / 2
+        ));
+    }
+    let mut pairs = Vec::with_capacity(grouped.len() / 2);
+    let mut rollouts = grouped.into_iter().map(|(_, r)| r);
+    for (k, params) in data.meta.instances.chunks(2).enumerate() {
+        if params[0] != params[1] {
+            return Err(format!(
+                "{rule}: instance {k} has different parameters for rollouts {} and {}",
+                2 * k,
+                2 * k + 1
+            ));
+        }
+        let (a, b) = (rollouts.next(), rollouts.next());
+        pairs.push((a.unwrap_or_default(), b.unwrap_or_default()));
+    }
+    Ok(pairs)
 }
 
 fn validate_step(path: &Path, meta: &DatasetMeta, step: &Timestep, sequence: u32) -> Result<()> {
@@ -147,6 +250,7 @@ mod tests {
                 state_names: vec!["theta".into(), "theta_dot".into()],
                 action_dim: 1,
                 dt: 0.05,
+                layout: DatasetLayout::Rollouts,
             },
             steps: r.timesteps(0).collect(),
         }
@@ -157,6 +261,18 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("d.mcap");
         let data = tiny_dataset();
+        write_dataset(&path, &data).unwrap();
+        assert_eq!(read_dataset(&path).unwrap(), data);
+    }
+
+    #[test]
+    fn floats_round_trip_to_the_last_bit() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("f.mcap");
+        let mut data = tiny_dataset();
+        // Needs serde_json's float_roundtrip: its default parser can be one ulp off for values like these.
+        data.steps[0].next_state = vec![-0.46664908355164947, 1.0 / 3.0];
+        data.steps[1].state = data.steps[0].next_state.clone();
         write_dataset(&path, &data).unwrap();
         assert_eq!(read_dataset(&path).unwrap(), data);
     }
@@ -190,5 +306,77 @@ mod tests {
         write_dataset(&path, &data).unwrap();
         let err = read_dataset(&path).unwrap_err().to_string();
         assert!(err.contains("format version 9 is not supported"), "{err}");
+    }
+
+    fn paired(instances: usize) -> Dataset {
+        let mut data = tiny_dataset();
+        data.meta.layout = DatasetLayout::InstancePairs;
+        data.meta.instances = (0..instances).flat_map(|k| vec![serde_json::json!({"alpha": k}); 2]).collect();
+        let one = Rollout::group(&data.steps).unwrap().remove(0).1;
+        data.steps = (0..2 * instances as u32).flat_map(|id| one.timesteps(id).collect::<Vec<_>>()).collect();
+        data
+    }
+
+    fn write_with_layout(path: &Path, data: &Dataset, layout_value: Option<&str>) {
+        let mut record = data.meta.to_record();
+        match layout_value {
+            Some(v) => record.insert("layout".into(), v.into()),
+            None => record.remove("layout"),
+        };
+        write_messages(path, &layout(&data.meta), record, &data.steps).unwrap();
+    }
+
+    #[test]
+    fn files_without_a_layout_read_as_plain_rollouts() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("old.mcap");
+        write_with_layout(&path, &tiny_dataset(), None);
+        assert_eq!(read_dataset(&path).unwrap().meta.layout, DatasetLayout::Rollouts);
+    }
+
+    #[test]
+    fn unknown_layout_is_named() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("odd.mcap");
+        write_with_layout(&path, &tiny_dataset(), Some("triples"));
+        let err = read_dataset(&path).unwrap_err().to_string();
+        assert!(err.contains("odd.mcap") && err.contains("'triples'") && err.contains("instance-pairs"), "{err}");
+    }
+
+    #[test]
+    fn instance_pairs_round_trip_and_pair_up() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("pairs.mcap");
+        let data = paired(3);
+        write_dataset(&path, &data).unwrap();
+        let back = read_dataset(&path).unwrap();
+        assert_eq!(back, data);
+        let pairs = instance_pairs(&back).unwrap();
+        assert_eq!(pairs.len(), 3);
+        assert_eq!(pairs[2].0.len(), 2);
+        assert!(instance_pairs(&tiny_dataset()).unwrap_err().to_string().contains("--instances"));
+    }
+
+    #[test]
+    fn a_missing_context_rollout_is_reported_with_the_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("half.mcap");
+        let mut data = paired(2);
+        data.steps.retain(|s| s.rollout != 3);
+        write_dataset(&path, &data).unwrap();
+        let err = read_dataset(&path).unwrap_err().to_string();
+        assert!(err.contains("half.mcap") && err.contains("instance 1") && err.contains("context-source"), "{err}");
+
+        let mut data = paired(2);
+        data.meta.instances[3] = serde_json::json!({"alpha": 9});
+        write_dataset(&path, &data).unwrap();
+        let err = read_dataset(&path).unwrap_err().to_string();
+        assert!(err.contains("instance 1 has different parameters"), "{err}");
+
+        let mut data = paired(2);
+        data.steps.retain(|s| s.rollout != 1);
+        write_dataset(&path, &data).unwrap();
+        let err = read_dataset(&path).unwrap_err().to_string();
+        assert!(err.contains("rollout 1 (instance 0) is missing"), "{err}");
     }
 }

@@ -1,5 +1,6 @@
 //! Rollouts and datasets on disk.
 
+pub mod actions_csv;
 pub mod ball_estimates;
 #[cfg(feature = "hdf5")]
 pub mod ball_hdf5;
@@ -12,5 +13,5 @@ pub mod mcap_io;
 pub mod rollout;
 pub mod schema;
 
-pub use dataset::{read_dataset, write_dataset, Dataset, DatasetMeta, FORMAT_VERSION};
+pub use dataset::{instance_pairs, read_dataset, write_dataset, Dataset, DatasetLayout, DatasetMeta, FORMAT_VERSION};
 pub use rollout::{Rollout, Timestep};

@@ -4,13 +4,15 @@
 pub mod ball;
 pub mod boards;
 pub mod embodiments;
+pub mod mountaincar;
 pub mod pendulum;
 pub mod registry;
+pub mod toy;
 
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
-pub use registry::{parse_env, EnvName};
+pub use registry::{instance_env, parse_env, EnvName, INSTANCE_STREAM};
 
 /// Names, sizes and bounds of an environment.
 #[derive(Clone, Debug, PartialEq)]

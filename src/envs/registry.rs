@@ -2,15 +2,27 @@
 
 use super::boards::spec::GAME_HELP;
 use super::boards::GameSpec;
+use super::mountaincar::MountainCar;
 use super::pendulum::{Pendulum, PendulumVariant};
+use super::toy::{Squash, Toy};
 use super::Env;
 use crate::error::{Error, Result};
+use crate::util::seeding::rng_for;
 
-pub const KNOWN_ENVS: &str = "pendulum[:light|heavy|mass=<m>|inverted|quadrant], lightsout[:<n>x<n>], tileswap, ball";
+pub const KNOWN_ENVS: &str =
+    "pendulum[:light|heavy|mass=<m>|inverted|quadrant], toy:inner|outer, mountaincar, lightsout[:<n>x<n>], tileswap, ball";
+
+/// The random stream, under an instance seed, that draws an instance's hidden parameters. Fixed forever:
+/// changing it would change which instance every recorded `--instance-seed` names.
+pub const INSTANCE_STREAM: u64 = u64::from_be_bytes(*b"instance");
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum EnvName {
     Pendulum(PendulumVariant),
+    /// The linear toy system of Explore the Context (eq. 4.40) with its action squashing.
+    Toy(Squash),
+    /// MountainCar over random Gaussian-bump terrain (eq. 4.41).
+    MountainCar,
     /// A board game on its own: board sets and symbolic planning, no simulator to step.
     Board(GameSpec),
     /// The table-tennis ball simulator: recorded as camera trajectories, not stepped by actions.
@@ -21,6 +33,8 @@ pub fn parse_env(name: &str) -> Result<EnvName> {
     let (family, variant) = name.split_once(':').unwrap_or((name, ""));
     match family {
         "pendulum" => Ok(EnvName::Pendulum(PendulumVariant::parse(variant)?)),
+        "toy" => Ok(EnvName::Toy(Squash::parse(variant)?)),
+        "mountaincar" if variant.is_empty() => Ok(EnvName::MountainCar),
         "lightsout" | "tileswap" => Ok(EnvName::Board(GameSpec::parse(name)?)),
         "ball" if variant.is_empty() => Ok(EnvName::Ball),
         _ => Err(Error::config(format!("unknown env '{name}'; supported: {KNOWN_ENVS}"))),
@@ -33,6 +47,8 @@ impl EnvName {
     pub fn build(&self) -> Result<Box<dyn Env>> {
         match self {
             EnvName::Pendulum(v) => Ok(Box::new(Pendulum::new(v.clone()))),
+            EnvName::Toy(squash) => Ok(Box::new(Toy::new(*squash))),
+            EnvName::MountainCar => Ok(Box::new(MountainCar::new())),
             EnvName::Board(g) => Err(Error::config(format!(
                 "'{}' is a board game, not a simulator to roll out; use `mbrl collect --env {} --boards --max-depth D` \
                  for board sets (games: {GAME_HELP})",
@@ -50,17 +66,29 @@ impl EnvName {
         match self {
             EnvName::Pendulum(v) => super::pendulum::dynamics::PendulumReward::for_params(&v.fixed_params())
                 .map(|r| Box::new(r) as Box<dyn super::RewardFn>),
-            EnvName::Board(_) | EnvName::Ball => None,
+            // The toy has no task; MountainCar's reward depends on the hidden terrain.
+            EnvName::Toy(_) | EnvName::MountainCar | EnvName::Board(_) | EnvName::Ball => None,
         }
     }
 
     pub fn canonical(&self) -> String {
         match self {
             EnvName::Pendulum(v) => v.env_name(),
+            EnvName::Toy(squash) => format!("toy:{}", squash.name()),
+            EnvName::MountainCar => "mountaincar".into(),
             EnvName::Board(g) => g.name(),
             EnvName::Ball => "ball".into(),
         }
     }
+}
+
+/// The simulator for `env` with the hidden parameters that `instance_seed` names. Every subcommand that takes
+/// `--instance-seed` goes through here, so one seed means one instance everywhere. Fixed environments
+/// (plain pendulum and its fixed variants) ignore the seed.
+pub fn instance_env(env: &EnvName, instance_seed: u64) -> Result<Box<dyn Env>> {
+    let mut sim = env.build()?;
+    sim.sample_instance(&mut rng_for(instance_seed, &[INSTANCE_STREAM]));
+    Ok(sim)
 }
 
 #[cfg(test)]
@@ -81,11 +109,36 @@ mod tests {
             "pendulum:heavy",
             "pendulum:inverted",
             "pendulum:quadrant",
+            "toy:inner",
+            "toy:outer",
+            "mountaincar",
             "lightsout",
             "lightsout:7x7",
             "tileswap",
         ] {
             assert_eq!(parse_env(name).unwrap().canonical(), name);
         }
+    }
+
+    #[test]
+    fn instance_seed_names_one_instance() {
+        for name in ["toy:inner", "mountaincar", "pendulum:quadrant"] {
+            let env = parse_env(name).unwrap();
+            let params = |seed| instance_env(&env, seed).unwrap().params();
+            assert_eq!(params(4), params(4), "{name}");
+            assert_ne!(params(4), params(5), "{name}");
+        }
+        let plain = parse_env("pendulum").unwrap();
+        assert_eq!(instance_env(&plain, 4).unwrap().params(), plain.build().unwrap().params());
+    }
+
+    #[test]
+    fn bare_toy_and_mountaincar_variants_are_explained() {
+        let err = parse_env("toy").unwrap_err().to_string();
+        assert!(err.contains("toy:inner"), "{err}");
+        let err = parse_env("mountaincar:steep").unwrap_err().to_string();
+        assert!(err.contains("mountaincar:steep") && err.contains("toy:inner|outer"), "{err}");
+        assert!(parse_env("toy:inner").unwrap().known_reward().is_none());
+        assert!(parse_env("mountaincar").unwrap().known_reward().is_none());
     }
 }

@@ -2,6 +2,7 @@
 
 pub mod ball;
 pub mod boards;
+pub mod context;
 pub mod dataset_report;
 pub mod plot;
 pub mod quick;

@@ -7,7 +7,7 @@ use serde::Serialize;
 
 use super::plot::{histogram, line_plot, Series};
 use super::stats::{mean, quantile};
-use crate::data::{write_dataset, Dataset, DatasetMeta, Rollout, FORMAT_VERSION};
+use crate::data::{write_dataset, Dataset, DatasetLayout, DatasetMeta, Rollout, FORMAT_VERSION};
 use crate::envs::pendulum::{angle_normalize, Pendulum, PendulumVariant, StartDistribution};
 use crate::envs::{BatchDynamics, Env};
 use crate::error::Result;
@@ -33,6 +33,8 @@ pub struct SwingupSettings {
     pub variant: PendulumVariant,
     pub cem: CemConfig,
     pub steps: usize,
+    /// Plan in the instance this seed names (`--instance-seed`) instead of drawing one per episode.
+    pub instance_seed: Option<u64>,
 }
 
 fn serialize_variant<S: serde::Serializer>(v: &PendulumVariant, s: S) -> std::result::Result<S::Ok, S::Error> {
@@ -44,7 +46,7 @@ impl SwingupSettings {
     pub fn thesis(variant: PendulumVariant) -> Self {
         let params = variant.fixed_params();
         let cem = CemConfig::for_box(&[-params.max_torque], &[params.max_torque]);
-        SwingupSettings { variant, cem, steps: 150 }
+        SwingupSettings { variant, cem, steps: 150, instance_seed: None }
     }
 }
 
@@ -97,6 +99,13 @@ pub fn run_episode(
     let mut env = Pendulum::new(settings.variant.clone()).with_start(StartDistribution::Hanging);
     let mut rng = rng_for(seed, &[episode, 0]);
     env.sample_instance(&mut rng);
+    if let Some(instance_seed) = settings.instance_seed {
+        let named =
+            crate::envs::instance_env(&crate::envs::EnvName::Pendulum(settings.variant.clone()), instance_seed)?;
+        let params = serde_json::from_value(named.params())
+            .map_err(|e| crate::error::Error::config(format!("instance {instance_seed}: {e}")))?;
+        env.set_params(params);
+    }
     env.reset(&mut rng);
     let truth = env.pendulum_dynamics();
     let model: &dyn BatchDynamics = match model {
@@ -153,6 +162,7 @@ pub fn episodes_dataset(
             state_names: spec.state_names.clone(),
             action_dim: spec.action_dim(),
             dt: spec.dt,
+            layout: DatasetLayout::Rollouts,
         },
         steps: episodes.iter().flat_map(|e| e.rollout.timesteps(e.episode as u32)).collect(),
     }

@@ -1,4 +1,5 @@
 pub mod ball;
+pub mod context;
 pub mod pets;
 
 use std::path::Path;
@@ -8,14 +9,16 @@ use crate::error::{Error, Result};
 use crate::train::OpenedCheckpoint;
 
 /// How a stochastic learned model is rolled out by planners.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct RolloutOptions {
     pub propagation: pets::Propagation,
     pub particles: usize,
+    /// Calibration transitions to condition a context model on (`None`: the empty context, the prior mean).
+    pub context: Option<std::path::PathBuf>,
 }
 
 /// The methods whose checkpoints `plan` can plan with.
-pub const PLANNING_METHODS: &str = "pets";
+pub const PLANNING_METHODS: &str = "pets, context";
 
 /// A trained model from its checkpoint directory, as dynamics for a planner in `env`. Which method made it is
 /// read from the checkpoint, so callers never branch on methods.
@@ -28,7 +31,23 @@ pub fn load_planning_model(dir: &Path, env: &EnvName, options: RolloutOptions) -
     }
     let method = OpenedCheckpoint::open(dir)?.manifest.method;
     match method.as_str() {
-        pets::METHOD => Ok(Box::new(pets::load_dynamics(dir, env, options.propagation, options.particles)?)),
+        pets::METHOD => {
+            if let Some(path) = &options.context {
+                return Err(Error::bad_file(
+                    path,
+                    format!("--context conditions context models; {} is a PETS ensemble", dir.display()),
+                ));
+            }
+            Ok(Box::new(pets::load_dynamics(dir, env, options.propagation, options.particles)?))
+        }
+        context::METHOD => {
+            let model = context::load(dir, env)?;
+            let rows = match &options.context {
+                Some(path) => context::calibration::read_context(&model, path)?,
+                None => Vec::new(),
+            };
+            Ok(Box::new(context::dynamics::ContextDynamics::new(model, &rows, env)?))
+        }
         other => Err(Error::bad_file(
             dir,
             format!(

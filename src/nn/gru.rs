@@ -52,9 +52,19 @@ impl GruCell {
     /// r = σ(W_ir x + b_ir + W_hr h + b_hr), z = σ(… z …), n = tanh(W_in x + b_in + r ⊙ (W_hn h + b_hn)),
     /// h' = (1 − z) ⊙ n + z ⊙ h.
     pub fn forward(&self, x: Tensor<2>, h: Tensor<2>) -> Tensor<2> {
+        self.step_from_input_gates(self.input_gates(x), h)
+    }
+
+    /// W_ih x + b_ih: [rows, 3H]. A sequence's inputs are all known before the recurrence runs, so their gates
+    /// are one large matmul instead of one small one per step.
+    pub fn input_gates(&self, x: Tensor<2>) -> Tensor<2> {
+        x.matmul(self.weight_ih.val().transpose()) + self.bias_ih.val().unsqueeze::<2>()
+    }
+
+    /// One step from precomputed input gates `gi` ([batch, 3H], from [`Self::input_gates`]).
+    pub fn step_from_input_gates(&self, gi: Tensor<2>, h: Tensor<2>) -> Tensor<2> {
         let hidden = self.hidden_size();
-        let batch = x.dims()[0];
-        let gi = x.matmul(self.weight_ih.val().transpose()) + self.bias_ih.val().unsqueeze::<2>();
+        let batch = gi.dims()[0];
         let gh = h.clone().matmul(self.weight_hh.val().transpose()) + self.bias_hh.val().unsqueeze::<2>();
         let gate = |t: &Tensor<2>, k: usize| t.clone().slice([0..batch, k * hidden..(k + 1) * hidden]);
         let r = sigmoid(gate(&gi, 0) + gate(&gh, 0));

@@ -82,6 +82,24 @@ impl RewardFn for PendulumReward {
     }
 }
 
+/// gym's cost of the pre-step state and the commanded action, counted once per simulator step of an action
+/// repeat: the swing-up objective a planner uses where the true reward depends on hidden parameters (the
+/// quadrant family scales the torque, and its repeat's second state is never observed). A surrogate, named so
+/// in reports; the environment's own reward is what episodes are scored by.
+#[derive(Clone, Debug)]
+pub struct NominalPendulumReward {
+    pub max_torque: f64,
+    pub action_repeat: usize,
+}
+
+impl RewardFn for NominalPendulumReward {
+    fn reward(&self, state: &[f64], action: &[f64], _next_state: &[f64]) -> f64 {
+        let torque = action[0].clamp(-self.max_torque, self.max_torque);
+        let cost = angle_normalize(state[0]).powi(2) + 0.1 * state[1].powi(2) + 0.001 * torque.powi(2);
+        -cost * self.action_repeat as f64
+    }
+}
+
 #[cfg(test)]
 mod reward_tests {
     use super::*;

@@ -1,0 +1,90 @@
+//! Explore the Context: one training step (batch 64 and 512 × 50-state chunks, the thesis network), one
+//! 1000-candidate × 20-step mean rollout on the fast path (the unit PyTorch's 7.3 batches/s refers to), one
+//! CEM iteration of EIG calibration (1000 candidates × 20 β samples × horizon 20) and one MPC step on the
+//! calibrated model (1000 × 20 × 10 iterations). PyTorch figures: benches/pytorch/context_reference.py.
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use mbrl::models::context::config::{ContextConfig, EnvFamily, Preset};
+use mbrl::models::context::data::{ContextData, Episode, InstancePair};
+use mbrl::models::context::eig::EigObjective;
+use mbrl::models::context::fast::{FastContextModel, RolloutScratch};
+use mbrl::models::context::net::{param_name, ContextNet};
+use mbrl::models::context::ContextTrainer;
+use mbrl::nn::tensor::inference_device;
+use mbrl::nn::ParamSet;
+use mbrl::planning::Objective;
+use mbrl::train::TrainingMethod;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+const STATE: usize = 3;
+const ACTION: usize = 1;
+
+/// Random pendulum-shaped rollout pairs (speed does not depend on what the numbers mean).
+fn data(instances: usize, len: usize) -> ContextData {
+    let mut rng = ChaCha8Rng::seed_from_u64(1);
+    let mut episode = || Episode {
+        states: (0..(len + 1) * STATE).map(|_| rng.random_range(-1.0..1.0)).collect(),
+        actions: (0..len * ACTION).map(|_| rng.random_range(-2.0..2.0)).collect(),
+        len,
+    };
+    let pairs = (0..instances).map(|_| InstancePair { target: episode(), source: episode() }).collect();
+    ContextData { state_dim: STATE, action_dim: ACTION, pairs }
+}
+
+fn paper_config(batch: usize) -> ContextConfig {
+    let mut c = ContextConfig::preset(Preset::Paper, EnvFamily::Control);
+    c.batch_size = batch;
+    c
+}
+
+fn train_step(c: &mut Criterion) {
+    let mut group = c.benchmark_group("context_train_step_50_states");
+    group.sample_size(10);
+    for batch in [64, 512] {
+        let mut trainer = ContextTrainer::new(paper_config(batch), 0, data(200, 100), data(0, 100)).unwrap();
+        let mut step = 0;
+        group.bench_function(format!("batch_{batch}"), |b| {
+            b.iter(|| {
+                step += 1;
+                trainer.step(step).unwrap()
+            })
+        });
+    }
+    group.finish();
+}
+
+fn model() -> FastContextModel {
+    let config = paper_config(64);
+    let net = ContextNet::init(&config, STATE, ACTION, &inference_device(), &mut ChaCha8Rng::seed_from_u64(2));
+    FastContextModel::from_params(&ParamSet::<f32>::from_module(&net, param_name)).unwrap()
+}
+
+fn planning(c: &mut Criterion) {
+    let fast = model();
+    let (candidates, horizon) = (1000, 20);
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    let actions64: Vec<f64> = (0..candidates * horizon).map(|_| rng.random_range(-2.0..2.0)).collect();
+    let actions: Vec<f32> = actions64.iter().map(|x| *x as f32).collect();
+    let init = vec![-1.0, 0.0, 0.0];
+    let betas: Vec<f32> = (0..candidates * fast.latent_dim).map(|_| rng.random_range(-1.0..1.0)).collect();
+
+    let mut group = c.benchmark_group("context_planning");
+    group.sample_size(10);
+    group.throughput(Throughput::Elements((candidates * horizon) as u64));
+    group.bench_function("rollout_1000x20_mean_one_thread", |b| {
+        let mut out = vec![0.0; candidates * horizon * STATE];
+        let mut scratch = RolloutScratch::default();
+        b.iter(|| fast.rollout_means(&init, &actions, &betas, candidates, horizon, &mut out, &mut scratch))
+    });
+    group.throughput(Throughput::Elements((candidates * horizon * 20) as u64));
+    group.bench_function("eig_cem_iteration_1000x20_beta20", |b| {
+        let objective = EigObjective::new(&fast, init.clone(), vec![0.0; fast.transition_features], 20, 4);
+        let mut costs = vec![0.0; candidates];
+        b.iter(|| objective.costs(&actions64, horizon, &mut costs))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, train_step, planning);
+criterion_main!(benches);

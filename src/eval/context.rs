@@ -1,0 +1,419 @@
+//! `mbrl eval context`: the protocol of thesis 4.5 at a chosen scale. Per context (an unseen instance):
+//! random validation rollouts, then random / open-loop / MPC calibration from one shared start, each giving a
+//! context set; the model conditioned on it (context mean) predicts the validation rollouts open loop. Reports
+//! the prediction MSE against the horizon, paired Wilcoxon signed-rank tests between strategies, the
+//! entropy after calibration, quadrants visited (pendulum) and, for the toy, the entropy after one transition
+//! as a function of the action (Fig. 4.4a).
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use rand::Rng;
+use serde::Serialize;
+
+use super::plot::{line_plot, Series};
+use super::stats::{mean, wilcoxon_signed_rank, Alternative};
+use crate::data::Rollout;
+use crate::envs::{instance_env, EnvName};
+use crate::error::{Error, Result};
+use crate::models::context::calibration::{
+    context_rows, run_calibration, CalibrationRequest, CalibrationSettings, Strategy,
+};
+use crate::models::context::fast::{gaussian_entropy, RolloutScratch};
+use crate::models::context::LoadedModel;
+use crate::run::dir::{Provenance, RunDir};
+use crate::run::{Event, Monitor, PanelSpec, Tee};
+use crate::util::atomic::write_text;
+use crate::util::seeding::{derive_seed, rng_for};
+use crate::util::table::write_csv;
+
+#[derive(Clone, Debug, Serialize)]
+pub struct ContextEvalSettings {
+    pub contexts: usize,
+    /// Validation rollouts per context and their length (thesis: 20 × 50).
+    pub validation_rollouts: usize,
+    pub validation_steps: usize,
+    pub strategies: Vec<Strategy>,
+    /// N, H_max and the CEM/β-sample sizes of every EIG calibration.
+    pub calibration: CalibrationSettings,
+}
+
+/// What one strategy achieved in one context.
+#[derive(Clone, Debug)]
+struct Outcome {
+    /// Per-step MSE over the validation rollouts (averaged over state dims and rollouts), by horizon.
+    mse_by_horizon: Vec<f64>,
+    final_entropy: f64,
+    quadrants: Option<usize>,
+}
+
+pub struct ContextEvalSummary {
+    /// Mean over contexts of the mean validation MSE, per strategy (in `settings.strategies` order).
+    pub mean_mse: Vec<f64>,
+    /// One-sided p-values that the first strategy named has lower MSE than the second.
+    pub tests: Vec<(Strategy, Strategy, f64)>,
+    /// Toy only: (mean entropy after one informative transition, after one non-informative transition).
+    pub toy_entropy: Option<(f64, f64)>,
+}
+
+fn layout(title: &str) -> Event {
+    Event::Layout {
+        title: title.into(),
+        panels: vec![PanelSpec {
+            title: "entropy of q(β | calibration transitions) [nats]".into(),
+            x_label: "transitions".into(),
+            series: vec!["calibration/entropy".into()],
+            restart_on_rewind: true,
+        }],
+    }
+}
+
+/// Open-loop mean predictions of `rollout` under β, per-step squared error averaged over model-space dims.
+fn prediction_errors(model: &LoadedModel, beta: &[f32], rollout: &Rollout) -> Vec<f64> {
+    let fast = &model.fast;
+    let horizon = rollout.len();
+    let s = fast.state_dim;
+    let actions: Vec<f32> = rollout.actions.iter().flatten().map(|a| *a as f32).collect();
+    let mut predicted = vec![0.0; horizon * s];
+    fast.rollout_means(
+        &model.features(&rollout.states[0]),
+        &actions,
+        beta,
+        1,
+        horizon,
+        &mut predicted,
+        &mut RolloutScratch::default(),
+    );
+    (0..horizon)
+        .map(|t| {
+            let truth = model.features(&rollout.states[t + 1]);
+            truth.iter().zip(&predicted[t * s..(t + 1) * s]).map(|(x, y)| ((x - y) as f64).powi(2)).sum::<f64>()
+                / s as f64
+        })
+        .collect()
+}
+
+fn random_rollout(env: &mut dyn crate::envs::Env, steps: usize, rng: &mut rand_chacha::ChaCha8Rng) -> Rollout {
+    let spec = env.spec();
+    let obs = env.reset(rng);
+    let mut rollout = Rollout::start(env.state(), obs);
+    for _ in 0..steps {
+        let action: Vec<f64> =
+            spec.action_low.iter().zip(&spec.action_high).map(|(&l, &h)| rng.random_range(l..=h)).collect();
+        let step = env.step(&action);
+        rollout.push(action, step.reward, env.state(), step.obs);
+    }
+    rollout
+}
+
+/// Entropy after a single transition from s = 0 under action a, the next state imagined by the model itself
+/// with β from the prior, averaged over `samples` draws (thesis Fig. 4.4a).
+pub fn entropy_after_one_action(model: &LoadedModel, actions: &[f64], samples: usize, seed: u64) -> Vec<f64> {
+    let fast = &model.fast;
+    let zero = vec![0.0f32; fast.transition_features];
+    let prior = fast.belief(&zero, 1);
+    let mut rng = rng_for(seed, &[]);
+    let betas: Vec<f32> = (0..samples)
+        .flat_map(|_| {
+            prior
+                .mean
+                .iter()
+                .zip(&prior.std)
+                .map(|(m, s)| m + s * rng.sample::<f32, _>(rand_distr::StandardNormal))
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    let init = model.features(&vec![0.0; model.run.model.angular.len()]);
+    actions
+        .iter()
+        .map(|&a| {
+            let acts = vec![a as f32; samples];
+            let mut next = vec![0.0; samples * fast.state_dim];
+            fast.rollout_means(&init, &acts, &betas, samples, 1, &mut next, &mut RolloutScratch::default());
+            let mut entropies = vec![0.0; samples];
+            fast.entropy_after(&zero, &init, &acts, &next, samples, 1, &mut entropies, &mut RolloutScratch::default());
+            entropies.iter().sum::<f64>() / samples as f64
+        })
+        .collect()
+}
+
+/// Runs the protocol and writes report.md, CSVs and PNGs into `report_dir`.
+pub fn evaluate(
+    model: &LoadedModel,
+    env: &EnvName,
+    settings: &ContextEvalSettings,
+    provenance: &Provenance,
+    report_dir: &Path,
+    monitor: &dyn Monitor,
+) -> Result<ContextEvalSummary> {
+    if settings.contexts < 2 || settings.validation_rollouts == 0 || settings.validation_steps == 0 {
+        return Err(Error::config("eval context needs at least 2 contexts and 1 validation rollout of ≥ 1 step"));
+    }
+    if settings.strategies.is_empty() {
+        return Err(Error::config("eval context needs at least one calibration strategy"));
+    }
+    settings.calibration.validate()?;
+    let run = RunDir::create(report_dir)?;
+    run.write_config(&serde_json::json!({
+        "job": "eval context",
+        "provenance": provenance,
+        "model": model.dir,
+        "env": env.canonical(),
+        "settings": settings,
+    }))?;
+    let metrics = run.metrics()?;
+    let monitor = Tee { first: monitor, second: &metrics };
+    monitor.emit(&layout(&format!("eval context: {} on {}", model.dir.display(), env.canonical())));
+    let seed = provenance.seed;
+    let is_quadrant = env.canonical() == "pendulum:quadrant";
+    let mut outcomes: Vec<Vec<Outcome>> = Vec::with_capacity(settings.contexts);
+    for k in 0..settings.contexts as u64 {
+        if monitor.is_cancelled() {
+            return Err(Error::Cancelled);
+        }
+        monitor.progress("contexts", k, settings.contexts as u64);
+        let instance_seed = derive_seed(seed, &[k, 0]);
+        let mut env_k = instance_env(env, instance_seed)?;
+        let mut rng = rng_for(seed, &[k, 1]);
+        let validation: Vec<Rollout> = (0..settings.validation_rollouts)
+            .map(|_| random_rollout(env_k.as_mut(), settings.validation_steps, &mut rng))
+            .collect();
+        // One start for every strategy: the thesis' fixed start, or one reset draw.
+        let start = crate::models::context::calibration::default_start(env).unwrap_or_else(|| {
+            env_k.reset(&mut rng);
+            env_k.state()
+        });
+        let mut per_strategy = Vec::new();
+        for (j, strategy) in settings.strategies.iter().enumerate() {
+            let request = CalibrationRequest {
+                env: env.clone(),
+                instance_seed,
+                init_state: Some(start.clone()),
+                settings: CalibrationSettings { strategy: *strategy, ..settings.calibration.clone() },
+                seed: derive_seed(seed, &[k, 2, j as u64]),
+            };
+            let (calibration, _) = run_calibration(model, &request, &crate::run::NullMonitor)?;
+            let rows = context_rows(model, &calibration.rollout);
+            let beta = model.fast.belief(&model.fast.pool(&rows), 1).mean;
+            let errors: Vec<Vec<f64>> = validation.iter().map(|r| prediction_errors(model, &beta, r)).collect();
+            let mse_by_horizon = (0..settings.validation_steps)
+                .map(|t| errors.iter().map(|e| e[t]).sum::<f64>() / errors.len() as f64)
+                .collect();
+            let quadrants = is_quadrant.then(|| {
+                let mut seen = [false; 4];
+                for s in &calibration.rollout.states {
+                    seen[crate::envs::pendulum::quadrant_of(s[0])] = true;
+                }
+                seen.iter().filter(|x| **x).count()
+            });
+            let final_entropy = *calibration.entropies.last().expect("entropy before calibration is always there");
+            monitor.scalar(&format!("context/{}/entropy", strategy.name()), k, final_entropy);
+            per_strategy.push(Outcome { mse_by_horizon, final_entropy, quadrants });
+        }
+        outcomes.push(per_strategy);
+    }
+    monitor.progress("contexts", settings.contexts as u64, settings.contexts as u64);
+    let summary = write_report(model, env, settings, &run, &outcomes)?;
+    metrics.emit(&Event::Finished { ok: true });
+    Ok(summary)
+}
+
+fn write_report(
+    model: &LoadedModel,
+    env: &EnvName,
+    settings: &ContextEvalSettings,
+    run: &RunDir,
+    outcomes: &[Vec<Outcome>],
+) -> Result<ContextEvalSummary> {
+    let strategies = &settings.strategies;
+    let per_context_mse =
+        |j: usize| -> Vec<f64> { outcomes.iter().map(|o| mean(&o[j].mse_by_horizon).unwrap_or(f64::NAN)).collect() };
+    let mean_mse: Vec<f64> = (0..strategies.len()).map(|j| mean(&per_context_mse(j)).unwrap_or(f64::NAN)).collect();
+
+    // Per-context table.
+    let mut rows = Vec::new();
+    for (k, o) in outcomes.iter().enumerate() {
+        for (j, s) in strategies.iter().enumerate() {
+            rows.push(vec![
+                k.to_string(),
+                s.name().to_string(),
+                format!("{:.6e}", mean(&o[j].mse_by_horizon).unwrap_or(f64::NAN)),
+                format!("{:.4}", o[j].final_entropy),
+                o[j].quadrants.map(|q| q.to_string()).unwrap_or_default(),
+            ]);
+        }
+    }
+    write_csv(&run.file("per_context.csv"), &["context", "strategy", "mean_mse", "final_entropy", "quadrants"], &rows)?;
+
+    // MSE against the horizon.
+    let horizon = settings.validation_steps;
+    let by_horizon: Vec<Vec<f64>> = (0..strategies.len())
+        .map(|j| {
+            (0..horizon)
+                .map(|t| outcomes.iter().map(|o| o[j].mse_by_horizon[t]).sum::<f64>() / outcomes.len() as f64)
+                .collect()
+        })
+        .collect();
+    let mut header = vec!["horizon".to_string()];
+    header.extend(strategies.iter().map(|s| format!("mse_{}", s.name().replace('-', "_"))));
+    let header_refs: Vec<&str> = header.iter().map(String::as_str).collect();
+    let rows: Vec<Vec<String>> = (0..horizon)
+        .map(|t| {
+            let mut row = vec![(t + 1).to_string()];
+            row.extend(by_horizon.iter().map(|v| format!("{:.6e}", v[t])));
+            row
+        })
+        .collect();
+    write_csv(&run.file("mse_vs_horizon.csv"), &header_refs, &rows)?;
+    let series: Vec<Series> = strategies
+        .iter()
+        .zip(&by_horizon)
+        .map(|(s, v)| Series {
+            name: s.name().into(),
+            points: v.iter().enumerate().map(|(t, m)| ((t + 1) as f64, *m)).collect(),
+        })
+        .collect();
+    line_plot(
+        &run.file("mse_vs_horizon.png"),
+        &format!(
+            "{}: open-loop prediction MSE after calibration (mean over {} contexts)",
+            env.canonical(),
+            outcomes.len()
+        ),
+        "prediction horizon [steps]",
+        "MSE (model space, mean over dims)",
+        &series,
+    )?;
+
+    // Paired tests: does strategy a give lower per-context MSE than strategy b?
+    let mut tests = Vec::new();
+    let mut test_rows = Vec::new();
+    let position = |s: Strategy| strategies.iter().position(|x| *x == s);
+    for (better, worse) in
+        [(Strategy::OpenLoop, Strategy::Random), (Strategy::Mpc, Strategy::Random), (Strategy::Mpc, Strategy::OpenLoop)]
+    {
+        let (Some(a), Some(b)) = (position(better), position(worse)) else { continue };
+        let result = wilcoxon_signed_rank(&per_context_mse(a), &per_context_mse(b), Alternative::Less)?;
+        tests.push((better, worse, result.p_value));
+        test_rows.push(vec![
+            better.name().to_string(),
+            worse.name().to_string(),
+            result.n.to_string(),
+            format!("{}", result.statistic),
+            format!("{:.4e}", result.p_value),
+        ]);
+    }
+    write_csv(
+        &run.file("wilcoxon.csv"),
+        &["lower", "than", "n_nonzero", "statistic", "p_value_one_sided"],
+        &test_rows,
+    )?;
+
+    let toy_entropy = if matches!(env, EnvName::Toy(_)) {
+        let actions: Vec<f64> = (0..=80).map(|i| -2.0 + 0.05 * i as f64).collect();
+        let entropies = entropy_after_one_action(model, &actions, 20, 11);
+        write_csv(
+            &run.file("entropy_vs_action.csv"),
+            &["action", "entropy"],
+            &actions
+                .iter()
+                .zip(&entropies)
+                .map(|(a, e)| vec![format!("{a:.2}"), format!("{e:.5}")])
+                .collect::<Vec<_>>(),
+        )?;
+        line_plot(
+            &run.file("entropy_vs_action.png"),
+            &format!("{}: entropy of q(β | one transition from s = 0) vs action", env.canonical()),
+            "action a",
+            "entropy [nats]",
+            &[Series {
+                name: "learned model".into(),
+                points: actions.iter().copied().zip(entropies.iter().copied()).collect(),
+            }],
+        )?;
+        let informative = |a: f64| match env {
+            EnvName::Toy(sq) => sq.name() == "inner" && a.abs() < 0.9 || sq.name() == "outer" && a.abs() > 1.1,
+            _ => false,
+        };
+        let non_informative = |a: f64| match env {
+            EnvName::Toy(sq) => sq.name() == "inner" && a.abs() > 1.1 || sq.name() == "outer" && a.abs() < 0.9,
+            _ => false,
+        };
+        let pick = |f: &dyn Fn(f64) -> bool| {
+            mean(&actions.iter().zip(&entropies).filter(|(a, _)| f(**a)).map(|(_, e)| *e).collect::<Vec<_>>())
+                .unwrap_or(f64::NAN)
+        };
+        Some((pick(&informative), pick(&non_informative)))
+    } else {
+        None
+    };
+
+    // report.md
+    let mut md = String::new();
+    let c = &settings.calibration;
+    let _ = writeln!(md, "# Explore the Context: calibration on {}\n", env.canonical());
+    let _ = writeln!(
+        md,
+        "Model `{}` ({} training steps). {} unseen contexts (instances), per context {} random validation rollouts of {} \
+         steps; every strategy starts from the same state and collects {} transitions. EIG planning: CEM {} candidates / \
+         {} elites / {} iterations, {} β samples, MPC horizon min({}, N − n). Predictions: open loop from each validation \
+         rollout's first state with the mean of q(β | calibration transitions); error = squared error averaged over the \
+         model-space state dimensions{}.\n",
+        model.dir.display(),
+        model.run.config.steps,
+        outcomes.len(),
+        settings.validation_rollouts,
+        settings.validation_steps,
+        c.transitions,
+        c.candidates,
+        c.elites,
+        c.iterations,
+        c.beta_samples,
+        c.horizon_max,
+        if model.run.model.angular.iter().any(|a| *a) { " (angles as cos, sin)" } else { "" }
+    );
+    let _ = writeln!(
+        md,
+        "| strategy | mean MSE | median final entropy [nats] |{}",
+        if outcomes[0][0].quadrants.is_some() { " contexts visiting all 4 quadrants |" } else { "" }
+    );
+    let _ = writeln!(md, "|---|---|---|{}", if outcomes[0][0].quadrants.is_some() { "---|" } else { "" });
+    for (j, s) in strategies.iter().enumerate() {
+        let entropies: Vec<f64> = outcomes.iter().map(|o| o[j].final_entropy).collect();
+        let quad = outcomes[0][j].quadrants.map(|_| {
+            format!(" {} / {} |", outcomes.iter().filter(|o| o[j].quadrants == Some(4)).count(), outcomes.len())
+        });
+        let _ = writeln!(
+            md,
+            "| {} | {:.4e} | {:.3} |{}",
+            s.name(),
+            mean_mse[j],
+            super::stats::quantile(&entropies, 0.5).unwrap_or(f64::NAN),
+            quad.unwrap_or_default()
+        );
+    }
+    let _ = writeln!(
+        md,
+        "\nPaired Wilcoxon signed-rank tests on the per-context mean MSE (one-sided: the first strategy lower):\n"
+    );
+    let _ = writeln!(md, "| lower | than | p |\n|---|---|---|");
+    for (a, b, p) in &tests {
+        let _ = writeln!(md, "| {} | {} | {:.3e} |", a.name(), b.name(), p);
+    }
+    if let Some((informative, non_informative)) = toy_entropy {
+        let _ = writeln!(
+            md,
+            "\nEntropy after one transition from s = 0 (model-imagined next state, 20 prior β samples; Fig. 4.4a): \
+             {informative:.3} nats for informative actions, {non_informative:.3} for non-informative ones \
+             (prior: {:.3}). See entropy_vs_action.png.",
+            gaussian_entropy(&model.fast.belief(&vec![0.0; model.fast.transition_features], 1).std)
+        );
+    }
+    let _ = writeln!(
+        md,
+        "\nFiles: per_context.csv, mse_vs_horizon.csv/.png, wilcoxon.csv{}.",
+        if toy_entropy.is_some() { ", entropy_vs_action.csv/.png" } else { "" }
+    );
+    write_text(&run.file("report.md"), &md)?;
+    Ok(ContextEvalSummary { mean_mse, tests, toy_entropy })
+}

@@ -1,0 +1,327 @@
+//! Calibration (thesis 4.4.5): act in an unseen instance to collect the transitions that tell the model most
+//! about its hidden parameters. Random actions are the baseline; open-loop calibration plans the whole sequence
+//! once by maximizing the EIG; MPC calibration replans after every transition with the horizon
+//! min(H_max, N − n).
+
+use rand::Rng;
+use serde::{Deserialize, Serialize};
+
+use super::eig::EigObjective;
+use super::fast::{gaussian_entropy, max_into};
+use super::LoadedModel;
+use crate::data::Rollout;
+use crate::envs::Env;
+use crate::error::{Error, Result};
+use crate::planning::{Cem, CemConfig, NoiseKind};
+use crate::run::Monitor;
+use crate::util::seeding::{derive_seed, rng_for};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Strategy {
+    Random,
+    OpenLoop,
+    Mpc,
+}
+
+impl Strategy {
+    pub fn name(self) -> &'static str {
+        match self {
+            Strategy::Random => "random",
+            Strategy::OpenLoop => "open-loop",
+            Strategy::Mpc => "mpc",
+        }
+    }
+
+    pub const ALL: [Strategy; 3] = [Strategy::Random, Strategy::OpenLoop, Strategy::Mpc];
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CalibrationSettings {
+    pub strategy: Strategy,
+    /// N: transitions to collect.
+    pub transitions: usize,
+    /// H_max of MPC calibration (pendulum 20, MountainCar 30).
+    pub horizon_max: usize,
+    pub candidates: usize,
+    pub elites: usize,
+    pub iterations: usize,
+    /// β samples of the Monte Carlo EIG (20 in the thesis).
+    pub beta_samples: usize,
+}
+
+impl CalibrationSettings {
+    /// The thesis' settings: CEM 1000 / 100 / 10, 20 β samples.
+    pub fn thesis(strategy: Strategy, transitions: usize, horizon_max: usize) -> Self {
+        CalibrationSettings {
+            strategy,
+            transitions,
+            horizon_max,
+            candidates: 1000,
+            elites: 100,
+            iterations: 10,
+            beta_samples: 20,
+        }
+    }
+
+    pub fn validate(&self) -> Result<()> {
+        let bad = |m: String| Err(Error::config(m));
+        if !(1..=10_000).contains(&self.transitions) {
+            return bad(format!("--transitions must be 1..=10000, got {}", self.transitions));
+        }
+        if !(1..=1000).contains(&self.horizon_max) {
+            return bad(format!("--horizon must be 1..=1000, got {}", self.horizon_max));
+        }
+        if !(1..=1000).contains(&self.beta_samples) {
+            return bad(format!("--beta-samples must be 1..=1000, got {}", self.beta_samples));
+        }
+        if !(2..=100_000).contains(&self.candidates) || !(2..=self.candidates).contains(&self.elites) {
+            return bad(format!(
+                "--candidates must be 2..=100000 and --elites 2..=candidates, got {} and {}",
+                self.candidates, self.elites
+            ));
+        }
+        if !(1..=1000).contains(&self.iterations) {
+            return bad(format!("--iters must be 1..=1000, got {}", self.iterations));
+        }
+        Ok(())
+    }
+}
+
+/// One executed calibration step.
+pub struct CalibrationStep<'a> {
+    pub t: usize,
+    pub state: &'a [f64],
+    pub action: &'a [f64],
+    pub next_state: &'a [f64],
+    /// H[q(β | transitions so far)] after this step.
+    pub entropy: f64,
+}
+
+pub struct Calibration {
+    pub rollout: Rollout,
+    /// Entropy of the belief before any transition (index 0) and after each one.
+    pub entropies: Vec<f64>,
+}
+
+/// Model-space rows [s, a, s'] of a rollout's transitions.
+pub fn context_rows(model: &LoadedModel, rollout: &Rollout) -> Vec<f32> {
+    let mut rows = Vec::new();
+    for t in 0..rollout.len() {
+        rows.extend(model.features(&rollout.states[t]));
+        rows.extend(rollout.actions[t].iter().map(|a| *a as f32));
+        rows.extend(model.features(&rollout.states[t + 1]));
+    }
+    rows
+}
+
+/// Runs `settings.strategy` in `env` from its current state. `seed` keys random actions, β samples and CEM.
+pub fn calibrate(
+    model: &LoadedModel,
+    env: &mut dyn Env,
+    settings: &CalibrationSettings,
+    seed: u64,
+    monitor: &dyn Monitor,
+    mut on_step: impl FnMut(&CalibrationStep),
+) -> Result<Calibration> {
+    settings.validate()?;
+    let spec = env.spec();
+    let fast = &model.fast;
+    let n = settings.transitions;
+    let mut pooled = vec![0.0f32; fast.transition_features];
+    let mut entropies = vec![gaussian_entropy(&fast.belief(&pooled, 1).std)];
+    let mut rollout = Rollout::start(env.state(), env.observe());
+    let cem_config = |horizon: usize| CemConfig {
+        horizon,
+        candidates: settings.candidates,
+        elites: settings.elites,
+        iterations: settings.iterations,
+        action_low: spec.action_low.clone(),
+        action_high: spec.action_high.clone(),
+        init_std: spec.action_low.iter().zip(&spec.action_high).map(|(l, h)| l.abs().max(h.abs())).collect(),
+        noise: NoiseKind::White,
+        warm_start: false,
+    };
+    let mut random = rng_for(seed, &[0]);
+    let mut open_loop_plan: Vec<f64> = Vec::new();
+    for t in 0..n {
+        if monitor.is_cancelled() {
+            return Err(Error::Cancelled);
+        }
+        let state = env.state();
+        let action: Vec<f64> = match settings.strategy {
+            Strategy::Random => {
+                spec.action_low.iter().zip(&spec.action_high).map(|(&l, &h)| random.random_range(l..=h)).collect()
+            }
+            Strategy::OpenLoop | Strategy::Mpc => {
+                let replan = settings.strategy == Strategy::Mpc || t == 0;
+                if replan {
+                    let horizon = if settings.strategy == Strategy::Mpc { settings.horizon_max.min(n - t) } else { n };
+                    let objective = EigObjective::new(
+                        fast,
+                        model.features(&state),
+                        pooled.clone(),
+                        settings.beta_samples,
+                        derive_seed(seed, &[1, t as u64]),
+                    );
+                    let mut cem = Cem::new(cem_config(horizon), derive_seed(seed, &[2, t as u64]))?;
+                    let phase = format!("step {}/{n}: EIG planning", t + 1);
+                    open_loop_plan = cem.plan(&objective, |it| {
+                        monitor.scalar("cem/best_entropy", it.iteration as u64, it.best_cost);
+                        monitor.progress(&phase, it.iteration as u64 + 1, settings.iterations as u64);
+                    });
+                    open_loop_plan.truncate(horizon * spec.action_dim());
+                }
+                let offset = if settings.strategy == Strategy::Mpc { 0 } else { t };
+                open_loop_plan[offset * spec.action_dim()..(offset + 1) * spec.action_dim()].to_vec()
+            }
+        };
+        let step = env.step(&action);
+        let next_state = env.state();
+        let mut row = model.features(&state);
+        row.extend(action.iter().map(|a| *a as f32));
+        row.extend(model.features(&next_state));
+        max_into(&mut pooled, &fast.pool(&row));
+        let entropy = gaussian_entropy(&fast.belief(&pooled, 1).std);
+        entropies.push(entropy);
+        on_step(&CalibrationStep { t, state: &state, action: &action, next_state: &next_state, entropy });
+        monitor.progress("calibration transitions", t as u64 + 1, n as u64);
+        rollout.push(action, step.reward, next_state, step.obs);
+    }
+    Ok(Calibration { rollout, entropies })
+}
+
+/// The start of a calibration when the user gives none: the thesis' x = 0 (toy) and x = ẋ = 0 (MountainCar);
+/// elsewhere the env's reset draw.
+pub fn default_start(env: &crate::envs::EnvName) -> Option<Vec<f64>> {
+    match env {
+        crate::envs::EnvName::Toy(_) | crate::envs::EnvName::MountainCar => Some(vec![0.0, 0.0]),
+        _ => None,
+    }
+}
+
+/// The live view of a calibration run.
+pub fn layout(title: &str, state_names: &[String]) -> crate::run::Event {
+    use crate::run::PanelSpec;
+    crate::run::Event::Layout {
+        title: title.to_string(),
+        panels: vec![
+            PanelSpec {
+                title: "entropy of q(β | calibration transitions) [nats]".into(),
+                x_label: "transitions".into(),
+                series: vec!["calibration/entropy".into()],
+                restart_on_rewind: false,
+            },
+            PanelSpec {
+                title: "executed trajectory".into(),
+                x_label: "step".into(),
+                series: state_names.iter().map(|n| format!("state/{n}")).collect(),
+                restart_on_rewind: false,
+            },
+            PanelSpec {
+                title: "EIG planning: best mean posterior entropy (current step)".into(),
+                x_label: "CEM iteration".into(),
+                series: vec!["cem/best_entropy".into()],
+                restart_on_rewind: true,
+            },
+        ],
+    }
+}
+
+/// A calibration in an instance of `env`, as the `calibrate` command and `eval context` run it.
+pub struct CalibrationRequest {
+    pub env: crate::envs::EnvName,
+    pub instance_seed: u64,
+    /// The start state (env state space); `None`: [`default_start`] or the env's reset draw.
+    pub init_state: Option<Vec<f64>>,
+    pub settings: CalibrationSettings,
+    pub seed: u64,
+}
+
+/// Builds the instance, puts it in its start state and calibrates; reports entropy and states to `monitor`.
+pub fn run_calibration(
+    model: &LoadedModel,
+    request: &CalibrationRequest,
+    monitor: &dyn Monitor,
+) -> Result<(Calibration, serde_json::Value)> {
+    let mut env = crate::envs::instance_env(&request.env, request.instance_seed)?;
+    let spec = env.spec();
+    // reset also seeds the env's own noise (toy), so it comes first even when the start is given.
+    env.reset(&mut rng_for(request.seed, &[3]));
+    if let Some(start) = request.init_state.clone().or_else(|| default_start(&request.env)) {
+        if start.len() != spec.state_dim() || start.iter().any(|x| !x.is_finite()) {
+            return Err(Error::config(format!(
+                "--init-state needs {} finite values ({}), got {}",
+                spec.state_dim(),
+                spec.state_names.join(", "),
+                start.len()
+            )));
+        }
+        env.set_state(&start);
+    }
+    let names = spec.state_names.clone();
+    let start = env.state();
+    for (name, x) in names.iter().zip(&start) {
+        monitor.scalar(&format!("state/{name}"), 0, *x);
+    }
+    let calibration = calibrate(model, env.as_mut(), &request.settings, request.seed, monitor, |step| {
+        monitor.scalar("calibration/entropy", step.t as u64 + 1, step.entropy);
+        for (name, x) in names.iter().zip(step.next_state) {
+            monitor.scalar(&format!("state/{name}"), step.t as u64 + 1, *x);
+        }
+    })?;
+    Ok((calibration, env.params()))
+}
+
+/// The calibration transitions as a one-rollout dataset (the context file `plan --context` reads).
+pub fn calibration_dataset(
+    env: &crate::envs::EnvName,
+    calibration: &Calibration,
+    instance: serde_json::Value,
+    seed: u64,
+    command_line: &str,
+) -> Result<crate::data::Dataset> {
+    let spec = env.build()?.spec();
+    Ok(crate::data::Dataset {
+        meta: crate::data::DatasetMeta {
+            format_version: crate::data::FORMAT_VERSION,
+            env: env.canonical(),
+            seed,
+            mbrl_version: crate::VERSION.to_string(),
+            command_line: command_line.to_string(),
+            instances: vec![instance],
+            state_names: spec.state_names.clone(),
+            action_dim: spec.action_dim(),
+            dt: spec.dt,
+            layout: crate::data::DatasetLayout::Rollouts,
+        },
+        steps: calibration.rollout.timesteps(0).collect(),
+    })
+}
+
+/// Model-space context rows from a context file (any rollout dataset of the model's env).
+pub fn read_context(model: &LoadedModel, path: &std::path::Path) -> Result<Vec<f32>> {
+    let dataset = crate::data::read_dataset(path)?;
+    if dataset.meta.env != model.run.env {
+        return Err(Error::bad_file(
+            path,
+            format!("holds transitions of '{}'; the model is of '{}'", dataset.meta.env, model.run.env),
+        ));
+    }
+    if dataset.meta.state_names != model.run.model.state_names || dataset.meta.action_dim != model.run.model.action_dim
+    {
+        return Err(Error::bad_file(
+            path,
+            format!(
+                "has states ({}) and {} action dimensions; the model expects ({}) and {}",
+                dataset.meta.state_names.join(", "),
+                dataset.meta.action_dim,
+                model.run.model.state_names.join(", "),
+                model.run.model.action_dim
+            ),
+        ));
+    }
+    let rollouts = Rollout::group(&dataset.steps)
+        .map_err(|i| Error::bad_file(path, format!("message {i} does not continue its rollout")))?;
+    Ok(rollouts.iter().flat_map(|(_, r)| context_rows(model, r)).collect())
+}

@@ -1,0 +1,280 @@
+//! Explore the Context (thesis chapter 4): a GRU dynamics model conditioned on a latent context β, a context
+//! encoder that turns observed transitions into a belief q(β | C) whose variance never grows as transitions are
+//! added, and calibration that picks actions by the expected information gain about β.
+
+pub mod calibration;
+pub mod config;
+pub mod data;
+pub mod dynamics;
+pub mod eig;
+pub mod fast;
+pub mod net;
+pub mod train;
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+pub use config::{ContextConfig, EnvFamily, Preset};
+pub use fast::FastContextModel;
+pub use train::ContextTrainer;
+
+use crate::data::{read_dataset, Dataset, Rollout};
+use crate::envs::{parse_env, EnvName};
+use crate::error::{Error, Result};
+use crate::run::dir::Provenance;
+use crate::run::Monitor;
+use crate::train::tensors::to_params;
+use crate::train::{
+    run_training, training_layout, validation_panel, DataFile, FitOutcome, FitSettings, OpenedCheckpoint, MODEL_FILE,
+};
+use data::{ContextData, Episode, InstancePair};
+
+pub const METHOD: &str = "context";
+const SPLIT_STREAM: u64 = 5;
+
+/// What the model is a model of.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelSpec {
+    pub state_names: Vec<String>,
+    pub angular: Vec<bool>,
+    pub action_dim: usize,
+    /// Model-space state size (angles as cos/sin).
+    pub feature_dim: usize,
+}
+
+/// config.json of a context-model checkpoint.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContextRun {
+    pub method: String,
+    pub env: String,
+    pub data: Vec<DataFile>,
+    pub seed: u64,
+    pub model: ModelSpec,
+    pub config: ContextConfig,
+    pub instances: InstanceCounts,
+    /// States per training chunk actually used (the config's, or fewer for short rollouts).
+    pub chunk_states: usize,
+    pub provenance: Provenance,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InstanceCounts {
+    pub train: usize,
+    pub valid: usize,
+}
+
+pub struct TrainRequest {
+    pub out: PathBuf,
+    pub data: PathBuf,
+    pub env: Option<String>,
+    pub config: ContextConfig,
+    pub seed: u64,
+    pub provenance: Provenance,
+}
+
+pub struct TrainReport {
+    pub run: ContextRun,
+    pub outcome: FitOutcome,
+    pub parameters: usize,
+}
+
+/// The Table B.1 column an env belongs to.
+pub fn family_of(env: &EnvName) -> EnvFamily {
+    if env.canonical().starts_with("toy:") {
+        EnvFamily::Toy
+    } else {
+        EnvFamily::Control
+    }
+}
+
+/// Instance pairs of a context dataset: rollout 2k is instance k's target rollout, 2k + 1 its context source.
+pub fn instance_pairs(dataset: &Dataset, path: &Path, angular: &[bool]) -> Result<ContextData> {
+    if dataset.meta.layout != crate::data::DatasetLayout::InstancePairs {
+        return Err(Error::bad_file(
+            path,
+            format!(
+                "holds independent rollouts; a context model trains on instance pairs (`mbrl collect --env {} --instances N --steps T`)",
+                dataset.meta.env
+            ),
+        ));
+    }
+    let rollouts = Rollout::group(&dataset.steps)
+        .map_err(|i| Error::bad_file(path, format!("message {i} does not continue its rollout")))?;
+    if rollouts.len() < 2 || rollouts.len() % 2 != 0 {
+        return Err(Error::bad_file(
+            path,
+            format!(
+                "holds {} rollouts; a context dataset has two per instance (make one with `mbrl collect --env {} --instances N`)",
+                rollouts.len(),
+                dataset.meta.env
+            ),
+        ));
+    }
+    let mut pairs = Vec::with_capacity(rollouts.len() / 2);
+    for (k, pair) in rollouts.chunks(2).enumerate() {
+        let ((ia, a), (ib, b)) = (&pair[0], &pair[1]);
+        if *ia != 2 * k as u32 || *ib != 2 * k as u32 + 1 {
+            return Err(Error::bad_file(
+                path,
+                format!("rollouts {ia} and {ib} are not the pair 2k, 2k+1 of instance {k}"),
+            ));
+        }
+        let same_instance = dataset.meta.instances.get(*ia as usize) == dataset.meta.instances.get(*ib as usize);
+        if !same_instance {
+            return Err(Error::bad_file(path, format!("rollouts {ia} and {ib} come from different instances")));
+        }
+        pairs.push(InstancePair {
+            target: Episode::from_rollout(a, angular),
+            source: Episode::from_rollout(b, angular),
+        });
+    }
+    let state_dim = pairs[0].target.states.len() / (pairs[0].target.len + 1);
+    Ok(ContextData { state_dim, action_dim: dataset.meta.action_dim, pairs })
+}
+
+fn env_of(dataset: &Dataset, requested: Option<&str>, data: &Path) -> Result<EnvName> {
+    let env = parse_env(&dataset.meta.env).map_err(|e| Error::bad_file(data, format!("dataset env: {e}")))?;
+    if let Some(requested) = requested {
+        let requested_env = parse_env(requested)?;
+        if requested_env.canonical() != env.canonical() {
+            return Err(Error::bad_file(
+                data,
+                format!("holds '{}' rollouts; --env asked for '{}'", env.canonical(), requested_env.canonical()),
+            ));
+        }
+    }
+    Ok(env)
+}
+
+/// Trains (or, with `resume`, continues) a context model into `request.out`.
+pub fn train(request: &TrainRequest, resume: bool, monitor: &dyn Monitor) -> Result<TrainReport> {
+    request.config.validate()?;
+    let file = DataFile::fingerprint(&request.data)?;
+    let dataset = read_dataset(&request.data)?;
+    let env = env_of(&dataset, request.env.as_deref(), &request.data)?;
+    let spec = env.build()?.spec();
+    if dataset.meta.state_names.len() != spec.angular.len() || dataset.meta.action_dim != spec.action_dim() {
+        return Err(Error::bad_file(
+            &request.data,
+            format!("state or action sizes differ from env '{}'", env.canonical()),
+        ));
+    }
+    let all = instance_pairs(&dataset, &request.data, &spec.angular)?;
+    let (train_data, valid_data) = all.split(request.config.validation_fraction, request.seed);
+    let feature_dim = train_data.state_dim;
+    let chunk_states = train_data.chunk_states(request.config.chunk_states)?;
+    let run = ContextRun {
+        method: METHOD.into(),
+        env: env.canonical(),
+        data: vec![file],
+        seed: request.seed,
+        model: ModelSpec {
+            state_names: dataset.meta.state_names.clone(),
+            angular: spec.angular.clone(),
+            action_dim: dataset.meta.action_dim,
+            feature_dim,
+        },
+        config: request.config.clone(),
+        instances: InstanceCounts { train: train_data.len(), valid: valid_data.len() },
+        chunk_states,
+        provenance: request.provenance.clone(),
+    };
+    let mut trainer = ContextTrainer::new(request.config.clone(), request.seed, train_data, valid_data)?;
+    let parameters = trainer.parameter_count();
+    let settings = FitSettings {
+        method: METHOD.into(),
+        env: Some(run.env.clone()),
+        total_steps: request.config.steps,
+        validate_every: request.config.validate_every,
+        checkpoint_every: request.config.checkpoint_every,
+    };
+    let config = serde_json::to_value(&run).map_err(|e| Error::config(e.to_string()))?;
+    let title = format!(
+        "train context model on {} ({} instances, batch {} × {} states)",
+        run.env, run.instances.train, request.config.batch_size, chunk_states
+    );
+    let outcome = run_training(
+        &request.out,
+        &config,
+        &settings,
+        &mut trainer,
+        resume,
+        &training_layout(&title, vec![validation_panel("validation loss (eq. 4.32, held-out instances)")]),
+        monitor,
+    )?;
+    Ok(TrainReport { run, outcome, parameters })
+}
+
+pub fn read_run(opened: &OpenedCheckpoint) -> Result<ContextRun> {
+    serde_json::from_value(opened.config.clone())
+        .map_err(|e| Error::bad_file(&opened.dir.file("config.json"), format!("not a context-model run config: {e}")))
+}
+
+/// Continues the run in `dir` from its last checkpoint, with the config and data it was started with.
+pub fn resume(dir: &Path, monitor: &dyn Monitor) -> Result<TrainReport> {
+    let opened = OpenedCheckpoint::open(dir)?;
+    let run = read_run(&opened)?;
+    for file in &run.data {
+        file.verify_unchanged()?;
+    }
+    let request = TrainRequest {
+        out: dir.to_path_buf(),
+        data: run.data[0].path.clone(),
+        env: Some(run.env.clone()),
+        config: run.config.clone(),
+        seed: run.seed,
+        provenance: run.provenance.clone(),
+    };
+    train(&request, true, monitor)
+}
+
+/// A finished context model, ready to calibrate and plan in `env`.
+pub struct LoadedModel {
+    pub run: ContextRun,
+    pub fast: FastContextModel,
+    pub dir: PathBuf,
+}
+
+impl LoadedModel {
+    /// Model-space features of an env state.
+    pub fn features(&self, state: &[f64]) -> Vec<f32> {
+        let mut out = Vec::with_capacity(self.run.model.feature_dim);
+        crate::models::pets::data::features(state, &[], &self.run.model.angular, &mut out);
+        out
+    }
+}
+
+/// Loads a finished context-model checkpoint for `env` (which must be the env it was trained on).
+pub fn load(dir: &Path, env: &EnvName) -> Result<LoadedModel> {
+    let opened = OpenedCheckpoint::open(dir)?;
+    if opened.manifest.method != METHOD {
+        return Err(Error::bad_file(
+            dir,
+            format!(
+                "is a '{}' checkpoint; this needs a context model (`mbrl train --method context`)",
+                opened.manifest.method
+            ),
+        ));
+    }
+    opened.expect_finished(METHOD)?;
+    let run = read_run(&opened)?;
+    if run.env != env.canonical() {
+        return Err(Error::bad_file(dir, format!("is a model of '{}', not of '{}'", run.env, env.canonical())));
+    }
+    let config_path = opened.dir.file("config.json");
+    run.config.validate().map_err(|e| Error::bad_file(&config_path, e.to_string()))?;
+    let model_path = opened.dir.file(MODEL_FILE);
+    let device = crate::nn::tensor::inference_device();
+    let layout_net = train::init_net(&run.config, run.model.feature_dim, run.model.action_dim, 0, &device);
+    let layout = crate::nn::ParamSet::<f32>::from_module(&layout_net, net::param_name);
+    let params = to_params(&model_path, &opened.tensors(MODEL_FILE)?, &layout)?;
+    let fast = FastContextModel::from_params(&params).map_err(|e| Error::bad_file(&model_path, e.to_string()))?;
+    Ok(LoadedModel { run, fast, dir: dir.to_path_buf() })
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,263 @@
+//! The context-conditional model of thesis 4.4 (sizes of appendix B.1) as a burn module, and its training loss
+//! (eq. 4.32 as the authors computed it).
+
+use burn::module::{Module, Param};
+use burn::tensor::activation::{relu, softplus, tanh};
+use burn::tensor::{Device, Tensor};
+use rand::Rng;
+
+use super::config::ContextConfig;
+use super::data::Batch;
+use crate::nn::tensor::{mask, tensor, zeros};
+use crate::nn::{max_pool_sets, GruCell, GruCellConfig, Linear, LinearConfig, NonNegLinear};
+
+/// Floor of the decoders' variance (B.1.1's SoftplusOffset(1e−4)).
+pub const VARIANCE_FLOOR: f32 = 1e-4;
+/// The context std head as coded: std = softplus(−0.3·enc + 0.5) + 0.01.
+pub const STD_SCALE: f32 = -0.3;
+pub const STD_SHIFT: f32 = 0.5;
+pub const STD_FLOOR: f32 = 0.01;
+
+/// Linear → ReLU → Linear; what follows the second layer is the caller's.
+#[derive(Module, Debug)]
+pub struct TwoLayer {
+    pub first: Linear,
+    pub second: Linear,
+}
+
+impl TwoLayer {
+    fn init<R: Rng + ?Sized>(d_in: usize, hidden: usize, d_out: usize, device: &Device, rng: &mut R) -> Self {
+        TwoLayer {
+            first: LinearConfig::new(d_in, hidden).init(device, rng),
+            second: LinearConfig::new(hidden, d_out).init(device, rng),
+        }
+    }
+
+    pub fn forward(&self, x: Tensor<2>) -> Tensor<2> {
+        self.second.forward(relu(self.first.forward(x)))
+    }
+}
+
+/// The monotone variance head: non-negative weights and ReLU, so its output never decreases as pooled features
+/// grow; negated and squashed, the std never grows when a transition joins the context (eq. 4.26).
+#[derive(Module, Debug)]
+pub struct MonotoneTwoLayer {
+    pub first: NonNegLinear,
+    pub second: NonNegLinear,
+}
+
+#[derive(Module, Debug)]
+pub struct ContextNet {
+    pub state_encoder: TwoLayer,
+    pub action_encoder: TwoLayer,
+    pub context_embedding: TwoLayer,
+    pub gru: GruCell,
+    pub mean_decoder: TwoLayer,
+    pub variance_decoder: Option<TwoLayer>,
+    /// Raw constant variance (softplus + floor), for homoscedastic systems.
+    pub constant_variance: Option<Param<Tensor<1>>>,
+    pub transition_encoder: TwoLayer,
+    pub context_mean: TwoLayer,
+    pub context_std: MonotoneTwoLayer,
+}
+
+/// A diagonal Gaussian belief over β.
+pub struct Belief {
+    pub mean: Tensor<2>,
+    pub std: Tensor<2>,
+}
+
+/// The loss and its parts (batch means), for the metrics log.
+pub struct LossParts {
+    pub loss: Tensor<1>,
+    pub reconstruction: Tensor<1>,
+    pub single_step: Tensor<1>,
+    pub multi_step: Tensor<1>,
+    pub kl: Tensor<1>,
+}
+
+impl ContextNet {
+    pub fn init<R: Rng + ?Sized>(
+        config: &ContextConfig,
+        state_dim: usize,
+        action_dim: usize,
+        device: &Device,
+        rng: &mut R,
+    ) -> Self {
+        let (e, h) = (config.embedding, config.hidden_units);
+        let (f, b) = (config.transition_features, config.latent_dim);
+        let state_encoder = TwoLayer::init(state_dim, h, e, device, rng);
+        let action_encoder = TwoLayer::init(action_dim, h, e, device, rng);
+        let context_embedding = TwoLayer::init(b, h, e, device, rng);
+        let gru = GruCellConfig::new(2 * e, e).init(device, rng);
+        let mean_decoder = TwoLayer::init(e, h, state_dim, device, rng);
+        let (variance_decoder, constant_variance) = if config.constant_variance {
+            (None, Some(Param::from_tensor(zeros([state_dim], device))))
+        } else {
+            (Some(TwoLayer::init(e, h, state_dim, device, rng)), None)
+        };
+        let transition_encoder = TwoLayer::init(2 * state_dim + action_dim, h, f, device, rng);
+        let context_mean = TwoLayer::init(f, h, b, device, rng);
+        let context_std = MonotoneTwoLayer {
+            first: LinearConfig::new(f, h).init_non_negative(device, rng),
+            second: LinearConfig::new(h, b).init_non_negative(device, rng),
+        };
+        ContextNet {
+            state_encoder,
+            action_encoder,
+            context_embedding,
+            gru,
+            mean_decoder,
+            variance_decoder,
+            constant_variance,
+            transition_encoder,
+            context_mean,
+            context_std,
+        }
+    }
+
+    pub fn embed_state(&self, s: Tensor<2>) -> Tensor<2> {
+        tanh(self.state_encoder.forward(s))
+    }
+
+    pub fn embed_action(&self, a: Tensor<2>) -> Tensor<2> {
+        relu(self.action_encoder.forward(a))
+    }
+
+    pub fn embed_context(&self, beta: Tensor<2>) -> Tensor<2> {
+        relu(self.context_embedding.forward(beta))
+    }
+
+    /// Mean and variance of the state given GRU states `h` ([rows, E]).
+    pub fn decode(&self, h: Tensor<2>) -> (Tensor<2>, Tensor<2>) {
+        let mean = self.mean_decoder.forward(h.clone());
+        let variance = match (&self.variance_decoder, &self.constant_variance) {
+            (Some(decoder), _) => softplus(decoder.forward(h), 1.0) + VARIANCE_FLOOR,
+            (None, Some(raw)) => {
+                let [rows, d] = mean.dims();
+                (softplus(raw.val(), 1.0) + VARIANCE_FLOOR).unsqueeze::<2>().expand([rows, d])
+            }
+            (None, None) => unreachable!("a context net has a variance decoder or a constant variance"),
+        };
+        (mean, variance)
+    }
+
+    /// Pooled transition features of padded sets: transitions [sets, M, 2S + A], present [sets, M] → [sets, D_F].
+    pub fn pool(&self, transitions: Tensor<3>, present: burn::tensor::Tensor<2, burn::tensor::Bool>) -> Tensor<2> {
+        let [sets, m, d] = transitions.dims();
+        let features = relu(self.transition_encoder.forward(transitions.reshape([sets * m, d])));
+        let f = features.dims()[1];
+        max_pool_sets(features.reshape([sets, m, f]), present)
+    }
+
+    pub fn belief(&self, pooled: Tensor<2>) -> Belief {
+        let mean = self.context_mean.forward(pooled.clone());
+        let enc = self.context_std.second.forward(relu(self.context_std.first.forward(pooled)));
+        let std = softplus(enc * STD_SCALE + STD_SHIFT, 1.0) + STD_FLOOR;
+        Belief { mean, std }
+    }
+
+    /// Eq. 4.32 over a batch: −mean_batch[mean_t recon + mean_t single-step + Σ_t multi-step]
+    /// + KL(q(β|∅) ‖ N(0, I)) + λ_KL · mean_batch Σ_i max(floor, KL_i(q(β|C∪D) ‖ q(β|C))).
+    pub fn loss(&self, batch: &Batch, config: &ContextConfig, device: &Device) -> LossParts {
+        let (b, n) = (batch.size, batch.chunk);
+        let t = n - 1;
+        let s = batch.states.len() / (b * n);
+        let a = batch.actions.len() / (b * t);
+        let tdim = 2 * s + a;
+        let (e, latent) = (config.embedding, config.latent_dim);
+
+        let states = tensor(batch.states.clone(), [b, n, s], device);
+        let chunk_pool = self.pool(
+            tensor(batch.chunk_transitions.clone(), [b, t, tdim], device),
+            mask(vec![true; b * t], [b, t], device),
+        );
+        let context_pool = self.pool(
+            tensor(batch.context.clone(), [b, batch.context_max, tdim], device),
+            mask(batch.present.clone(), [b, batch.context_max], device),
+        );
+        // Max pooling distributes over a union: pool(C ∪ D) = max(pool(C), pool(D)).
+        let union_pool = chunk_pool.max_pair(context_pool.clone());
+        let posterior = self.belief(union_pool);
+        let prior = self.belief(context_pool);
+        let empty = self.belief(zeros([1, config.transition_features], device));
+
+        let kl_empty = kl_standard_normal(&empty).sum();
+        let kl_per_dim = kl_gaussians(&posterior, &prior).clamp_min(config.kl_floor as f32);
+        let kl_context = kl_per_dim.sum_dim(1).mean();
+
+        // Reconstruction: every chunk state through the state encoder and the decoder.
+        let h_all = self.embed_state(states.clone().reshape([b * n, s]));
+        let reconstruction =
+            log_likelihood(self.decode(h_all.clone()), states.clone().reshape([b * n, s])).reshape([b, n]).mean_dim(1);
+
+        // Single-step predictions from every chunk state, each with a fresh β sample.
+        let actions = tensor(batch.actions.clone(), [b * t, a], device);
+        let action_emb = self.embed_action(actions).reshape([b, t, e]);
+        let post_mean = posterior.mean.clone().unsqueeze_dim::<3>(1).expand([b, t, latent]);
+        let post_std = posterior.std.clone().unsqueeze_dim::<3>(1).expand([b, t, latent]);
+        let beta_single = post_mean + post_std * tensor(batch.noise_single.clone(), [b, t, latent], device);
+        let ctx_single = self.embed_context(beta_single.reshape([b * t, latent])).reshape([b, t, e]);
+        let h_prev = h_all.reshape([b, n, e]).slice([0..b, 0..t, 0..e]).reshape([b * t, e]);
+        let gi_single =
+            self.gru.input_gates(Tensor::cat(vec![ctx_single, action_emb.clone()], 2).reshape([b * t, 2 * e]));
+        let h_single = self.gru.step_from_input_gates(gi_single, h_prev);
+        let next_states = states.clone().slice([0..b, 1..n, 0..s]).reshape([b * t, s]);
+        let single_step = log_likelihood(self.decode(h_single), next_states).reshape([b, t]).mean_dim(1);
+
+        // Multi-step: one β for the whole chunk, open loop from s_0; predictions of s_2.. enter the sum.
+        let beta = posterior.mean + posterior.std * tensor(batch.noise_sequence.clone(), [b, latent], device);
+        let ctx = self.embed_context(beta).unsqueeze_dim::<3>(1).expand([b, t, e]);
+        let gi_seq =
+            self.gru.input_gates(Tensor::cat(vec![ctx, action_emb], 2).reshape([b * t, 2 * e])).reshape([b, t, 3 * e]);
+        let mut h = self.embed_state(states.clone().slice([0..b, 0..1, 0..s]).reshape([b, s]));
+        let mut open_loop = Vec::with_capacity(t.saturating_sub(1));
+        for k in 0..t {
+            let gi = gi_seq.clone().slice([0..b, k..k + 1, 0..3 * e]).reshape([b, 3 * e]);
+            h = self.gru.step_from_input_gates(gi, h);
+            if k >= 1 {
+                open_loop.push(h.clone());
+            }
+        }
+        let multi_step = if open_loop.is_empty() {
+            zeros([b, 1], device).sum_dim(1)
+        } else {
+            let steps = open_loop.len();
+            let hs = Tensor::stack::<3>(open_loop, 1).reshape([b * steps, e]);
+            let targets = states.slice([0..b, 2..n, 0..s]).reshape([b * steps, s]);
+            log_likelihood(self.decode(hs), targets).reshape([b, steps]).sum_dim(1)
+        };
+
+        let reconstruction = reconstruction.reshape([b]).mean();
+        let single_step = single_step.reshape([b]).mean();
+        let multi_step = multi_step.reshape([b]).mean();
+        let kl = kl_empty + kl_context * config.kl_weight as f32;
+        let loss = (reconstruction.clone() + single_step.clone() + multi_step.clone()).neg() + kl.clone();
+        LossParts { loss, reconstruction, single_step, multi_step, kl }
+    }
+}
+
+/// Σ over state dimensions of log N(x | mean, variance): [rows, S] → [rows, 1].
+fn log_likelihood((mean, variance): (Tensor<2>, Tensor<2>), x: Tensor<2>) -> Tensor<2> {
+    let log_2pi = (2.0 * std::f32::consts::PI).ln();
+    let sq = (x - mean).powi_scalar(2) / variance.clone();
+    ((sq + variance.log() + log_2pi) * -0.5).sum_dim(1)
+}
+
+/// KL(N(m, s²) ‖ N(0, 1)) per dimension.
+fn kl_standard_normal(q: &Belief) -> Tensor<2> {
+    let var = q.std.clone().powi_scalar(2);
+    (var + q.mean.clone().powi_scalar(2) - 1.0) * 0.5 - q.std.clone().log()
+}
+
+/// KL(p ‖ q) per dimension for diagonal Gaussians.
+fn kl_gaussians(p: &Belief, q: &Belief) -> Tensor<2> {
+    let ratio = (p.std.clone() / q.std.clone()).powi_scalar(2);
+    let shift = ((p.mean.clone() - q.mean.clone()) / q.std.clone()).powi_scalar(2);
+    (ratio + shift - 1.0) * 0.5 + (q.std.clone() / p.std.clone()).log()
+}
+
+/// The names checkpoints store (module paths as they are).
+pub fn param_name(path: &str) -> String {
+    path.to_string()
+}

@@ -1,0 +1,181 @@
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use super::config::{ContextConfig, EnvFamily, Preset};
+use super::data::{ContextData, Episode, InstancePair};
+use super::fast::{gaussian_entropy, FastContextModel};
+use super::net::{param_name, ContextNet};
+use super::train::ContextTrainer;
+use crate::nn::tensor::{inference_device, mask, tensor, values};
+use crate::nn::ParamSet;
+use crate::train::TrainingMethod;
+
+fn tiny_config() -> ContextConfig {
+    let mut c = ContextConfig::preset(Preset::Small, EnvFamily::Control);
+    c.embedding = 16;
+    c.hidden_units = 16;
+    c.transition_features = 8;
+    c.latent_dim = 2;
+    c.batch_size = 8;
+    c.chunk_states = 6;
+    c.context_max = 4;
+    c
+}
+
+/// A trained-looking network: weights of unit scale rather than the small initial ones.
+fn random_net(config: &ContextConfig, s: usize, a: usize, seed: u64) -> (ContextNet, ParamSet) {
+    let device = inference_device();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let net = ContextNet::init(config, s, a, &device, &mut rng);
+    let mut params = ParamSet::<f32>::from_module(&net, param_name);
+    params.tensors.iter_mut().flat_map(|t| t.values.iter_mut()).for_each(|v| *v = rng.random_range(-0.5..0.5));
+    (params.load_into(net, &device).unwrap(), params)
+}
+
+fn close(a: &[f32], b: &[f32], tol: f32) {
+    assert_eq!(a.len(), b.len());
+    for (x, y) in a.iter().zip(b) {
+        assert!((x - y).abs() <= tol * (1.0 + y.abs()), "{x} vs {y}");
+    }
+}
+
+#[test]
+fn fast_path_matches_the_burn_network() {
+    let config = tiny_config();
+    let (s, a, rows, horizon) = (3, 1, 5, 4);
+    let (net, params) = random_net(&config, s, a, 1);
+    let fast = FastContextModel::from_params(&params).unwrap();
+    let device = inference_device();
+    let mut rng = ChaCha8Rng::seed_from_u64(2);
+    let mut sample = |n: usize| -> Vec<f32> { (0..n).map(|_| rng.random_range(-1.5..1.5)).collect() };
+
+    // Beliefs of a set.
+    let set = sample(3 * (2 * s + a));
+    let pooled_burn = net.pool(tensor(set.clone(), [1, 3, 2 * s + a], &device), mask(vec![true; 3], [1, 3], &device));
+    let belief_burn = net.belief(pooled_burn.clone());
+    let pooled = fast.pool(&set);
+    close(&pooled, &values(&pooled_burn), 1e-4);
+    let belief = fast.belief(&pooled, 1);
+    close(&belief.mean, &values(&belief_burn.mean), 1e-4);
+    close(&belief.std, &values(&belief_burn.std), 1e-4);
+
+    // Mean rollouts: the GRU driven from the embedded start state with one β per row.
+    let init = sample(s);
+    let actions = sample(rows * horizon * a);
+    let betas = sample(rows * config.latent_dim);
+    let mut out = vec![0.0; rows * horizon * s];
+    fast.rollout_means(&init, &actions, &betas, rows, horizon, &mut out, &mut Default::default());
+    let ctx = net.embed_context(tensor(betas.clone(), [rows, config.latent_dim], &device));
+    let mut h = net.embed_state(tensor(init.repeat(rows), [rows, s], &device));
+    for t in 0..horizon {
+        let act: Vec<f32> =
+            (0..rows).flat_map(|r| actions[(r * horizon + t) * a..(r * horizon + t + 1) * a].to_vec()).collect();
+        let x = burn::tensor::Tensor::cat(vec![ctx.clone(), net.embed_action(tensor(act, [rows, a], &device))], 1);
+        h = net.gru.forward(x, h);
+        let (mean, _) = net.decode(h.clone());
+        let expected = values(&mean);
+        let got: Vec<f32> =
+            (0..rows).flat_map(|r| out[(r * horizon + t) * s..(r * horizon + t + 1) * s].to_vec()).collect();
+        close(&got, &expected, 1e-3);
+    }
+}
+
+#[test]
+fn context_std_never_grows_when_a_transition_is_added() {
+    // Property over random networks and random sets: eq. 4.26 holds by construction, whatever the weights.
+    let config = tiny_config();
+    let (s, a) = (3, 1);
+    let d = 2 * s + a;
+    for seed in 0..20 {
+        let (_, params) = random_net(&config, s, a, 100 + seed);
+        let fast = FastContextModel::from_params(&params).unwrap();
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let mut set: Vec<f32> = Vec::new();
+        let mut previous = fast.belief(&fast.pool(&set), 1).std;
+        for _ in 0..12 {
+            set.extend((0..d).map(|_| rng.random_range(-3.0f32..3.0)));
+            let std = fast.belief(&fast.pool(&set), 1).std;
+            for (now, before) in std.iter().zip(&previous) {
+                // Monotone in exact arithmetic; the GEMM may round a sum of unchanged terms by an ulp.
+                assert!(*now <= before * (1.0 + 1e-6), "std grew from {before} to {now} (seed {seed})");
+            }
+            previous = std;
+        }
+    }
+}
+
+#[test]
+fn entropy_after_an_imagined_rollout_matches_pooling_it_by_hand() {
+    let config = tiny_config();
+    let (s, a, horizon) = (3, 1, 3);
+    let (_, params) = random_net(&config, s, a, 9);
+    let fast = FastContextModel::from_params(&params).unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(10);
+    let base: Vec<f32> = (0..2 * (2 * s + a)).map(|_| rng.random_range(-1.0..1.0)).collect();
+    let init: Vec<f32> = (0..s).map(|_| rng.random_range(-1.0..1.0)).collect();
+    let actions: Vec<f32> = (0..horizon * a).map(|_| rng.random_range(-2.0..2.0)).collect();
+    let states: Vec<f32> = (0..horizon * s).map(|_| rng.random_range(-1.0..1.0)).collect();
+    let mut out = [0.0];
+    fast.entropy_after(&fast.pool(&base), &init, &actions, &states, 1, horizon, &mut out, &mut Default::default());
+    let mut all = base.clone();
+    for t in 0..horizon {
+        all.extend_from_slice(if t == 0 { &init } else { &states[(t - 1) * s..t * s] });
+        all.extend_from_slice(&actions[t * a..(t + 1) * a]);
+        all.extend_from_slice(&states[t * s..(t + 1) * s]);
+    }
+    let expected = gaussian_entropy(&fast.belief(&fast.pool(&all), 1).std);
+    assert!((out[0] - expected).abs() < 1e-5, "{} vs {expected}", out[0]);
+}
+
+/// Toy-like data: s' = A s + [α, 0] u for |u| < 1 (no noise), α per instance.
+fn toy_like(instances: usize, len: usize, seed: u64) -> ContextData {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let episode = |alpha: f32, rng: &mut ChaCha8Rng| {
+        let mut x = [rng.random_range(-1.0f32..1.0), rng.random_range(-1.0f32..1.0)];
+        let (mut states, mut actions) = (x.to_vec(), Vec::new());
+        for _ in 0..len {
+            let u: f32 = rng.random_range(-2.0..2.0);
+            let squash = (1.0 - u.abs()).max(0.0);
+            x = [0.8 * x[0] + 0.2 * x[1] + alpha * squash, -0.2 * x[0] + 0.8 * x[1]];
+            states.extend_from_slice(&x);
+            actions.push(u);
+        }
+        Episode { states, actions, len }
+    };
+    let pairs = (0..instances)
+        .map(|_| {
+            let alpha = rng.random_range(-1.0..1.0);
+            InstancePair { target: episode(alpha, &mut rng), source: episode(alpha, &mut rng) }
+        })
+        .collect();
+    ContextData { state_dim: 2, action_dim: 1, pairs }
+}
+
+#[test]
+fn training_lowers_the_loss_and_resumes_identically() {
+    let mut config = tiny_config();
+    config.constant_variance = true;
+    config.latent_dim = 1;
+    let data = toy_like(40, 12, 3);
+    let (train, valid) = data.split(0.2, 1);
+    let mut trainer = ContextTrainer::new(config.clone(), 7, train.clone(), valid.clone()).unwrap();
+    let first = trainer.validate().unwrap().unwrap();
+    for step in 1..=300 {
+        let loss = trainer.step(step).unwrap();
+        assert!(loss.is_finite());
+    }
+    let later = trainer.validate().unwrap().unwrap();
+    assert!(later < first - 1.0, "validation loss {first} → {later}");
+
+    // Stop at step 30 and restore into a fresh trainer: the next steps give the same losses.
+    let mut a = ContextTrainer::new(config.clone(), 7, train.clone(), valid.clone()).unwrap();
+    for step in 1..=30 {
+        a.step(step).unwrap();
+    }
+    let saved = a.state();
+    let mut b = ContextTrainer::new(config, 7, train, valid).unwrap();
+    b.restore(&saved).unwrap();
+    for step in 31..=35 {
+        assert_eq!(a.step(step).unwrap(), b.step(step).unwrap());
+    }
+}

@@ -1,0 +1,132 @@
+//! Training the context model on the shared loop: one step = one batch of (chunk, context set) pairs through
+//! eq. 4.32 with burn's autodiff, then our Adam.
+
+use burn::tensor::Device;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+
+use super::config::ContextConfig;
+use super::data::{Batch, ContextData};
+use super::net::{param_name, ContextNet};
+use crate::error::{Error, Result};
+use crate::nn::tensor::{scalar, training_device};
+use crate::nn::{Adam, ParamSet};
+use crate::train::{state, StoredTensor, TrainingMethod};
+use crate::util::seeding::{derive_seed, rng_for};
+
+const INIT_STREAM: u64 = 1;
+const BATCH_STREAM: u64 = 3;
+const VALID_STREAM: u64 = 4;
+
+pub struct ContextTrainer {
+    config: ContextConfig,
+    seed: u64,
+    device: Device,
+    net: Option<ContextNet>,
+    params: ParamSet,
+    adam: Adam<f32>,
+    train: ContextData,
+    chunk: usize,
+    /// Drawn once (appendix B.2.2) so every validation compares the same batches.
+    valid_batches: Vec<Batch>,
+}
+
+/// A fresh network of this shape (the weights of a seeded initialization).
+pub fn init_net(config: &ContextConfig, state_dim: usize, action_dim: usize, seed: u64, device: &Device) -> ContextNet {
+    let mut rng = ChaCha8Rng::seed_from_u64(derive_seed(seed, &[INIT_STREAM]));
+    ContextNet::init(config, state_dim, action_dim, device, &mut rng)
+}
+
+impl ContextTrainer {
+    pub fn new(config: ContextConfig, seed: u64, train: ContextData, valid: ContextData) -> Result<Self> {
+        config.validate()?;
+        if train.is_empty() {
+            return Err(Error::data("no training instances"));
+        }
+        let chunk = train.chunk_states(config.chunk_states)?;
+        let device = training_device();
+        let net = init_net(&config, train.state_dim, train.action_dim, seed, &device);
+        let params = ParamSet::<f32>::from_module(&net, param_name);
+        let sizes: Vec<usize> = params.tensors.iter().map(|t| t.values.len()).collect();
+        let adam = Adam::new(config.optimizer, &sizes);
+        let valid_batches = if valid.is_empty() {
+            Vec::new()
+        } else {
+            let valid_chunk = valid.chunk_states(chunk)?;
+            (0..config.validation_batches as u64)
+                .map(|k| {
+                    let mut rng = rng_for(seed, &[VALID_STREAM, k]);
+                    valid.sample_batch(
+                        &mut rng,
+                        config.batch_size,
+                        valid_chunk,
+                        config.context_max,
+                        0.0,
+                        config.latent_dim,
+                    )
+                })
+                .collect()
+        };
+        Ok(ContextTrainer { config, seed, device, net: Some(net), params, adam, train, chunk, valid_batches })
+    }
+
+    fn net(&self) -> &ContextNet {
+        self.net.as_ref().expect("the network is only taken out while loading new weights")
+    }
+
+    fn load_params(&mut self) -> Result<()> {
+        let net = self.net.take().expect("network present");
+        self.net = Some(self.params.load_into(net, &self.device)?);
+        Ok(())
+    }
+
+    pub fn parameter_count(&self) -> usize {
+        self.params.count()
+    }
+
+    pub fn chunk(&self) -> usize {
+        self.chunk
+    }
+}
+
+impl TrainingMethod for ContextTrainer {
+    fn step(&mut self, step: u64) -> Result<f64> {
+        let mut rng = rng_for(self.seed, &[BATCH_STREAM, step]);
+        let c = &self.config;
+        let from_target = c.context_from_target.at(step - 1);
+        let batch =
+            self.train.sample_batch(&mut rng, c.batch_size, self.chunk, c.context_max, from_target, c.latent_dim);
+        let net = self.net();
+        let parts = net.loss(&batch, &self.config, &self.device);
+        let value = scalar(&parts.loss);
+        if !value.is_finite() {
+            return Ok(value);
+        }
+        let mut grads = ParamSet::<f32>::gradients(net, &parts.loss.backward());
+        self.adam.update(&mut self.params.values_mut(), &mut grads)?;
+        self.load_params()?;
+        Ok(value)
+    }
+
+    fn validate(&mut self) -> Result<Option<f64>> {
+        if self.valid_batches.is_empty() {
+            return Ok(None);
+        }
+        let net = self.net();
+        let total: f64 = self.valid_batches.iter().map(|b| scalar(&net.loss(b, &self.config, &self.device).loss)).sum();
+        Ok(Some(total / self.valid_batches.len() as f64))
+    }
+
+    fn weights(&self) -> Vec<StoredTensor> {
+        state::weights(&self.params)
+    }
+
+    fn state(&self) -> Vec<StoredTensor> {
+        state::save(&self.params, &self.adam)
+    }
+
+    fn restore(&mut self, saved: &[StoredTensor]) -> Result<()> {
+        state::restore(saved, &mut self.params, &mut self.adam)?;
+        self.load_params()
+    }
+}
