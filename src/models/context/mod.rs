@@ -20,7 +20,7 @@ pub use fast::FastContextModel;
 pub use train::ContextTrainer;
 
 use crate::data::{read_dataset, Dataset, Rollout};
-use crate::envs::{parse_env, EnvName};
+use crate::envs::EnvName;
 use crate::error::{Error, Result};
 use crate::run::dir::Provenance;
 use crate::run::Monitor;
@@ -136,26 +136,12 @@ pub fn instance_pairs(dataset: &Dataset, path: &Path, angular: &[bool]) -> Resul
     Ok(ContextData { state_dim, action_dim: dataset.meta.action_dim, pairs })
 }
 
-fn env_of(dataset: &Dataset, requested: Option<&str>, data: &Path) -> Result<EnvName> {
-    let env = parse_env(&dataset.meta.env).map_err(|e| Error::bad_file(data, format!("dataset env: {e}")))?;
-    if let Some(requested) = requested {
-        let requested_env = parse_env(requested)?;
-        if requested_env.canonical() != env.canonical() {
-            return Err(Error::bad_file(
-                data,
-                format!("holds '{}' rollouts; --env asked for '{}'", env.canonical(), requested_env.canonical()),
-            ));
-        }
-    }
-    Ok(env)
-}
-
 /// Trains (or, with `resume`, continues) a context model into `request.out`.
 pub fn train(request: &TrainRequest, resume: bool, monitor: &dyn Monitor) -> Result<TrainReport> {
     request.config.validate()?;
     let file = DataFile::fingerprint(&request.data)?;
     let dataset = read_dataset(&request.data)?;
-    let env = env_of(&dataset, request.env.as_deref(), &request.data)?;
+    let env = crate::models::pets::env_of(&dataset, request.env.as_deref(), &request.data)?;
     let spec = env.build()?.spec();
     if dataset.meta.state_names.len() != spec.angular.len() || dataset.meta.action_dim != spec.action_dim() {
         return Err(Error::bad_file(
