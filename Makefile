@@ -4,7 +4,7 @@
 MBRL := target/release/mbrl
 SEED ?= 0
 
-.PHONY: build test bench completions repro-quick repro-swingup repro-pendulum-data repro-boards repro-ball repro-pets repro-pets-loop clean-reports
+.PHONY: build test bench completions repro-quick repro-swingup repro-pendulum-data repro-boards repro-ball repro-pets repro-pets-loop repro-context clean-reports
 
 build:
 	cargo build --release
@@ -61,6 +61,33 @@ repro-pets-loop: build
 		$(MBRL) train --method pets --env pendulum $$data --steps 1000 --seed $(SEED) --no-tui -q --out models/pets-loop || exit 1; \
 		$(MBRL) plan --env pendulum --model models/pets-loop --steps 150 --seed $$i --no-tui --out datasets/pets-loop/iter-$$i.mcap || exit 1; \
 	done
+
+# Thesis 4.5 (Explore the Context): per env, instance pairs, a context model and the calibration protocol in
+# unseen contexts (random / open-loop / MPC from one start; MSE vs horizon, Wilcoxon tests; pendulum: quadrants
+# and swing-up return beside ground truth; toy: entropy vs action). CONTEXT_PRESET=medium (200 units, a tenth of
+# Table B.1's steps) takes hours per env on 2 cores; CONTEXT_PRESET=small (64 units; toy 32) and smaller CEM
+# (CONTEXT_CEM="--candidates 200 --elites 20 --iters 5 --beta-samples 10") make a run of about an hour.
+CONTEXT_PRESET ?= medium
+CONTEXT_CONTEXTS ?= 50
+CONTEXT_CEM ?=
+CONTEXT_SWINGUP ?= --swingup
+repro-context: build
+	for sq in inner outer; do \
+		$(MBRL) collect --env toy:$$sq --instances 5000 --steps 100 --seed $(SEED) --no-tui -q --out datasets/context/toy-$$sq.mcap || exit 1; \
+		$(MBRL) train --method context --data datasets/context/toy-$$sq.mcap --preset $(CONTEXT_PRESET) --seed $(SEED) --no-tui -q --out models/context/toy-$$sq || exit 1; \
+		for n in 1 2 3; do \
+			$(MBRL) eval context --model models/context/toy-$$sq --env toy:$$sq --transitions $$n --contexts $(CONTEXT_CONTEXTS) \
+				$(CONTEXT_CEM) --seed $(SEED) --no-tui -q --out reports/context/toy-$$sq-n$$n || exit 1; \
+		done; \
+	done
+	$(MBRL) collect --env pendulum:quadrant --instances 10000 --steps 100 --seed $(SEED) --no-tui -q --out datasets/context/pendulum-quadrant.mcap
+	$(MBRL) train --method context --data datasets/context/pendulum-quadrant.mcap --preset $(CONTEXT_PRESET) --seed $(SEED) --no-tui -q --out models/context/pendulum-quadrant
+	$(MBRL) eval context --model models/context/pendulum-quadrant --env pendulum:quadrant --transitions 30 --horizon 20 \
+		--contexts $(CONTEXT_CONTEXTS) $(CONTEXT_CEM) $(CONTEXT_SWINGUP) --seed $(SEED) --no-tui -q --out reports/context/pendulum-quadrant
+	$(MBRL) collect --env mountaincar --instances 5000 --steps 100 --seed $(SEED) --no-tui -q --out datasets/context/mountaincar.mcap
+	$(MBRL) train --method context --data datasets/context/mountaincar.mcap --preset $(CONTEXT_PRESET) --seed $(SEED) --no-tui -q --out models/context/mountaincar
+	$(MBRL) eval context --model models/context/mountaincar --env mountaincar --transitions 50 --horizon 30 \
+		--contexts $(CONTEXT_CONTEXTS) $(CONTEXT_CEM) --seed $(SEED) --no-tui -q --out reports/context/mountaincar
 
 # Thesis chapter 7 environments: depth/split tables, board sets, embodied play with scripted controllers.
 repro-boards: build

@@ -1,18 +1,26 @@
 //! Explore the Context: one training step (batch 64 and 512 × 50-state chunks, the thesis network), one
 //! 1000-candidate × 20-step mean rollout on the fast path (the unit PyTorch's 7.3 batches/s refers to), one
-//! CEM iteration of EIG calibration (1000 candidates × 20 β samples × horizon 20) and one MPC step on the
-//! calibrated model (1000 × 20 × 10 iterations). PyTorch figures: benches/pytorch/context_reference.py.
+//! CEM iteration of EIG calibration (1000 candidates × 20 β samples × horizon 20) and one MPC step on a calibrated
+//! checkpoint (1000 × 20 × 10 iterations). PyTorch figures: benches/pytorch/context_reference.py.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use mbrl::data::collect::{collect_instance_pairs, InstancePairSettings};
+use mbrl::data::write_dataset;
+use mbrl::envs::parse_env;
 use mbrl::models::context::config::{ContextConfig, EnvFamily, Preset};
 use mbrl::models::context::data::{ContextData, Episode, InstancePair};
+use mbrl::models::context::dynamics::ContextDynamics;
 use mbrl::models::context::eig::EigObjective;
 use mbrl::models::context::fast::{FastContextModel, RolloutScratch};
 use mbrl::models::context::net::{param_name, ContextNet};
 use mbrl::models::context::ContextTrainer;
+use mbrl::models::context::{load, train, TrainRequest};
 use mbrl::nn::tensor::inference_device;
 use mbrl::nn::ParamSet;
 use mbrl::planning::Objective;
+use mbrl::planning::{Cem, CemConfig, ReturnObjective};
+use mbrl::run::dir::Provenance;
+use mbrl::run::NullMonitor;
 use mbrl::train::TrainingMethod;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -86,5 +94,30 @@ fn planning(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, train_step, planning);
+/// A real (one-step-trained) paper-size checkpoint on pendulum:quadrant data, loaded as the CLI loads it and
+/// conditioned on a few transitions: the MPC step a `plan --context` run repeats every env step.
+fn mpc_step(c: &mut Criterion) {
+    let dir = tempfile::tempdir().unwrap();
+    let env = parse_env("pendulum:quadrant").unwrap();
+    let data = dir.path().join("pairs.mcap");
+    let collect =
+        InstancePairSettings { env: env.clone(), instances: 20, steps: 60, seed: 1, command_line: String::new() };
+    write_dataset(&data, &collect_instance_pairs(&collect, &NullMonitor).unwrap()).unwrap();
+    let mut config = paper_config(64);
+    config.steps = 1;
+    let provenance = Provenance::new(String::new(), 0, 1);
+    let request = TrainRequest { out: dir.path().join("model"), data, env: None, config, seed: 0, provenance };
+    train(&request, false, &NullMonitor).unwrap();
+    let model = load(&request.out, &env).unwrap();
+    let context: Vec<f32> = (0..10 * model.fast.transition_dim()).map(|i| ((i % 7) as f32 - 3.0) * 0.3).collect();
+    let dynamics = ContextDynamics::new(model, &context, &env).unwrap();
+    let init = [std::f64::consts::PI, 0.0];
+    let mut group = c.benchmark_group("context_mpc_step_1000x20x10");
+    group.sample_size(10);
+    let mut cem = Cem::new(CemConfig::for_box(&[-2.0], &[2.0]), 0).unwrap();
+    group.bench_function("paper_net", |b| b.iter(|| cem.plan(&ReturnObjective::new(&dynamics, &init, 0), |_| {})));
+    group.finish();
+}
+
+criterion_group!(benches, train_step, planning, mpc_step);
 criterion_main!(benches);

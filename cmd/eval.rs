@@ -6,6 +6,7 @@ use anyhow::bail;
 use clap::{Args, Subcommand};
 use mbrl::envs::boards::{GameSpec, LightsOut, TileSwap};
 use mbrl::envs::pendulum::PendulumVariant;
+use mbrl::envs::EnvName;
 use mbrl::eval::ball::{self, BallEvalSettings};
 use mbrl::eval::boards::{self, EmbodiedSettings};
 use mbrl::eval::dataset_report;
@@ -76,7 +77,7 @@ enum Protocol {
     /// Explore the Context (thesis 4.5): calibration strategies compared by prediction error after calibration.
     #[command(
         after_help = "Examples:\n  mbrl eval context --model models/context-toy-inner --env toy:inner --transitions 1\n  \
-                            mbrl eval context --model models/context-pendulum-quadrant --env pendulum:quadrant --contexts 50 --transitions 30 --horizon 20"
+                            mbrl eval context --model models/context-pendulum-quadrant --env pendulum:quadrant --contexts 50 --transitions 30 --horizon 20 --swingup"
     )]
     Context(ContextArgs),
     /// Pendulum swing-up with MPC: success rate, returns, angle plots.
@@ -305,6 +306,16 @@ struct ContextArgs {
     /// β samples of the information gain (thesis 20).
     #[arg(long, default_value_t = 20)]
     beta_samples: usize,
+    /// Pendulum: after each calibration, swing up with MPC on the calibrated model (thesis 4.5.3), and once on
+    /// the true equations as the reference.
+    #[arg(long)]
+    swingup: bool,
+    /// Agent steps of each swing-up (thesis 50; the quadrant pendulum repeats each action twice).
+    #[arg(long, default_value_t = 50, requires = "swingup")]
+    swingup_steps: usize,
+    /// CEM candidates of the swing-up planner (thesis 1000; elites are a tenth, 10 iterations, horizon 20).
+    #[arg(long, default_value_t = 1000, requires = "swingup")]
+    swingup_candidates: usize,
     /// Report directory.
     #[arg(long, default_value = "reports/context")]
     out: PathBuf,
@@ -318,7 +329,7 @@ fn eval_context(global: &GlobalArgs, provenance: &Provenance, a: ContextArgs) ->
     }
     let strategies: Vec<Strategy> =
         if a.strategy.is_empty() { Strategy::ALL.to_vec() } else { a.strategy.iter().map(|s| s.strategy()).collect() };
-    let settings = mbrl::eval::context::ContextEvalSettings {
+    let mut settings = mbrl::eval::context::ContextEvalSettings {
         contexts: a.contexts,
         validation_rollouts: a.validation_rollouts,
         validation_steps: a.validation_steps,
@@ -332,8 +343,22 @@ fn eval_context(global: &GlobalArgs, provenance: &Provenance, a: ContextArgs) ->
             iterations: a.iters,
             beta_samples: a.beta_samples,
         },
+        swingup: None,
     };
     settings.calibration.validate()?;
+    if a.swingup {
+        let EnvName::Pendulum(variant) = &env else {
+            bail!("--swingup needs a pendulum env (pendulum:quadrant in the thesis), not '{}'", env.canonical());
+        };
+        if !(2..=100_000).contains(&a.swingup_candidates) || !(1..=10_000).contains(&a.swingup_steps) {
+            bail!("--swingup-candidates must be 2..=100000 and --swingup-steps 1..=10000");
+        }
+        let mut swingup = SwingupSettings::thesis(variant.clone());
+        swingup.steps = a.swingup_steps;
+        swingup.cem.candidates = a.swingup_candidates;
+        swingup.cem.elites = (a.swingup_candidates / 10).max(2);
+        settings.swingup = Some(swingup);
+    }
     if !(2..=100_000).contains(&a.contexts)
         || !(1..=10_000).contains(&a.validation_rollouts)
         || !(1..=10_000).contains(&a.validation_steps)
@@ -349,6 +374,15 @@ fn eval_context(global: &GlobalArgs, provenance: &Provenance, a: ContextArgs) ->
     }
     for (better, worse, p) in &summary.tests {
         println!("Wilcoxon: {} lower than {}: p = {p:.3e}", better.name(), worse.name());
+    }
+    if let Some(sw) = &summary.swingup {
+        for (s, r) in strategies.iter().zip(&sw.mean_return) {
+            println!("{:<10} mean swing-up return {r:.1}", s.name());
+        }
+        println!("ground truth mean swing-up return {:.1}", sw.ground_truth_mean_return);
+        for (better, worse, p) in &sw.tests {
+            println!("Wilcoxon: {} higher swing-up return than {}: p = {p:.3e}", better.name(), worse.name());
+        }
     }
     if let Some((informative, non_informative)) = summary.toy_entropy {
         println!("entropy after one transition: informative actions {informative:.3}, non-informative {non_informative:.3} nats");

@@ -444,7 +444,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__context)
-            opts="-q -h -V --model --env --contexts --validation-rollouts --validation-steps --transitions --horizon --strategy --candidates --elites --iters --beta-samples --out --seed --threads --tui --no-tui --quiet --help --version"
+            opts="-q -h -V --model --env --contexts --validation-rollouts --validation-steps --transitions --horizon --strategy --candidates --elites --iters --beta-samples --swingup --swingup-steps --swingup-candidates --out --seed --threads --tui --no-tui --quiet --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -495,6 +495,14 @@ _mbrl() {
                     return 0
                     ;;
                 --beta-samples)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --swingup-steps)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --swingup-candidates)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;

@@ -154,4 +154,19 @@ fn wrong_inputs_are_one_line_errors() {
         .unwrap();
     assert!(!out.status.success());
     assert!(stderr_of(&out).contains("toy:inner"), "{}", stderr_of(&out));
+    // A checkpoint of another method.
+    std::fs::write(d.join("five.toml"), "steps = 5\n").unwrap();
+    run_ok(d, &["collect", "--env", "pendulum", "--rollouts", "4", "--steps", "20", "-q", "--out", "pend4.mcap"]);
+    run_ok(d, &["train", "--method", "pets", "--data", "pend4.mcap", "--config", "five.toml", "-q", "--out", "pets"]);
+    for args in [
+        &["calibrate", "--model", "pets", "--env", "pendulum:quadrant", "--instance-seed", "1", "--strategy", "random"]
+            [..],
+        &["eval", "context", "--model", "pets", "--env", "pendulum", "--out", "report"][..],
+    ] {
+        let out = mbrl(d).args(args).args(["--no-tui"]).output().unwrap();
+        assert!(!out.status.success());
+        let err = stderr_of(&out);
+        assert!(err.contains("'pets' checkpoint") && err.lines().count() == 1, "{err}");
+    }
+    assert!(!d.join("report").exists());
 }

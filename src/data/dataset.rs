@@ -147,7 +147,7 @@ pub fn read_dataset(path: &Path) -> Result<Dataset> {
     }
     let data = Dataset { meta, steps };
     if data.meta.layout == DatasetLayout::InstancePairs {
-        pair_up(&data).map_err(|e| Error::bad_file(path, e))?;
+        check_pairs(&data.meta, &data.steps).map_err(|e| Error::bad_file(path, e))?;
     }
     Ok(data)
 }
@@ -166,48 +166,65 @@ pub fn instance_pairs(data: &Dataset) -> Result<Vec<(Rollout, Rollout)>> {
 
 /// Checks the pairing rules and groups the rollouts; the error says what is wrong, the caller adds where.
 fn pair_up(data: &Dataset) -> std::result::Result<Vec<(Rollout, Rollout)>, String> {
-    let rule = "layout 'instance-pairs'";
-    let grouped = Rollout::group(&data.steps).map_err(|i| {
-        let s = &data.steps[i];
-        format!("{rule}: message {i} (rollout {}, t {}) does not continue its rollout", s.rollout, s.t)
-    })?;
-    let expected_rollouts = data.meta.instances.len();
-    if !expected_rollouts.is_multiple_of(2) {
-        return Err(format!(
-            "{rule}: 'instances' has {expected_rollouts} entries; expected two (equal) entries per instance"
-        ));
-    }
-    for (position, (id, _)) in grouped.iter().enumerate() {
-        if *id as usize != position {
-            return Err(format!(
-                "{rule}: rollout {position} (instance {}) is missing or out of order (found rollout {id} there)",
-                position / 2
-            ));
-        }
-    }
-    if grouped.len() != expected_rollouts {
-        let missing = grouped.len();
-        return Err(format!(
-            "{rule}: instance {} lacks its {} rollout {missing}; expected {expected_rollouts} rollouts for {} instances",
-            missing / 2,
-            if missing % 2 == 0 { "target" } else { "context-source" },
-            expected_rollouts / 2
-        ));
-    }
-    let mut pairs = Vec::with_capacity(grouped.len() / 2);
+    check_pairs(&data.meta, &data.steps)?;
+    let grouped = Rollout::group(&data.steps).map_err(|i| format!("message {i} does not continue its rollout"))?;
     let mut rollouts = grouped.into_iter().map(|(_, r)| r);
-    for (k, params) in data.meta.instances.chunks(2).enumerate() {
-        if params[0] != params[1] {
-            return Err(format!(
-                "{rule}: instance {k} has different parameters for rollouts {} and {}",
-                2 * k,
-                2 * k + 1
-            ));
-        }
-        let (a, b) = (rollouts.next(), rollouts.next());
-        pairs.push((a.unwrap_or_default(), b.unwrap_or_default()));
+    let mut pairs = Vec::with_capacity(data.meta.instances.len() / 2);
+    while let (Some(a), Some(b)) = (rollouts.next(), rollouts.next()) {
+        pairs.push((a, b));
     }
     Ok(pairs)
+}
+
+/// The pairing rules, checked in one pass without copying the data (readers call it on every file).
+fn check_pairs(meta: &DatasetMeta, steps: &[Timestep]) -> std::result::Result<(), String> {
+    let rule = "layout 'instance-pairs'";
+    let rollouts = meta.instances.len();
+    if !rollouts.is_multiple_of(2) {
+        return Err(format!("{rule}: 'instances' has {rollouts} entries; expected two (equal) entries per instance"));
+    }
+    let mut next_id = 0usize;
+    let mut previous: Option<&Timestep> = None;
+    for (i, step) in steps.iter().enumerate() {
+        match previous {
+            Some(p) if p.rollout == step.rollout => {
+                if step.t != p.t + 1 || step.state != p.next_state {
+                    return Err(format!(
+                        "{rule}: message {i} (rollout {}, t {}) does not continue its rollout",
+                        step.rollout, step.t
+                    ));
+                }
+            }
+            _ => {
+                if step.rollout as usize != next_id || step.t != 0 {
+                    return Err(format!(
+                        "{rule}: rollout {next_id} (instance {}) is missing or out of order (message {i} is rollout \
+                         {}, t {})",
+                        next_id / 2,
+                        step.rollout,
+                        step.t
+                    ));
+                }
+                if next_id >= rollouts {
+                    return Err(format!("{rule}: rollout {next_id} has no entry in 'instances' ({rollouts} entries)"));
+                }
+                next_id += 1;
+            }
+        }
+        previous = Some(step);
+    }
+    if next_id != rollouts {
+        return Err(format!(
+            "{rule}: instance {} lacks its {} rollout {next_id}; expected {rollouts} rollouts for {} instances",
+            next_id / 2,
+            if next_id.is_multiple_of(2) { "target" } else { "context-source" },
+            rollouts / 2
+        ));
+    }
+    if let Some(k) = (0..rollouts / 2).find(|k| meta.instances[2 * k] != meta.instances[2 * k + 1]) {
+        return Err(format!("{rule}: instance {k} has different parameters for rollouts {} and {}", 2 * k, 2 * k + 1));
+    }
+    Ok(())
 }
 
 fn validate_step(path: &Path, meta: &DatasetMeta, step: &Timestep, sequence: u32) -> Result<()> {

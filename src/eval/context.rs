@@ -13,12 +13,14 @@ use serde::Serialize;
 
 use super::plot::{line_plot, Series};
 use super::stats::{mean, wilcoxon_signed_rank, Alternative};
+use super::swingup::{self, SwingupSettings};
 use crate::data::Rollout;
 use crate::envs::{instance_env, EnvName};
 use crate::error::{Error, Result};
 use crate::models::context::calibration::{
     context_rows, run_calibration, CalibrationRequest, CalibrationSettings, Strategy,
 };
+use crate::models::context::dynamics::ContextDynamics;
 use crate::models::context::fast::{gaussian_entropy, RolloutScratch};
 use crate::models::context::LoadedModel;
 use crate::run::dir::{Provenance, RunDir};
@@ -36,6 +38,10 @@ pub struct ContextEvalSettings {
     pub strategies: Vec<Strategy>,
     /// N, H_max and the CEM/β-sample sizes of every EIG calibration.
     pub calibration: CalibrationSettings,
+    /// Pendulum only: after each calibration, a swing-up planned on the model conditioned on it (thesis 4.5.3:
+    /// CEM 1000/100/10, horizon 20, 50 agent steps), and one planned on the simulator's own equations in the
+    /// same instance as the ground-truth reference.
+    pub swingup: Option<SwingupSettings>,
 }
 
 /// What one strategy achieved in one context.
@@ -45,6 +51,7 @@ struct Outcome {
     mse_by_horizon: Vec<f64>,
     final_entropy: f64,
     quadrants: Option<usize>,
+    swingup_return: Option<f64>,
 }
 
 pub struct ContextEvalSummary {
@@ -54,6 +61,15 @@ pub struct ContextEvalSummary {
     pub tests: Vec<(Strategy, Strategy, f64)>,
     /// Toy only: (mean entropy after one informative transition, after one non-informative transition).
     pub toy_entropy: Option<(f64, f64)>,
+    /// With `swingup`: mean swing-up return per strategy, the ground-truth model's mean return, and one-sided
+    /// p-values that the first strategy named gives a higher return than the second.
+    pub swingup: Option<SwingupSummary>,
+}
+
+pub struct SwingupSummary {
+    pub mean_return: Vec<f64>,
+    pub ground_truth_mean_return: f64,
+    pub tests: Vec<(Strategy, Strategy, f64)>,
 }
 
 fn layout(title: &str) -> Event {
@@ -153,6 +169,17 @@ pub fn evaluate(
         return Err(Error::config("eval context needs at least one calibration strategy"));
     }
     settings.calibration.validate()?;
+    if let Some(swingup) = &settings.swingup {
+        if !matches!(env, EnvName::Pendulum(_)) {
+            return Err(Error::config(format!(
+                "the swing-up test needs a pendulum env (pendulum:quadrant in the thesis), not '{}'",
+                env.canonical()
+            )));
+        }
+        if swingup.steps == 0 {
+            return Err(Error::config("the swing-up test needs at least 1 step"));
+        }
+    }
     let run = RunDir::create(report_dir)?;
     run.write_config(&serde_json::json!({
         "job": "eval context",
@@ -167,6 +194,7 @@ pub fn evaluate(
     let seed = provenance.seed;
     let is_quadrant = env.canonical() == "pendulum:quadrant";
     let mut outcomes: Vec<Vec<Outcome>> = Vec::with_capacity(settings.contexts);
+    let mut ground_truth_returns = Vec::new();
     for k in 0..settings.contexts as u64 {
         if monitor.is_cancelled() {
             return Err(Error::Cancelled);
@@ -183,6 +211,19 @@ pub fn evaluate(
             env_k.reset(&mut rng);
             env_k.state()
         });
+        let swingup_seed = derive_seed(seed, &[k, 3]);
+        let swingup_settings = settings.swingup.as_ref().map(|sw| SwingupSettings {
+            variant: match env {
+                EnvName::Pendulum(v) => v.clone(),
+                _ => unreachable!("checked above: the swing-up test runs on pendulum envs"),
+            },
+            instance_seed: Some(instance_seed),
+            ..sw.clone()
+        });
+        if let Some(sw) = &swingup_settings {
+            let truth = swingup::run_episode(sw, None, swingup_seed, 0, &crate::run::NullMonitor)?;
+            ground_truth_returns.push(truth.total_return);
+        }
         let mut per_strategy = Vec::new();
         for (j, strategy) in settings.strategies.iter().enumerate() {
             let request = CalibrationRequest {
@@ -208,14 +249,52 @@ pub fn evaluate(
             });
             let final_entropy = *calibration.entropies.last().expect("entropy before calibration is always there");
             monitor.scalar(&format!("context/{}/entropy", strategy.name()), k, final_entropy);
-            per_strategy.push(Outcome { mse_by_horizon, final_entropy, quadrants });
+            // The same start and candidate seed for every strategy: the returns are paired by context.
+            let swingup_return = match &swingup_settings {
+                Some(sw) => {
+                    let dynamics = ContextDynamics::new(model.clone(), &rows, env)?;
+                    let episode = swingup::run_episode(sw, Some(&dynamics), swingup_seed, 0, &crate::run::NullMonitor)?;
+                    monitor.scalar(&format!("context/{}/swingup_return", strategy.name()), k, episode.total_return);
+                    Some(episode.total_return)
+                }
+                None => None,
+            };
+            per_strategy.push(Outcome { mse_by_horizon, final_entropy, quadrants, swingup_return });
         }
         outcomes.push(per_strategy);
     }
     monitor.progress("contexts", settings.contexts as u64, settings.contexts as u64);
-    let summary = write_report(model, env, settings, &run, &outcomes)?;
+    let summary = write_report(model, env, settings, &run, &outcomes, &ground_truth_returns)?;
     metrics.emit(&Event::Finished { ok: true });
     Ok(summary)
+}
+
+/// Wilcoxon signed-rank tests of open-loop and MPC against random and of MPC against open-loop, on the per-context
+/// values `metric(strategy index)`, for the strategies that were run; one CSV row each.
+fn paired_tests(
+    strategies: &[Strategy],
+    metric: &dyn Fn(usize) -> Vec<f64>,
+    alternative: Alternative,
+    label: &str,
+    rows: &mut Vec<Vec<String>>,
+) -> Result<Vec<(Strategy, Strategy, f64)>> {
+    let position = |s: Strategy| strategies.iter().position(|x| *x == s);
+    let mut tests = Vec::new();
+    for (better, worse) in
+        [(Strategy::OpenLoop, Strategy::Random), (Strategy::Mpc, Strategy::Random), (Strategy::Mpc, Strategy::OpenLoop)]
+    {
+        let (Some(a), Some(b)) = (position(better), position(worse)) else { continue };
+        let result = wilcoxon_signed_rank(&metric(a), &metric(b), alternative)?;
+        tests.push((better, worse, result.p_value));
+        rows.push(vec![
+            format!("{} ({label})", better.name()),
+            worse.name().to_string(),
+            result.n.to_string(),
+            format!("{}", result.statistic),
+            format!("{:.4e}", result.p_value),
+        ]);
+    }
+    Ok(tests)
 }
 
 fn write_report(
@@ -224,6 +303,7 @@ fn write_report(
     settings: &ContextEvalSettings,
     run: &RunDir,
     outcomes: &[Vec<Outcome>],
+    ground_truth_returns: &[f64],
 ) -> Result<ContextEvalSummary> {
     let strategies = &settings.strategies;
     let per_context_mse =
@@ -240,10 +320,15 @@ fn write_report(
                 format!("{:.6e}", mean(&o[j].mse_by_horizon).unwrap_or(f64::NAN)),
                 format!("{:.4}", o[j].final_entropy),
                 o[j].quadrants.map(|q| q.to_string()).unwrap_or_default(),
+                o[j].swingup_return.map(|r| format!("{r:.3}")).unwrap_or_default(),
             ]);
         }
     }
-    write_csv(&run.file("per_context.csv"), &["context", "strategy", "mean_mse", "final_entropy", "quadrants"], &rows)?;
+    write_csv(
+        &run.file("per_context.csv"),
+        &["context", "strategy", "mean_mse", "final_entropy", "quadrants", "swingup_return"],
+        &rows,
+    )?;
 
     // MSE against the horizon.
     let horizon = settings.validation_steps;
@@ -275,37 +360,36 @@ fn write_report(
         .collect();
     line_plot(
         &run.file("mse_vs_horizon.png"),
-        &format!(
-            "{}: open-loop prediction MSE after calibration (mean over {} contexts)",
-            env.canonical(),
-            outcomes.len()
-        ),
+        &format!("{}: prediction MSE after calibration ({} contexts)", env.canonical(), outcomes.len()),
         "prediction horizon [steps]",
         "MSE (model space, mean over dims)",
         &series,
     )?;
 
-    // Paired tests: does strategy a give lower per-context MSE than strategy b?
-    let mut tests = Vec::new();
+    // Paired one-sided tests between strategies, per context: lower MSE, and (pendulum) higher swing-up return.
     let mut test_rows = Vec::new();
-    let position = |s: Strategy| strategies.iter().position(|x| *x == s);
-    for (better, worse) in
-        [(Strategy::OpenLoop, Strategy::Random), (Strategy::Mpc, Strategy::Random), (Strategy::Mpc, Strategy::OpenLoop)]
-    {
-        let (Some(a), Some(b)) = (position(better), position(worse)) else { continue };
-        let result = wilcoxon_signed_rank(&per_context_mse(a), &per_context_mse(b), Alternative::Less)?;
-        tests.push((better, worse, result.p_value));
-        test_rows.push(vec![
-            better.name().to_string(),
-            worse.name().to_string(),
-            result.n.to_string(),
-            format!("{}", result.statistic),
-            format!("{:.4e}", result.p_value),
-        ]);
-    }
+    let tests = paired_tests(strategies, &per_context_mse, Alternative::Less, "MSE lower", &mut test_rows)?;
+    let swingup = if settings.swingup.is_some() {
+        let per_context_return =
+            |j: usize| -> Vec<f64> { outcomes.iter().map(|o| o[j].swingup_return.unwrap_or(f64::NAN)).collect() };
+        let tests = paired_tests(
+            strategies,
+            &per_context_return,
+            Alternative::Greater,
+            "swing-up return higher",
+            &mut test_rows,
+        )?;
+        Some(SwingupSummary {
+            mean_return: (0..strategies.len()).map(|j| mean(&per_context_return(j)).unwrap_or(f64::NAN)).collect(),
+            ground_truth_mean_return: mean(ground_truth_returns).unwrap_or(f64::NAN),
+            tests,
+        })
+    } else {
+        None
+    };
     write_csv(
         &run.file("wilcoxon.csv"),
-        &["lower", "than", "n_nonzero", "statistic", "p_value_one_sided"],
+        &["better", "than", "n_nonzero", "statistic", "p_value_one_sided"],
         &test_rows,
     )?;
 
@@ -372,12 +456,19 @@ fn write_report(
         c.horizon_max,
         if model.run.model.angular.iter().any(|a| *a) { " (angles as cos, sin)" } else { "" }
     );
+    let has_quadrants = outcomes[0][0].quadrants.is_some();
     let _ = writeln!(
         md,
-        "| strategy | mean MSE | median final entropy [nats] |{}",
-        if outcomes[0][0].quadrants.is_some() { " contexts visiting all 4 quadrants |" } else { "" }
+        "| strategy | mean MSE | median final entropy [nats] |{}{}",
+        if has_quadrants { " contexts visiting all 4 quadrants |" } else { "" },
+        if swingup.is_some() { " mean swing-up return |" } else { "" }
     );
-    let _ = writeln!(md, "|---|---|---|{}", if outcomes[0][0].quadrants.is_some() { "---|" } else { "" });
+    let _ = writeln!(
+        md,
+        "|---|---|---|{}{}",
+        if has_quadrants { "---|" } else { "" },
+        if swingup.is_some() { "---|" } else { "" }
+    );
     for (j, s) in strategies.iter().enumerate() {
         let entropies: Vec<f64> = outcomes.iter().map(|o| o[j].final_entropy).collect();
         let quad = outcomes[0][j].quadrants.map(|_| {
@@ -385,12 +476,32 @@ fn write_report(
         });
         let _ = writeln!(
             md,
-            "| {} | {:.4e} | {:.3} |{}",
+            "| {} | {:.4e} | {:.3} |{}{}",
             s.name(),
             mean_mse[j],
             super::stats::quantile(&entropies, 0.5).unwrap_or(f64::NAN),
-            quad.unwrap_or_default()
+            quad.unwrap_or_default(),
+            swingup.as_ref().map(|sw| format!(" {:.1} |", sw.mean_return[j])).unwrap_or_default()
         );
+    }
+    if let (Some(sw), Some(settings)) = (&swingup, &settings.swingup) {
+        let _ = writeln!(
+            md,
+            "\nSwing-up after calibration (thesis 4.5.3): MPC on the model conditioned on each strategy's transitions \
+             (context mean), {} agent steps from hanging, CEM {} / {} / {}, horizon {}, scored by the env's reward in \
+             the same instance. Ground truth (CEM on the simulator's own equations, same instances and seeds): mean \
+             return {:.1} (thesis: about −215).\n",
+            settings.steps,
+            settings.cem.candidates,
+            settings.cem.elites,
+            settings.cem.iterations,
+            settings.cem.horizon,
+            sw.ground_truth_mean_return
+        );
+        let _ = writeln!(md, "| higher return | than | p |\n|---|---|---|");
+        for (a, b, p) in &sw.tests {
+            let _ = writeln!(md, "| {} | {} | {:.3e} |", a.name(), b.name(), p);
+        }
     }
     let _ = writeln!(
         md,
@@ -415,5 +526,60 @@ fn write_report(
         if toy_entropy.is_some() { ", entropy_vs_action.csv/.png" } else { "" }
     );
     write_text(&run.file("report.md"), &md)?;
-    Ok(ContextEvalSummary { mean_mse, tests, toy_entropy })
+    Ok(ContextEvalSummary { mean_mse, tests, toy_entropy, swingup })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::data::collect::{collect_instance_pairs, InstancePairSettings};
+    use crate::data::write_dataset;
+    use crate::envs::toy::Squash;
+    use crate::models::context::{self, ContextConfig, EnvFamily, Preset};
+    use crate::run::NullMonitor;
+
+    /// The small-scale claims of thesis 4.5.2 on the δ<1 toy: after one calibration transition, open-loop EIG
+    /// calibration predicts better than random actions, and an informative action (|u| < 1) leaves a narrower
+    /// belief than a non-informative one. A short `small`-preset run (about 20 s in release) must get there.
+    #[test]
+    fn open_loop_calibration_beats_random_on_the_toy() {
+        let dir = tempfile::tempdir().unwrap();
+        let env = EnvName::Toy(Squash::Inner);
+        let data = dir.path().join("pairs.mcap");
+        let collect =
+            InstancePairSettings { env: env.clone(), instances: 400, steps: 100, seed: 7, command_line: String::new() };
+        write_dataset(&data, &collect_instance_pairs(&collect, &NullMonitor).unwrap()).unwrap();
+        let mut config = ContextConfig::preset(Preset::Small, EnvFamily::Toy);
+        config.steps = 1000;
+        let provenance = Provenance::new(String::new(), 3, 1);
+        let request = context::TrainRequest {
+            out: dir.path().join("model"),
+            data,
+            env: None,
+            config,
+            seed: 3,
+            provenance: provenance.clone(),
+        };
+        context::train(&request, false, &NullMonitor).unwrap();
+        let model = context::load(&request.out, &env).unwrap();
+        let settings = ContextEvalSettings {
+            contexts: 20,
+            validation_rollouts: 10,
+            validation_steps: 30,
+            strategies: vec![Strategy::Random, Strategy::OpenLoop],
+            calibration: CalibrationSettings {
+                candidates: 100,
+                elites: 10,
+                iterations: 4,
+                ..CalibrationSettings::thesis(Strategy::Random, 1, 1)
+            },
+            swingup: None,
+        };
+        let summary = evaluate(&model, &env, &settings, &provenance, &dir.path().join("eval"), &NullMonitor).unwrap();
+        let (better, worse, p) = summary.tests[0];
+        assert_eq!((better, worse), (Strategy::OpenLoop, Strategy::Random));
+        assert!(p < 0.05, "open-loop vs random: p = {p}, mean MSE {:?}", summary.mean_mse);
+        let (informative, non_informative) = summary.toy_entropy.unwrap();
+        assert!(informative < non_informative, "entropy {informative} (informative) vs {non_informative}");
+    }
 }

@@ -5,23 +5,29 @@ use std::path::Path;
 
 use super::ball::{self, BallEvalSettings};
 use super::boards::{self, EmbodiedSettings};
+use super::context::{self as context_eval, ContextEvalSettings};
 use super::swingup::{self, SwingupSettings};
-use crate::data::collect::{collect_random, CollectSettings};
+use crate::data::collect::{collect_instance_pairs, collect_random, CollectSettings, InstancePairSettings};
 use crate::data::collect_ball::{collect_ball, BallCollectSettings};
 use crate::data::write_dataset;
 use crate::envs::ball::Orientation;
 use crate::envs::boards::{LightsOut, Split};
 use crate::envs::embodiments::Embodiment;
 use crate::envs::pendulum::PendulumVariant;
+use crate::envs::toy::Squash;
 use crate::envs::EnvName;
 use crate::error::{Error, Result};
 use crate::models::ball::checkpoint::{load_ball_model, LoadedBallModel};
 use crate::models::ball::learn::{train, TrainSettings};
 use crate::models::ball::BallModel;
+use crate::models::context;
+use crate::models::context::calibration::{CalibrationSettings, Strategy};
+use crate::models::context::{ContextConfig, EnvFamily, Preset as ContextPreset};
 use crate::models::pets::{self, PetsConfig, Preset, Propagation};
 use crate::run::dir::Provenance;
 use crate::run::Monitor;
 use crate::util::atomic::write_text;
+use crate::util::seeding::derive_seed;
 
 pub const SWINGUP_EPISODES: usize = 5;
 pub const EMBODIED_BOARDS_PER_DEPTH: usize = 20;
@@ -36,6 +42,12 @@ pub const QUICK_PETS_EPISODES: usize = 3;
 pub const QUICK_PETS_SWINGUP_STEPS: usize = 100;
 pub const QUICK_PETS_CANDIDATES: usize = 400;
 pub const QUICK_PETS_PARTICLES: usize = 5;
+
+/// The toy slice of Explore the Context: data, `small` preset training and the calibration comparison of
+/// thesis 4.5 with one calibration transition; `make repro-context` runs the medium scale.
+pub const QUICK_CONTEXT_INSTANCES: usize = 1000;
+pub const QUICK_CONTEXT_CONTEXTS: usize = 30;
+pub const QUICK_CONTEXT_CANDIDATES: usize = 200;
 
 pub struct QuickSummary {
     pub lines: Vec<String>,
@@ -75,6 +87,9 @@ pub fn run_quick(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor)
     ));
     lines.push(pets_slice(provenance, out_dir, monitor)?);
     lines.push(ball_slice(provenance, out_dir, monitor)?);
+    for squash in [Squash::Inner, Squash::Outer] {
+        lines.push(context_slice(squash, provenance, out_dir, monitor)?);
+    }
     let mut md = String::from("# mbrl quick reproduction\n\nSmall-scale runs of each implemented method.\n\n");
     for line in &lines {
         md.push_str(&format!("- {line}\n"));
@@ -178,5 +193,69 @@ fn ball_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) ->
         median("trained (quick)"),
         median("thesis"),
         median("ridge baseline")
+    ))
+}
+
+/// Explore the Context on one toy system: instance pairs → a `small` context model → random vs open-loop EIG
+/// calibration with one transition in unseen contexts, and the entropy after one (non-)informative action.
+fn context_slice(squash: Squash, provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) -> Result<String> {
+    let env = EnvName::Toy(squash);
+    let name = env.canonical();
+    let dir = out_dir.join(name.replace(':', "-"));
+    let data_path = dir.join("instance-pairs.mcap");
+    // The eval draws its contexts from the run seed; the training instances come from a stream of their own.
+    let collect = InstancePairSettings {
+        env: env.clone(),
+        instances: QUICK_CONTEXT_INSTANCES,
+        steps: 100,
+        seed: derive_seed(provenance.seed, &[u64::from_le_bytes(*b"ctx-data")]),
+        command_line: provenance.command_line.clone(),
+    };
+    write_dataset(&data_path, &collect_instance_pairs(&collect, monitor)?)?;
+    let config = ContextConfig::preset(ContextPreset::Small, EnvFamily::Toy);
+    let steps = config.steps;
+    let request = context::TrainRequest {
+        out: dir.join("model"),
+        data: data_path,
+        env: None,
+        config,
+        seed: provenance.seed,
+        provenance: provenance.clone(),
+    };
+    context::train(&request, false, monitor)?;
+    let model = context::load(&request.out, &env)?;
+    let settings = ContextEvalSettings {
+        contexts: QUICK_CONTEXT_CONTEXTS,
+        validation_rollouts: 20,
+        validation_steps: 50,
+        strategies: vec![Strategy::Random, Strategy::OpenLoop],
+        calibration: CalibrationSettings {
+            candidates: QUICK_CONTEXT_CANDIDATES,
+            elites: QUICK_CONTEXT_CANDIDATES / 10,
+            iterations: 5,
+            ..CalibrationSettings::thesis(Strategy::Random, 1, 1)
+        },
+        swingup: None,
+    };
+    let summary = context_eval::evaluate(&model, &env, &settings, provenance, &dir.join("eval"), monitor)?;
+    let p_value = summary
+        .tests
+        .iter()
+        .find(|(better, worse, _)| *better == Strategy::OpenLoop && *worse == Strategy::Random)
+        .map(|(_, _, p)| format!("{p:.1e}"))
+        .unwrap_or_else(|| "–".into());
+    let entropy = summary
+        .toy_entropy
+        .map(|(informative, other)| format!("{informative:.2} vs {other:.2} nats"))
+        .unwrap_or_else(|| "–".into());
+    Ok(format!(
+        "Explore the Context, {name}: context model (small preset, {steps} steps on {} instance pairs); one calibration \
+         transition in {} unseen contexts: prediction MSE random {:.2e}, open-loop EIG {:.2e} (Wilcoxon one-sided p = \
+         {p_value}); entropy of q(β) after one informative vs non-informative action {entropy}; see {}/eval/report.md",
+        QUICK_CONTEXT_INSTANCES,
+        QUICK_CONTEXT_CONTEXTS,
+        summary.mean_mse[0],
+        summary.mean_mse[1],
+        name.replace(':', "-"),
     ))
 }

@@ -61,6 +61,19 @@ impl GruCell {
         x.matmul(self.weight_ih.val().transpose()) + self.bias_ih.val().unsqueeze::<2>()
     }
 
+    /// What columns `block` of the input contribute to the input gates, without the bias. An input made of
+    /// parts (context, action) can then have each part's gates computed once and shared or broadcast.
+    pub fn input_gates_part(&self, x: Tensor<2>, block: std::ops::Range<usize>) -> Tensor<2> {
+        let weight = self.weight_ih.val();
+        let gates = weight.dims()[0];
+        x.matmul(weight.slice([0..gates, block]).transpose())
+    }
+
+    /// The input-gate bias as a [1, 3H] row, to add to sums of [`Self::input_gates_part`].
+    pub fn input_bias(&self) -> Tensor<2> {
+        self.bias_ih.val().unsqueeze::<2>()
+    }
+
     /// One step from precomputed input gates `gi` ([batch, 3H], from [`Self::input_gates`]).
     pub fn step_from_input_gates(&self, gi: Tensor<2>, h: Tensor<2>) -> Tensor<2> {
         let hidden = self.hidden_size();

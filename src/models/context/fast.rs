@@ -8,6 +8,7 @@ use crate::nn::activation::fast_softplus;
 use crate::nn::dense::{DenseGru, DenseLayer, DenseStack, StackScratch};
 use crate::nn::{Activation, ParamSet};
 
+#[derive(Clone)]
 pub struct FastContextModel {
     pub state_dim: usize,
     pub action_dim: usize,

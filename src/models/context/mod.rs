@@ -19,7 +19,7 @@ pub use config::{ContextConfig, EnvFamily, Preset};
 pub use fast::FastContextModel;
 pub use train::ContextTrainer;
 
-use crate::data::{read_dataset, Dataset, Rollout};
+use crate::data::{read_dataset, Dataset};
 use crate::envs::EnvName;
 use crate::error::{Error, Result};
 use crate::run::dir::Provenance;
@@ -102,36 +102,20 @@ pub fn instance_pairs(dataset: &Dataset, path: &Path, angular: &[bool]) -> Resul
             ),
         ));
     }
-    let rollouts = Rollout::group(&dataset.steps)
-        .map_err(|i| Error::bad_file(path, format!("message {i} does not continue its rollout")))?;
-    if rollouts.len() < 2 || rollouts.len() % 2 != 0 {
+    let grouped = crate::data::instance_pairs(dataset).map_err(|e| Error::bad_file(path, e.to_string()))?;
+    if grouped.is_empty() {
         return Err(Error::bad_file(
             path,
-            format!(
-                "holds {} rollouts; a context dataset has two per instance (make one with `mbrl collect --env {} --instances N`)",
-                rollouts.len(),
-                dataset.meta.env
-            ),
+            format!("holds no instance pairs (make some with `mbrl collect --env {} --instances N`)", dataset.meta.env),
         ));
     }
-    let mut pairs = Vec::with_capacity(rollouts.len() / 2);
-    for (k, pair) in rollouts.chunks(2).enumerate() {
-        let ((ia, a), (ib, b)) = (&pair[0], &pair[1]);
-        if *ia != 2 * k as u32 || *ib != 2 * k as u32 + 1 {
-            return Err(Error::bad_file(
-                path,
-                format!("rollouts {ia} and {ib} are not the pair 2k, 2k+1 of instance {k}"),
-            ));
-        }
-        let same_instance = dataset.meta.instances.get(*ia as usize) == dataset.meta.instances.get(*ib as usize);
-        if !same_instance {
-            return Err(Error::bad_file(path, format!("rollouts {ia} and {ib} come from different instances")));
-        }
-        pairs.push(InstancePair {
+    let pairs: Vec<InstancePair> = grouped
+        .iter()
+        .map(|(a, b)| InstancePair {
             target: Episode::from_rollout(a, angular),
             source: Episode::from_rollout(b, angular),
-        });
-    }
+        })
+        .collect();
     let state_dim = pairs[0].target.states.len() / (pairs[0].target.len + 1);
     Ok(ContextData { state_dim, action_dim: dataset.meta.action_dim, pairs })
 }
@@ -219,6 +203,7 @@ pub fn resume(dir: &Path, monitor: &dyn Monitor) -> Result<TrainReport> {
 }
 
 /// A finished context model, ready to calibrate and plan in `env`.
+#[derive(Clone)]
 pub struct LoadedModel {
     pub run: ContextRun,
     pub fast: FastContextModel,

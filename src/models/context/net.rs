@@ -186,31 +186,26 @@ impl ContextNet {
         let kl_per_dim = kl_gaussians(&posterior, &prior).clamp_min(config.kl_floor as f32);
         let kl_context = kl_per_dim.sum_dim(1).mean();
 
-        // Reconstruction: every chunk state through the state encoder and the decoder.
+        // The GRU input is [context embedding, action embedding]: the action part of the input gates is shared by
+        // the single-step and multi-step predictions, and the multi-step context part is one row per chunk.
         let h_all = self.embed_state(states.clone().reshape([b * n, s]));
-        let reconstruction =
-            log_likelihood(self.decode(h_all.clone()), states.clone().reshape([b * n, s])).reshape([b, n]).mean_dim(1);
+        let actions = tensor(batch.actions.clone(), [b * t, a], device);
+        let action_gates = self.gru.input_gates_part(self.embed_action(actions), e..2 * e) + self.gru.input_bias();
 
         // Single-step predictions from every chunk state, each with a fresh β sample.
-        let actions = tensor(batch.actions.clone(), [b * t, a], device);
-        let action_emb = self.embed_action(actions).reshape([b, t, e]);
         let post_mean = posterior.mean.clone().unsqueeze_dim::<3>(1).expand([b, t, latent]);
         let post_std = posterior.std.clone().unsqueeze_dim::<3>(1).expand([b, t, latent]);
         let beta_single = post_mean + post_std * tensor(batch.noise_single.clone(), [b, t, latent], device);
-        let ctx_single = self.embed_context(beta_single.reshape([b * t, latent])).reshape([b, t, e]);
-        let h_prev = h_all.reshape([b, n, e]).slice([0..b, 0..t, 0..e]).reshape([b * t, e]);
-        let gi_single =
-            self.gru.input_gates(Tensor::cat(vec![ctx_single, action_emb.clone()], 2).reshape([b * t, 2 * e]));
+        let ctx_single = self.embed_context(beta_single.reshape([b * t, latent]));
+        let h_prev = h_all.clone().reshape([b, n, e]).slice([0..b, 0..t, 0..e]).reshape([b * t, e]);
+        let gi_single = action_gates.clone() + self.gru.input_gates_part(ctx_single, 0..e);
         let h_single = self.gru.step_from_input_gates(gi_single, h_prev);
-        let next_states = states.clone().slice([0..b, 1..n, 0..s]).reshape([b * t, s]);
-        let single_step = log_likelihood(self.decode(h_single), next_states).reshape([b, t]).mean_dim(1);
 
         // Multi-step: one β for the whole chunk, open loop from s_0; predictions of s_2.. enter the sum.
         let beta = posterior.mean + posterior.std * tensor(batch.noise_sequence.clone(), [b, latent], device);
-        let ctx = self.embed_context(beta).unsqueeze_dim::<3>(1).expand([b, t, e]);
-        let gi_seq =
-            self.gru.input_gates(Tensor::cat(vec![ctx, action_emb], 2).reshape([b * t, 2 * e])).reshape([b, t, 3 * e]);
-        let mut h = self.embed_state(states.clone().slice([0..b, 0..1, 0..s]).reshape([b, s]));
+        let ctx_gates = self.gru.input_gates_part(self.embed_context(beta), 0..e);
+        let gi_seq = action_gates.reshape([b, t, 3 * e]) + ctx_gates.unsqueeze_dim::<3>(1).expand([b, t, 3 * e]);
+        let mut h = h_all.clone().reshape([b, n, e]).slice([0..b, 0..1, 0..e]).reshape([b, e]);
         let mut open_loop = Vec::with_capacity(t.saturating_sub(1));
         for k in 0..t {
             let gi = gi_seq.clone().slice([0..b, k..k + 1, 0..3 * e]).reshape([b, 3 * e]);
@@ -219,13 +214,26 @@ impl ContextNet {
                 open_loop.push(h.clone());
             }
         }
-        let multi_step = if open_loop.is_empty() {
+        let steps = open_loop.len();
+
+        // One decoder pass over the reconstruction, single-step and multi-step GRU states (larger matmuls).
+        let mut decoded = vec![h_all, h_single];
+        if steps > 0 {
+            decoded.push(Tensor::stack::<3>(open_loop, 1).reshape([b * steps, e]));
+        }
+        let mut targets =
+            vec![states.clone().reshape([b * n, s]), states.clone().slice([0..b, 1..n, 0..s]).reshape([b * t, s])];
+        if steps > 0 {
+            targets.push(states.slice([0..b, 2..n, 0..s]).reshape([b * steps, s]));
+        }
+        let likelihood = log_likelihood(self.decode(Tensor::cat(decoded, 0)), Tensor::cat(targets, 0));
+        let rows = |start: usize, len: usize| likelihood.clone().slice([start..start + len, 0..1]);
+        let reconstruction = rows(0, b * n).reshape([b, n]).mean_dim(1);
+        let single_step = rows(b * n, b * t).reshape([b, t]).mean_dim(1);
+        let multi_step = if steps == 0 {
             zeros([b, 1], device).sum_dim(1)
         } else {
-            let steps = open_loop.len();
-            let hs = Tensor::stack::<3>(open_loop, 1).reshape([b * steps, e]);
-            let targets = states.slice([0..b, 2..n, 0..s]).reshape([b * steps, s]);
-            log_likelihood(self.decode(hs), targets).reshape([b, steps]).sum_dim(1)
+            rows(b * (n + t), b * steps).reshape([b, steps]).sum_dim(1)
         };
 
         let reconstruction = reconstruction.reshape([b]).mean();
