@@ -234,6 +234,11 @@ pub fn evaluate(
                 seed: derive_seed(seed, &[k, 2, j as u64]),
             };
             let (calibration, _) = run_calibration(model, &request, &crate::run::NullMonitor)?;
+            // The calibration runs quietly (its own layout would replace this job's); its entropy curve is
+            // replayed into the panel declared above, which restarts at transition 0 for every strategy.
+            for (n, entropy) in calibration.entropies.iter().enumerate() {
+                monitor.scalar("calibration/entropy", n as u64, *entropy);
+            }
             let rows = context_rows(model, &calibration.rollout);
             let beta = model.fast.belief(&model.fast.pool(&rows), 1).mean;
             let errors: Vec<Vec<f64>> = validation.iter().map(|r| prediction_errors(model, &beta, r)).collect();
