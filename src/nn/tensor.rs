@@ -6,11 +6,13 @@ use burn::tensor::{Bool, DType, Device, Tensor, TensorData};
 
 /// The CPU device networks train on (flex backend with autodiff).
 pub fn training_device() -> Device {
+    crate::util::alloc::keep_freed_memory();
     Device::flex().autodiff()
 }
 
 /// The same device without autodiff, for inference that needs no gradients.
 pub fn inference_device() -> Device {
+    crate::util::alloc::keep_freed_memory();
     Device::flex()
 }
 

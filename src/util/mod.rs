@@ -1,6 +1,7 @@
 //! What every room may use and none owns: seeded random streams, atomic file writes, CSV tables. Nothing here
 //! imports from another room, so any module can depend on it without creating a cycle.
 
+pub mod alloc;
 pub mod atomic;
 pub mod seeding;
 pub mod table;

@@ -10,6 +10,7 @@ use burn::tensor::{Bool, DType, Device, Int, Tensor, TensorData};
 /// process train on the same flex device in f32, and whichever module configured it first would otherwise decide
 /// the precision of the other.
 pub fn training_device() -> Device {
+    crate::util::alloc::keep_freed_memory();
     Device::flex().autodiff()
 }
 
