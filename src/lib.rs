@@ -9,6 +9,7 @@ pub mod filtering;
 pub mod models;
 pub mod nn;
 pub mod planning;
+pub mod rl;
 pub mod run;
 pub mod train;
 pub mod tui;

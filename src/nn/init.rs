@@ -22,3 +22,9 @@ pub fn truncated_normal<R: Rng + ?Sized>(rng: &mut R, n: usize, fan_in: usize) -
         })
         .collect()
 }
+
+/// torch.nn.init.xavier_uniform_ with gain 1 for a [fan_out, fan_in] weight: U(−a, a), a = √(6/(fan_in + fan_out)).
+pub fn xavier_uniform<R: Rng + ?Sized>(rng: &mut R, fan_in: usize, fan_out: usize) -> Vec<f32> {
+    let bound = (6.0 / (fan_in + fan_out).max(1) as f64).sqrt();
+    (0..fan_in * fan_out).map(|_| rng.random_range(-bound..bound) as f32).collect()
+}

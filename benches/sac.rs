@@ -1,0 +1,50 @@
+//! SAC at SEADS' Cursor-LightsOut sizes: network input 2 (cursor) + 25 (board) + 1 (remaining time) + 25
+//! (one-hot skill) = 53, action 3, hidden [256, 256]. One update at batch 128 (SEADS runs 16 per epoch) and one
+//! `act` for the 32 episodes collected in lockstep.
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use mbrl::rl::sac::{Sac, SacConfig, TransitionBatch};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+const OBS: usize = 53;
+
+fn config() -> SacConfig {
+    SacConfig::new(OBS, vec![-0.2, -0.2, -1.0], vec![0.2, 0.2, 1.0])
+}
+
+fn batch(rng: &mut ChaCha8Rng, rows: usize) -> TransitionBatch {
+    let mut uniform = |n: usize, lo: f32, hi: f32| (0..n).map(|_| rng.random_range(lo..hi)).collect::<Vec<f32>>();
+    TransitionBatch {
+        rows,
+        obs: uniform(rows * OBS, 0.0, 1.0),
+        actions: uniform(rows * 3, -0.2, 0.2),
+        rewards: uniform(rows, -2.0, 1.0),
+        next_obs: uniform(rows * OBS, 0.0, 1.0),
+        done: uniform(rows, 0.0, 1.0).into_iter().map(|x| (x < 0.1) as u8 as f32).collect(),
+    }
+}
+
+fn update(c: &mut Criterion) {
+    let mut rng = ChaCha8Rng::seed_from_u64(1);
+    let mut sac = Sac::new(config(), &mut rng).unwrap();
+    let batch = batch(&mut rng, 128);
+    let mut group = c.benchmark_group("sac_cursor_lightsout");
+    group.sample_size(30);
+    group.throughput(Throughput::Elements(1));
+    group.bench_function("update_batch128", |b| b.iter(|| sac.update(&batch, &mut rng).unwrap()));
+    group.finish();
+}
+
+fn act(c: &mut Criterion) {
+    let mut rng = ChaCha8Rng::seed_from_u64(2);
+    let sac = Sac::new(config(), &mut rng).unwrap();
+    let obs: Vec<f32> = (0..32 * OBS).map(|_| rng.random_range(0.0..1.0)).collect();
+    let mut group = c.benchmark_group("sac_cursor_lightsout");
+    group.bench_function("act_32_rows_stochastic", |b| b.iter(|| sac.act(&obs, 32, false, &mut rng)));
+    group.bench_function("act_32_rows_deterministic", |b| b.iter(|| sac.act(&obs, 32, true, &mut rng)));
+    group.finish();
+}
+
+criterion_group!(benches, update, act);
+criterion_main!(benches);

@@ -1,0 +1,287 @@
+//! SAC against direct formulas, the burn forward pass, a one-step task it must learn, and its saved state.
+
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use super::agent::log_prob;
+use super::inference::squash;
+use super::*;
+use crate::nn::tensor::{tensor, training_device, values};
+use crate::train::tensors::TensorData;
+
+fn config(obs_dim: usize, low: Vec<f64>, high: Vec<f64>) -> SacConfig {
+    SacConfig { hidden: vec![32, 32], ..SacConfig::new(obs_dim, low, high) }
+}
+
+fn cursor_like() -> SacConfig {
+    config(6, vec![-0.2, -0.2, -1.0], vec![0.2, 0.2, 1.0])
+}
+
+fn random_obs(rng: &mut ChaCha8Rng, n: usize, scale: f32) -> Vec<f32> {
+    (0..n).map(|_| rng.random_range(-scale..scale)).collect()
+}
+
+fn random_batch(rng: &mut ChaCha8Rng, c: &SacConfig, rows: usize) -> TransitionBatch {
+    let actions = (0..rows * c.action_dim)
+        .map(|i| {
+            let k = i % c.action_dim;
+            rng.random_range(c.action_low[k]..c.action_high[k]) as f32
+        })
+        .collect();
+    TransitionBatch {
+        rows,
+        obs: random_obs(rng, rows * c.obs_dim, 1.0),
+        actions,
+        rewards: random_obs(rng, rows, 1.0),
+        next_obs: random_obs(rng, rows * c.obs_dim, 1.0),
+        done: (0..rows).map(|i| (i % 3 == 0) as u8 as f32).collect(),
+    }
+}
+
+fn assert_in_bounds(actions: &[f32], c: &SacConfig) {
+    for (i, a) in actions.iter().enumerate() {
+        let k = i % c.action_dim;
+        assert!(*a >= c.action_low[k] as f32 && *a <= c.action_high[k] as f32, "action {i} = {a} outside dim {k}");
+    }
+}
+
+#[test]
+fn deterministic_actions_match_the_burn_forward_and_stay_in_bounds() {
+    let c = cursor_like();
+    let mut rng = ChaCha8Rng::seed_from_u64(1);
+    let sac = Sac::new(c.clone(), &mut rng).unwrap();
+    let rows = 40;
+    // Large inputs drive some outputs into tanh's saturation, where the bounds matter.
+    let obs = random_obs(&mut rng, rows * c.obs_dim, 30.0);
+    let fast = sac.act(&obs, rows, true, &mut rng);
+    assert_in_bounds(&fast, &c);
+    let (mean, _) = sac.policy_module().forward(tensor(obs, [rows, c.obs_dim], &training_device()));
+    let (scale, bias) = (c.action_scale(), c.action_bias());
+    for (i, (m, f)) in values(&mean).iter().zip(&fast).enumerate() {
+        let expected = m.tanh() * scale[i % 3] + bias[i % 3];
+        assert!((f - expected).abs() <= 1e-5 * (1.0 + expected.abs()), "row {} dim {}: {f} vs {expected}", i / 3, i % 3);
+    }
+    assert!(fast.iter().any(|a| a.abs() > 0.15), "no output near saturation; the test lost its point");
+}
+
+#[test]
+fn stochastic_actions_stay_in_bounds_vary_and_follow_the_seed() {
+    let c = cursor_like();
+    let sac = Sac::new(c.clone(), &mut ChaCha8Rng::seed_from_u64(2)).unwrap();
+    let rows = 64;
+    let obs: Vec<f32> = [0.3, -0.1, 0.5, 0.0, 1.0, -0.7].repeat(rows);
+    let a = sac.act(&obs, rows, false, &mut ChaCha8Rng::seed_from_u64(5));
+    assert_in_bounds(&a, &c);
+    let first_dim: Vec<f32> = a.iter().step_by(3).copied().collect();
+    let spread = first_dim.iter().cloned().fold(f32::MIN, f32::max) - first_dim.iter().cloned().fold(f32::MAX, f32::min);
+    assert!(spread > 0.05, "samples of one observation barely vary: spread {spread}");
+    assert_eq!(a, sac.act(&obs, rows, false, &mut ChaCha8Rng::seed_from_u64(5)));
+    assert_ne!(a, sac.act(&obs, rows, false, &mut ChaCha8Rng::seed_from_u64(6)));
+    assert!(sac.try_act(&obs[1..], rows, false, &mut ChaCha8Rng::seed_from_u64(5)).is_err());
+}
+
+#[test]
+fn tanh_gaussian_log_prob_matches_the_direct_formula() {
+    let (mean, log_std, eps) = (
+        vec![0.3f32, -1.5, 2.0, 0.0, -0.2, 0.9],
+        vec![-1.0f32, 0.5, -3.0, 0.0, 1.5, -0.4],
+        vec![0.7f32, -1.2, 0.1, 2.3, -0.4, 0.0],
+    );
+    let expected: Vec<f64> = (0..2)
+        .map(|r| {
+            (0..3)
+                .map(|k| {
+                    let i = r * 3 + k;
+                    let (m, s, e) = (mean[i] as f64, log_std[i] as f64, eps[i] as f64);
+                    let u = m + s.exp() * e;
+                    let normal = -0.5 * ((u - m) / s.exp()).powi(2) - s - 0.5 * (2.0 * std::f64::consts::PI).ln();
+                    normal - (1.0 - u.tanh().powi(2) + 1e-6).ln()
+                })
+                .sum()
+        })
+        .collect();
+    let device = training_device();
+    let squashed: Vec<f32> = (0..6).map(|i| (mean[i] + log_std[i].exp() * eps[i]).tanh()).collect();
+    let burn = values(&log_prob(
+        tensor(eps.clone(), [2, 3], &device),
+        tensor(log_std.clone(), [2, 3], &device),
+        tensor(squashed.clone(), [2, 3], &device),
+    ));
+    let (fast_actions, fast) = squash(&mean, &log_std, &eps, 3);
+    for r in 0..2 {
+        assert!((burn[r] as f64 - expected[r]).abs() < 1e-3, "burn row {r}: {} vs {}", burn[r], expected[r]);
+        assert!((fast[r] as f64 - expected[r]).abs() < 1e-3, "fast row {r}: {} vs {}", fast[r], expected[r]);
+    }
+    assert_eq!(fast_actions, squashed);
+}
+
+#[test]
+fn learns_to_match_the_observation_on_a_one_step_task() {
+    // obs x ∈ [−1, 1], reward −(a − x)², episode over: the best action is a = x (env bounds ±1.5 test rescaling).
+    let mut c = config(1, vec![-1.5], vec![1.5]);
+    c.alpha = 0.01;
+    c.learning_rate = 3e-3;
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    let mut sac = Sac::new(c.clone(), &mut rng).unwrap();
+    let probe: Vec<f32> = (0..41).map(|i| -1.0 + i as f32 / 20.0).collect();
+    let error = |sac: &Sac| -> f32 {
+        let a = sac.act(&probe, probe.len(), true, &mut ChaCha8Rng::seed_from_u64(0));
+        a.iter().zip(&probe).map(|(a, x)| (a - x).abs()).sum::<f32>() / probe.len() as f32
+    };
+    let before = error(&sac);
+    for _ in 0..300 {
+        let rows = 128;
+        let obs = random_obs(&mut rng, rows, 1.0);
+        let actions: Vec<f32> = (0..rows).map(|_| rng.random_range(-1.5f32..1.5)).collect();
+        let rewards = obs.iter().zip(&actions).map(|(x, a)| -(a - x) * (a - x)).collect();
+        let batch = TransitionBatch { rows, next_obs: obs.clone(), obs, actions, rewards, done: vec![1.0; rows] };
+        let losses = sac.update(&batch, &mut rng).unwrap();
+        assert!(losses.actor.is_finite() && losses.critic.is_finite());
+    }
+    let after = error(&sac);
+    assert!(before > 0.3, "the untrained policy already solves the task: {before}");
+    assert!(after < 0.1, "mean abs error after training {after} (before {before})");
+}
+
+#[test]
+fn restored_agent_continues_bit_identically() {
+    let c = cursor_like();
+    let mut data_rng = ChaCha8Rng::seed_from_u64(3);
+    let batches: Vec<TransitionBatch> = (0..5).map(|_| random_batch(&mut data_rng, &c, 32)).collect();
+    let mut a = Sac::new(c.clone(), &mut ChaCha8Rng::seed_from_u64(11)).unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(12);
+    for b in &batches[..3] {
+        a.update(b, &mut rng).unwrap();
+    }
+    let mut b = Sac::new(c.clone(), &mut ChaCha8Rng::seed_from_u64(99)).unwrap();
+    assert_ne!(a.weights(), b.weights());
+    b.restore(&a.state()).unwrap();
+    assert_eq!(a.state(), b.state());
+    let (mut rng_a, mut rng_b) = (ChaCha8Rng::seed_from_u64(13), ChaCha8Rng::seed_from_u64(13));
+    for batch in &batches[3..] {
+        assert_eq!(a.update(batch, &mut rng_a).unwrap(), b.update(batch, &mut rng_b).unwrap());
+    }
+    assert_eq!(a.state(), b.state());
+    assert_eq!(a.updates(), 5);
+}
+
+#[test]
+fn the_same_seed_gives_the_same_agent_and_names_follow_pytorch() {
+    let c = cursor_like();
+    let a = Sac::new(c.clone(), &mut ChaCha8Rng::seed_from_u64(4)).unwrap();
+    let b = Sac::new(c, &mut ChaCha8Rng::seed_from_u64(4)).unwrap();
+    assert_eq!(a.state(), b.state());
+    let names: Vec<String> = a.weights().iter().map(|t| t.name.clone()).collect();
+    let expected = [
+        "policy.net.0.weight",
+        "policy.net.0.bias",
+        "policy.net.2.weight",
+        "policy.net.2.bias",
+        "policy.mean_linear.weight",
+        "policy.mean_linear.bias",
+        "policy.log_std_linear.weight",
+        "policy.log_std_linear.bias",
+        "critic.q1.0.weight",
+        "critic.q1.0.bias",
+        "critic.q1.2.weight",
+        "critic.q1.2.bias",
+        "critic.q1.4.weight",
+        "critic.q1.4.bias",
+        "critic.q2.0.weight",
+    ];
+    assert_eq!(names[..expected.len()], expected);
+    assert_eq!(a.weights()[8].shape, vec![32, 6 + 3]);
+    // Xavier-uniform weights, zero biases.
+    let w = &a.weights()[0];
+    let bound = (6.0f32 / (6 + 32) as f32).sqrt();
+    let TensorData::F32(v) = &w.data else { panic!("f32 weights") };
+    assert!(v.iter().all(|x| x.abs() <= bound) && v.iter().any(|x| x.abs() > 0.8 * bound));
+    assert!(matches!(&a.weights()[1].data, TensorData::F32(b) if b.iter().all(|x| *x == 0.0)));
+}
+
+#[test]
+fn from_weights_rebuilds_the_same_policy() {
+    let c = cursor_like();
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    let mut a = Sac::new(c.clone(), &mut rng).unwrap();
+    let batch = random_batch(&mut rng, &c, 16);
+    a.update(&batch, &mut rng).unwrap();
+    let b = Sac::from_weights(c.clone(), &a.weights()).unwrap();
+    let obs = random_obs(&mut rng, 8 * c.obs_dim, 1.0);
+    let mut r = ChaCha8Rng::seed_from_u64(0);
+    assert_eq!(a.act(&obs, 8, true, &mut r), b.act(&obs, 8, true, &mut r));
+    assert_eq!(b.critic_params().tensors[0].values, a.critic_params().tensors[0].values);
+    assert_eq!(b.target_params().tensors[0].values, a.critic_params().tensors[0].values);
+}
+
+#[test]
+fn wrong_layouts_are_errors_and_leave_the_agent_unchanged() {
+    let c = cursor_like();
+    let mut rng = ChaCha8Rng::seed_from_u64(6);
+    let mut sac = Sac::new(c.clone(), &mut rng).unwrap();
+    let before = sac.state();
+
+    let mut missing = before.clone();
+    missing.remove(4);
+    let err = sac.restore(&missing).unwrap_err().to_string();
+    assert!(err.contains("tensors"), "{err}");
+
+    let mut short = before.clone();
+    if let TensorData::F32(v) = &mut short[0].data {
+        v.pop();
+    }
+    let err = sac.restore(&short).unwrap_err().to_string();
+    assert!(err.contains(&short[0].name), "{err}");
+
+    let mut renamed = before.clone();
+    renamed.last_mut().unwrap().name = "steps".into();
+    assert!(sac.restore(&renamed).unwrap_err().to_string().contains("updates"));
+
+    let mut nan = before.clone();
+    nan[2].data = TensorData::F32(vec![f32::NAN; nan[2].shape.iter().product()]);
+    assert!(sac.restore(&nan).is_err());
+    assert_eq!(sac.state(), before);
+
+    let bigger = SacConfig { hidden: vec![32, 48], ..c.clone() };
+    assert!(Sac::from_weights(bigger, &sac.weights()).is_err());
+    assert!(Sac::from_weights(c.clone(), &sac.state()).is_err());
+    let mut f64_weights = sac.weights();
+    f64_weights[0] = crate::train::StoredTensor::f64(f64_weights[0].name.clone(), f64_weights[0].shape.clone(), vec![0.0; 32 * 6]);
+    assert!(Sac::from_weights(c, &f64_weights).unwrap_err().to_string().contains("f32"));
+}
+
+#[test]
+fn bad_batches_and_configs_are_errors() {
+    let c = cursor_like();
+    let mut rng = ChaCha8Rng::seed_from_u64(8);
+    let mut sac = Sac::new(c.clone(), &mut rng).unwrap();
+    let good = random_batch(&mut rng, &c, 8);
+    let mut short = good.clone();
+    short.next_obs.pop();
+    assert!(sac.update(&short, &mut rng).unwrap_err().to_string().contains("next_obs"));
+    let mut nan = good.clone();
+    nan.rewards[5] = f32::NAN;
+    assert!(sac.update(&nan, &mut rng).unwrap_err().to_string().contains("row 5"));
+    assert!(sac.update(&TransitionBatch::default(), &mut rng).is_err());
+    assert_eq!(sac.updates(), 0);
+    assert!(sac.update(&good, &mut rng).is_ok());
+
+    let cases: Vec<(SacConfig, &str)> = vec![
+        (SacConfig { obs_dim: 0, ..c.clone() }, "obs_dim"),
+        (SacConfig { action_dim: 2, ..c.clone() }, "action_low"),
+        (SacConfig { action_low: vec![-0.2, 0.3, -1.0], ..c.clone() }, "low"),
+        (SacConfig { action_high: vec![0.2, f64::INFINITY, 1.0], ..c.clone() }, "finite"),
+        (SacConfig { hidden: vec![], ..c.clone() }, "hidden"),
+        (SacConfig { hidden: vec![32, 0], ..c.clone() }, "hidden"),
+        (SacConfig { gamma: f64::NAN, ..c.clone() }, "gamma"),
+        (SacConfig { tau: 0.0, ..c.clone() }, "tau"),
+        (SacConfig { learning_rate: 10.0, ..c.clone() }, "learning_rate"),
+        (SacConfig { alpha: -0.1, ..c.clone() }, "alpha"),
+        (SacConfig { batch_size: 0, ..c.clone() }, "batch_size"),
+    ];
+    for (bad, field) in cases {
+        let err = bad.validate().unwrap_err().to_string();
+        assert!(err.contains(field) && !err.contains('\n'), "{field}: {err}");
+        assert!(Sac::new(bad, &mut rng).is_err());
+    }
+}
