@@ -197,12 +197,8 @@ impl Sac {
             })
             .collect();
 
-        let actions: Vec<f32> = batch
-            .actions
-            .iter()
-            .enumerate()
-            .map(|(i, a)| (a - self.bias[i % ad]) / self.scale[i % ad])
-            .collect();
+        let actions: Vec<f32> =
+            batch.actions.iter().enumerate().map(|(i, a)| (a - self.bias[i % ad]) / self.scale[i % ad]).collect();
         let input = tensor(concat_rows(&batch.obs, od, &actions, ad, n), [n, od + ad], &self.device);
         let target = tensor(y, [n, 1], &self.device);
         let (q1, q2) = self.critic_module().forward(input);

@@ -50,7 +50,10 @@ impl TransitionBatch {
                 )));
             }
             if let Some(i) = values.iter().position(|x| !x.is_finite()) {
-                return Err(Error::data(format!("sac update: batch '{name}' has a non-finite value at row {}", i / width)));
+                return Err(Error::data(format!(
+                    "sac update: batch '{name}' has a non-finite value at row {}",
+                    i / width
+                )));
             }
         }
         Ok(())

@@ -46,7 +46,13 @@ fn linear<R: Rng + ?Sized>(d_in: usize, d_out: usize, device: &Device, rng: &mut
     }
 }
 
-fn mlp<R: Rng + ?Sized>(d_in: usize, hidden: &[usize], d_out: Option<usize>, device: &Device, rng: &mut R) -> Vec<Linear> {
+fn mlp<R: Rng + ?Sized>(
+    d_in: usize,
+    hidden: &[usize],
+    d_out: Option<usize>,
+    device: &Device,
+    rng: &mut R,
+) -> Vec<Linear> {
     let mut widths = vec![d_in];
     widths.extend_from_slice(hidden);
     widths.extend(d_out);

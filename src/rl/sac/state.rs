@@ -18,7 +18,10 @@ fn f32_tensor(t: &crate::nn::NamedTensor, name: String) -> StoredTensor {
 
 /// The f32 values of tensor `name` with exactly `n` finite values.
 fn lookup(stored: &[StoredTensor], name: &str, n: usize, what: &str) -> Result<Vec<f32>> {
-    let found = stored.iter().find(|t| t.name == name).ok_or_else(|| Error::config(format!("{what}: lacks the tensor '{name}'")))?;
+    let found = stored
+        .iter()
+        .find(|t| t.name == name)
+        .ok_or_else(|| Error::config(format!("{what}: lacks the tensor '{name}'")))?;
     let TensorData::F32(values) = &found.data else {
         return Err(Error::config(format!("{what}: tensor '{name}' is not f32")));
     };
@@ -68,7 +71,12 @@ impl Sac {
     /// The actor and the twin critic, named like the reference `policy.state_dict()` and
     /// `critic.state_dict()` under `policy.` and `critic.`.
     pub fn weights(&self) -> Vec<StoredTensor> {
-        self.policy_params.tensors.iter().chain(&self.critic_params.tensors).map(|t| f32_tensor(t, t.name.clone())).collect()
+        self.policy_params
+            .tensors
+            .iter()
+            .chain(&self.critic_params.tensors)
+            .map(|t| f32_tensor(t, t.name.clone()))
+            .collect()
     }
 
     /// Everything a byte-identical resume needs except the caller's RNG.
@@ -77,7 +85,11 @@ impl Sac {
         for (params, adam) in [(&self.policy_params, &self.policy_adam), (&self.critic_params, &self.critic_adam)] {
             for (k, t) in params.tensors.iter().enumerate() {
                 out.push(f32_tensor(t, format!("live.{}", t.name)));
-                out.push(StoredTensor::f32(format!("adam.exp_avg.{}", t.name), t.shape.clone(), adam.exp_avg[k].clone()));
+                out.push(StoredTensor::f32(
+                    format!("adam.exp_avg.{}", t.name),
+                    t.shape.clone(),
+                    adam.exp_avg[k].clone(),
+                ));
                 out.push(StoredTensor::f32(
                     format!("adam.exp_avg_sq.{}", t.name),
                     t.shape.clone(),
@@ -109,8 +121,10 @@ impl Sac {
         let critic_step = counter(state, CRITIC_STEP, what)?;
         let updates = counter(state, UPDATES, what)?;
         (self.policy_params, self.critic_params, self.target_params) = (policy, critic, target);
-        (self.policy_adam.exp_avg, self.policy_adam.exp_avg_sq, self.policy_adam.step) = (policy_m, policy_v, policy_step);
-        (self.critic_adam.exp_avg, self.critic_adam.exp_avg_sq, self.critic_adam.step) = (critic_m, critic_v, critic_step);
+        (self.policy_adam.exp_avg, self.policy_adam.exp_avg_sq, self.policy_adam.step) =
+            (policy_m, policy_v, policy_step);
+        (self.critic_adam.exp_avg, self.critic_adam.exp_avg_sq, self.critic_adam.step) =
+            (critic_m, critic_v, critic_step);
         self.updates = updates;
         self.load_policy()?;
         self.load_critic()?;

@@ -4,7 +4,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::agent::log_prob;
-use super::inference::squash;
+use super::inference::{squash, TwinQFast};
+use super::networks::{QNetwork, CRITIC_TARGET};
 use super::*;
 use crate::nn::tensor::{tensor, training_device, values};
 use crate::train::tensors::TensorData;
@@ -59,9 +60,32 @@ fn deterministic_actions_match_the_burn_forward_and_stay_in_bounds() {
     let (scale, bias) = (c.action_scale(), c.action_bias());
     for (i, (m, f)) in values(&mean).iter().zip(&fast).enumerate() {
         let expected = m.tanh() * scale[i % 3] + bias[i % 3];
-        assert!((f - expected).abs() <= 1e-5 * (1.0 + expected.abs()), "row {} dim {}: {f} vs {expected}", i / 3, i % 3);
+        assert!(
+            (f - expected).abs() <= 1e-5 * (1.0 + expected.abs()),
+            "row {} dim {}: {f} vs {expected}",
+            i / 3,
+            i % 3
+        );
     }
     assert!(fast.iter().any(|a| a.abs() > 0.15), "no output near saturation; the test lost its point");
+}
+
+#[test]
+fn target_critic_fast_path_matches_the_burn_critic() {
+    // The target starts as a copy of the critic, so the fast path's min Q must equal burn's min(Q1, Q2).
+    let c = cursor_like();
+    let mut rng = ChaCha8Rng::seed_from_u64(9);
+    let sac = Sac::new(c.clone(), &mut rng).unwrap();
+    let target = TwinQFast::from_params(sac.target_params(), CRITIC_TARGET, c.hidden.len()).unwrap();
+    let (rows, width) = (17, c.obs_dim + c.action_dim);
+    let input = random_obs(&mut rng, rows * width, 2.0);
+    let fast = target.min_q(&input, rows);
+    let critic = QNetwork::init(&c, &training_device(), &mut ChaCha8Rng::seed_from_u64(0));
+    let critic = sac.critic_params().load_into(critic, &training_device()).unwrap();
+    let (q1, q2) = critic.forward(tensor(input, [rows, width], &training_device()));
+    for (f, q) in fast.iter().zip(values(&q1.min_pair(q2))) {
+        assert!((f - q).abs() <= 1e-5 * (1.0 + q.abs()), "{f} vs {q}");
+    }
 }
 
 #[test]
@@ -73,7 +97,8 @@ fn stochastic_actions_stay_in_bounds_vary_and_follow_the_seed() {
     let a = sac.act(&obs, rows, false, &mut ChaCha8Rng::seed_from_u64(5));
     assert_in_bounds(&a, &c);
     let first_dim: Vec<f32> = a.iter().step_by(3).copied().collect();
-    let spread = first_dim.iter().cloned().fold(f32::MIN, f32::max) - first_dim.iter().cloned().fold(f32::MAX, f32::min);
+    let spread =
+        first_dim.iter().cloned().fold(f32::MIN, f32::max) - first_dim.iter().cloned().fold(f32::MAX, f32::min);
     assert!(spread > 0.05, "samples of one observation barely vary: spread {spread}");
     assert_eq!(a, sac.act(&obs, rows, false, &mut ChaCha8Rng::seed_from_u64(5)));
     assert_ne!(a, sac.act(&obs, rows, false, &mut ChaCha8Rng::seed_from_u64(6)));
@@ -246,7 +271,8 @@ fn wrong_layouts_are_errors_and_leave_the_agent_unchanged() {
     assert!(Sac::from_weights(bigger, &sac.weights()).is_err());
     assert!(Sac::from_weights(c.clone(), &sac.state()).is_err());
     let mut f64_weights = sac.weights();
-    f64_weights[0] = crate::train::StoredTensor::f64(f64_weights[0].name.clone(), f64_weights[0].shape.clone(), vec![0.0; 32 * 6]);
+    f64_weights[0] =
+        crate::train::StoredTensor::f64(f64_weights[0].name.clone(), f64_weights[0].shape.clone(), vec![0.0; 32 * 6]);
     assert!(Sac::from_weights(c, &f64_weights).unwrap_err().to_string().contains("f32"));
 }
 
