@@ -45,6 +45,9 @@ pub trait BoardGame: Clone + Send + Sync + 'static {
     /// The move a push at `point` performs, if any.
     fn move_at(&self, point: BoardPoint) -> Option<usize>;
     fn move_name(&self, mv: usize) -> String;
+    /// A board drawn uniformly from all boards the moves reach from the goal (every such board is
+    /// solvable, each equally likely).
+    fn scramble(&self, rng: &mut rand_chacha::ChaCha8Rng) -> Self::State;
     /// Whether some sequence of moves reaches the goal from `state`.
     fn is_solvable(&self, _state: Self::State) -> bool {
         true

@@ -200,6 +200,16 @@ impl BoardGame for TileSwap {
         best.filter(|&(d, _)| d <= PIVOT_RADIUS_L1).map(|(_, mv)| mv)
     }
 
+    /// A uniform permutation (Fisher-Yates): adjacent swaps generate every permutation of the chips.
+    fn scramble(&self, rng: &mut rand_chacha::ChaCha8Rng) -> TileSwapState {
+        use rand::Rng;
+        let mut chips: [usize; FIELDS] = std::array::from_fn(|i| i);
+        for i in (1..FIELDS).rev() {
+            chips.swap(i, rng.random_range(0..=i));
+        }
+        TileSwapState::from_chips(&chips)
+    }
+
     fn move_name(&self, mv: usize) -> String {
         let (a, b) = self.pairs[mv];
         format!("swap fields {a}-{b}")

@@ -63,9 +63,21 @@ impl Manipulator for Reacher {
         vec![c1, s1, c2, s2, self.v[0], self.v[1], f[0], f[1]]
     }
 
+    fn state_names(&self) -> Vec<&'static str> {
+        vec!["shoulder_angle", "wrist_angle", "shoulder_velocity", "wrist_velocity"]
+    }
+
     /// [shoulder angle, wrist angle, shoulder velocity, wrist velocity].
     fn state(&self) -> Vec<f64> {
         vec![self.q[0], self.q[1], self.v[0], self.v[1]]
+    }
+
+    /// The shoulder turns freely; the wrist stays within its stops (radians).
+    fn state_problem(&self, state: &[f64]) -> Option<String> {
+        let wrist = state.get(1).copied()?;
+        (wrist.abs() > WRIST_LIMIT).then(|| {
+            format!("wrist_angle = {wrist} is beyond the wrist's stops; expected radians in [-{WRIST_LIMIT}, {WRIST_LIMIT}] (±160°)")
+        })
     }
 
     fn set_state(&mut self, state: &[f64]) {
