@@ -11,11 +11,15 @@ use mbrl::data::collect::{
     collect_instance_pairs, collect_random, parse_state, replay, CollectSettings, InstancePairSettings, ReplaySettings,
 };
 use mbrl::data::collect_ball::{collect_ball, BallCollectSettings};
+use mbrl::data::collect_embodied::{
+    collect_embodied, parse_manipulator_state, replay_embodied, EmbodiedCollectSettings, EmbodiedReplaySettings,
+};
 use mbrl::data::{write_dataset, Dataset};
 use mbrl::envs::ball::Orientation;
 use mbrl::envs::boards::depth::{DenseIndex, DepthTable};
 use mbrl::envs::boards::sets::board_set;
 use mbrl::envs::boards::{GameSpec, LightsOut, Split, TileSwap};
+use mbrl::envs::embodiments::Embodiment;
 use mbrl::envs::{parse_env, EnvName};
 
 use crate::common::{command_line, file_stem, run_job, GlobalArgs};
@@ -39,6 +43,8 @@ Examples:
   mbrl collect --env lightsout --boards --max-depth 5 --split test --out datasets/lightsout-test.mcap
   mbrl collect --env ball --trajectories 100 --augment-rotations 19 --out datasets/ball-train.mcap
   mbrl collect --env ball --trajectories 30 --orientation unseen-3 --out datasets/ball-unseen-3.mcap
+  mbrl collect --env lightsout:cursor --episodes 1000 --seed 1 --out datasets/lightsout-cursor-random.mcap
+  mbrl collect --env tileswap:reacher --actions actions.csv --init-state 0.5,1.2,0,0 --board 1,0,2,3,4,5,6,7,8
 
 Start states: θ ~ U[-π, π], θ̇ ~ U[-8, 8] (pendulum); s ~ N(0, I) (toy); x ~ U[-0.8, 0.8],
 ẋ ~ U[-2, 2] (mountaincar). Actions uniform in the env's bounds. Parametrized envs (pendulum:quadrant,
@@ -48,10 +54,16 @@ share instance k); the parameters go into the metadata.
 --init-state or a reset state drawn from --seed, in the instance --instance-seed names (default: --seed);
 actions beyond the bounds are clipped by the env.
 Board sets (lightsout 5x5, tileswap) hold every board of depth 1..D with its train/test split.
+Embodied boards (<game>:cursor|reacher) are recorded as skill episodes, one rollout each: an episode ends
+when the board changes or after 10 (cursor) / 50 (reacher) steps. --episodes N: random actions, each
+episode from a uniformly scrambled board and a reset manipulator. --actions: one run through the CSV
+(3 columns: dx,dy,push for cursor; two torques,push for reacher), split into episodes the same way, from
+--board (default: the solved board) and --init-state (cursor: x,y in [0,1]; reacher: shoulder,wrist
+angles in rad (|wrist| <= 160 deg) and their velocities; default: a reset drawn from --seed).
 Ball shots: launcher settings drawn as in thesis 6.5.1, 180 Hz camera with ~1 mm noise and dropouts.")]
 pub struct CollectArgs {
     /// Environment: pendulum[:light|heavy|mass=<m>|inverted|quadrant], toy:inner|outer, mountaincar, lightsout,
-    /// tileswap, ball.
+    /// tileswap, <game>:cursor|reacher (e.g. lightsout:cursor, tileswap:reacher), ball.
     #[arg(long)]
     env: String,
     /// Number of rollouts, each in its own instance of a parametrized env.
@@ -63,13 +75,21 @@ pub struct CollectArgs {
     /// Replay these actions (CSV: one row per step, one column per action dimension) instead of random ones.
     #[arg(long, value_name = "CSV", conflicts_with_all = ["rollouts", "instances", "steps", "trajectories", "boards"])]
     actions: Option<PathBuf>,
-    /// With --actions: the start state, comma-separated (pendulum: θ,θ̇; toy: s1,s2; mountaincar: x,ẋ).
+    /// With --actions: the start state, comma-separated (pendulum: θ,θ̇; toy: s1,s2; mountaincar: x,ẋ;
+    /// <game>:cursor: x,y; <game>:reacher: shoulder,wrist,shoulder velocity,wrist velocity).
     #[arg(long, value_name = "X1,X2,…", requires = "actions", allow_hyphen_values = true)]
     init_state: Option<String>,
     /// With --actions: which instance of a parametrized env (default: --seed); the same seed names the same
     /// instance in every subcommand.
     #[arg(long, value_name = "S", requires = "actions")]
     instance_seed: Option<u64>,
+    /// With --actions on <game>:cursor|reacher: the start board, comma-separated as solve-board takes it
+    /// (default: the solved board).
+    #[arg(long, value_name = "BOARD", requires = "actions")]
+    board: Option<String>,
+    /// For <game>:cursor|reacher: N skill episodes of random actions, each from a scrambled board.
+    #[arg(long, value_name = "N", conflicts_with_all = ["rollouts", "instances", "steps", "actions", "boards"])]
+    episodes: Option<usize>,
     /// Steps per rollout.
     #[arg(long, default_value_t = 30)]
     steps: usize,
@@ -110,6 +130,13 @@ pub fn run(global: &GlobalArgs, args: CollectArgs) -> anyhow::Result<()> {
     }
     if args.trajectories.is_some() {
         bail!("--trajectories is for --env ball, not '{}'", env.canonical());
+    }
+    if let EnvName::Embodied(game, embodiment) = env {
+        return collect_embodied_episodes(global, game, embodiment, &args);
+    }
+    if args.episodes.is_some() || args.board.is_some() {
+        let flag = if args.episodes.is_some() { "--episodes" } else { "--board" };
+        bail!("{flag} is for board games played by a manipulator (e.g. lightsout:cursor), not '{}'", env.canonical());
     }
     if let EnvName::Board(game) = env {
         if !args.boards {
@@ -182,6 +209,54 @@ fn replay_actions(global: &GlobalArgs, env: EnvName, actions: &Path, args: &Coll
     let data: Dataset = replay(&settings)?;
     write_dataset(&out, &data)?;
     println!("wrote a replay of {} actions in {} to {}", data.steps.len(), data.meta.env, out.display());
+    Ok(())
+}
+
+fn collect_embodied_episodes(
+    global: &GlobalArgs,
+    game: GameSpec,
+    embodiment: Embodiment,
+    args: &CollectArgs,
+) -> anyhow::Result<()> {
+    let name = EnvName::Embodied(game, embodiment).canonical();
+    if args.boards {
+        bail!("--boards is for board games alone; for board sets use --env {}", game.name());
+    }
+    let mode = if args.actions.is_some() { "replay" } else { "random" };
+    let out = args.out.clone().unwrap_or_else(|| PathBuf::from(format!("datasets/{}-{mode}.mcap", file_stem(&name))));
+    let data = match (&args.actions, args.episodes) {
+        (Some(actions), _) => {
+            let init_state =
+                args.init_state.as_deref().map(|text| parse_manipulator_state(text, game, embodiment)).transpose()?;
+            let action_dim = mbrl::envs::parse_env(&name)?.build()?.spec().action_dim();
+            let settings = EmbodiedReplaySettings {
+                game,
+                embodiment,
+                actions: read_actions(actions, action_dim)?,
+                init_state,
+                board: args.board.clone(),
+                seed: global.seed,
+                command_line: command_line(),
+            };
+            let data = replay_embodied(&settings)?;
+            write_dataset(&out, &data)?;
+            data
+        }
+        (None, Some(episodes)) => {
+            let settings =
+                EmbodiedCollectSettings { game, embodiment, episodes, seed: global.seed, command_line: command_line() };
+            run_job(global, "collect", |monitor| {
+                let data = collect_embodied(&settings, monitor)?;
+                write_dataset(&out, &data)?;
+                Ok(data)
+            })?
+        }
+        (None, None) => bail!(
+            "'{name}' is recorded as skill episodes: give --episodes N (random actions) or --actions CSV (a replay)"
+        ),
+    };
+    let episodes = data.meta.instances.len();
+    println!("wrote {} steps in {episodes} skill episodes of {name} to {}", data.steps.len(), out.display());
     Ok(())
 }
 

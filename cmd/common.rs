@@ -131,6 +131,11 @@ pub fn pendulum_variant(name: &str) -> anyhow::Result<mbrl::envs::pendulum::Pend
         env @ (mbrl::envs::EnvName::Toy(_) | mbrl::envs::EnvName::MountainCar) => {
             anyhow::bail!("'{}' has no MPC task here yet; CEM planning supports pendulum envs", env.canonical())
         }
+        env @ mbrl::envs::EnvName::Embodied(..) => anyhow::bail!(
+            "'{}' is a board game played by a manipulator: plan its moves with `mbrl solve-board --embodiment`; CEM \
+             planning supports pendulum envs",
+            env.canonical()
+        ),
         mbrl::envs::EnvName::Board(g) => anyhow::bail!(
             "'{}' is a board game: solve it with `mbrl solve-board --game {}`; CEM planning supports pendulum envs",
             g.name(),

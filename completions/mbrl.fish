@@ -42,12 +42,14 @@ complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "eval" -d 'Run an evaluati
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "watch" -d 'Follow a running or finished run (training or eval) in the live view'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "completions" -d 'Print a shell completion script'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l env -d 'Environment: pendulum[:light|heavy|mass=<m>|inverted|quadrant], toy:inner|outer, mountaincar, lightsout, tileswap, ball' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l env -d 'Environment: pendulum[:light|heavy|mass=<m>|inverted|quadrant], toy:inner|outer, mountaincar, lightsout, tileswap, <game>:cursor|reacher (e.g. lightsout:cursor, tileswap:reacher), ball' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l rollouts -d 'Number of rollouts, each in its own instance of a parametrized env' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l instances -d 'Instead of --rollouts: N instances with two rollouts each (ids 2k, 2k+1), for context models' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l actions -d 'Replay these actions (CSV: one row per step, one column per action dimension) instead of random ones' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l init-state -d 'With --actions: the start state, comma-separated (pendulum: θ,θ̇; toy: s1,s2; mountaincar: x,ẋ)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l init-state -d 'With --actions: the start state, comma-separated (pendulum: θ,θ̇; toy: s1,s2; mountaincar: x,ẋ; <game>:cursor: x,y; <game>:reacher: shoulder,wrist,shoulder velocity,wrist velocity)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l instance-seed -d 'With --actions: which instance of a parametrized env (default: --seed); the same seed names the same instance in every subcommand' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l board -d 'With --actions on <game>:cursor|reacher: the start board, comma-separated as solve-board takes it (default: the solved board)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l episodes -d 'For <game>:cursor|reacher: N skill episodes of random actions, each from a scrambled board' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l steps -d 'Steps per rollout' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l policy -d 'Behaviour policy' -r -f -a "random\t'Uniformly random actions within the action bounds'"
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l out -d 'Output file (default: datasets/<env>-random.mcap, <env>-pairs.mcap, <env>-replay.mcap, or <game>-boards-d<D>.mcap)' -r -F

@@ -11,7 +11,7 @@ use crate::run::Monitor;
 use crate::util::seeding::{derive_seed, rng_for};
 
 /// The random stream under `--seed` that a replay's reset state (and toy noise) come from.
-const REPLAY_STREAM: u64 = u64::from_be_bytes(*b"replay\0\0");
+pub(super) const REPLAY_STREAM: u64 = u64::from_be_bytes(*b"replay\0\0");
 
 /// Refuse before allocating: a dataset is built in memory before it is written.
 const MAX_DATASET_BYTES: f64 = 16.0 * (1u64 << 30) as f64;
@@ -184,7 +184,7 @@ fn random_rollout(env: &mut dyn Env, spec: &EnvSpec, rng: &mut ChaCha8Rng, steps
 }
 
 /// Observations are stored only where they differ from the state (see datasets/README.md).
-fn timesteps<'a>(spec: &EnvSpec, rollout: &'a Rollout, id: u32) -> impl Iterator<Item = Timestep> + 'a {
+pub(super) fn timesteps<'a>(spec: &EnvSpec, rollout: &'a Rollout, id: u32) -> impl Iterator<Item = Timestep> + 'a {
     let keep_obs = spec.obs_names != spec.state_names;
     rollout.timesteps(id).map(move |mut step| {
         if !keep_obs {
@@ -194,7 +194,7 @@ fn timesteps<'a>(spec: &EnvSpec, rollout: &'a Rollout, id: u32) -> impl Iterator
     })
 }
 
-fn meta(
+pub(super) fn meta(
     spec: &EnvSpec,
     seed: u64,
     command_line: &str,
@@ -216,7 +216,7 @@ fn meta(
 }
 
 /// A transition in memory: the struct, its vectors' heap blocks, and the f64s in them.
-fn check_size(spec: &EnvSpec, rollouts: usize, steps: usize, flags: &str) -> Result<()> {
+pub(super) fn check_size(spec: &EnvSpec, rollouts: usize, steps: usize, flags: &str) -> Result<()> {
     let values = 2 * spec.state_dim() + spec.action_dim() + 2 * spec.obs_names.len();
     let per_step = (std::mem::size_of::<Timestep>() + 5 * 16 + 8 * values) as f64;
     let bytes = rollouts as f64 * steps as f64 * per_step;

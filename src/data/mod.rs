@@ -8,6 +8,7 @@ pub mod ball_io;
 pub mod boardset;
 pub mod collect;
 pub mod collect_ball;
+pub mod collect_embodied;
 pub mod dataset;
 pub mod mcap_io;
 pub mod rollout;

@@ -1,7 +1,9 @@
 //! Turns an environment name from the command line (`family[:variant]`) into a simulator.
 
 use super::boards::spec::GAME_HELP;
-use super::boards::GameSpec;
+use super::boards::{BoardGame, GameSpec, LightsOut, TileSwap};
+use super::embodiments::embodied::EmbodiedBoard;
+use super::embodiments::Embodiment;
 use super::mountaincar::MountainCar;
 use super::pendulum::{Pendulum, PendulumVariant};
 use super::toy::{Squash, Toy};
@@ -10,7 +12,8 @@ use crate::error::{Error, Result};
 use crate::util::seeding::rng_for;
 
 pub const KNOWN_ENVS: &str =
-    "pendulum[:light|heavy|mass=<m>|inverted|quadrant], toy:inner|outer, mountaincar, lightsout[:<n>x<n>], tileswap, ball";
+    "pendulum[:light|heavy|mass=<m>|inverted|quadrant], toy:inner|outer, mountaincar, lightsout[:<n>x<n>], tileswap, \
+     <game>:cursor|reacher (a board game played by a manipulator), ball";
 
 /// The random stream, under an instance seed, that draws an instance's hidden parameters. Fixed forever:
 /// changing it would change which instance every recorded `--instance-seed` names.
@@ -25,11 +28,19 @@ pub enum EnvName {
     MountainCar,
     /// A board game on its own: board sets and symbolic planning, no simulator to step.
     Board(GameSpec),
+    /// A board game played through a manipulator (`lightsout:cursor`, `tileswap:reacher`, …): stepped by
+    /// the manipulator's actions, its state the manipulator's ⊕ board bits ⊕ remaining skill time.
+    Embodied(GameSpec, Embodiment),
     /// The table-tennis ball simulator: recorded as camera trajectories, not stepped by actions.
     Ball,
 }
 
 pub fn parse_env(name: &str) -> Result<EnvName> {
+    if let Some((game, manipulator)) = name.rsplit_once(':') {
+        if let Ok(embodiment) = Embodiment::parse(manipulator) {
+            return Ok(EnvName::Embodied(GameSpec::parse(game)?, embodiment));
+        }
+    }
     let (family, variant) = name.split_once(':').unwrap_or((name, ""));
     match family {
         "pendulum" => Ok(EnvName::Pendulum(PendulumVariant::parse(variant)?)),
@@ -55,6 +66,10 @@ impl EnvName {
                 g.name(),
                 g.name()
             ))),
+            EnvName::Embodied(game, embodiment) => match game {
+                GameSpec::LightsOut(n) => Ok(embodied(LightsOut::new(*n)?, *embodiment)),
+                GameSpec::TileSwap => Ok(embodied(TileSwap::new(), *embodiment)),
+            },
             EnvName::Ball => Err(Error::config(
                 "'ball' is recorded as camera trajectories: use `mbrl collect --env ball --trajectories N`",
             )),
@@ -67,7 +82,7 @@ impl EnvName {
             EnvName::Pendulum(v) => super::pendulum::dynamics::PendulumReward::for_params(&v.fixed_params())
                 .map(|r| Box::new(r) as Box<dyn super::RewardFn>),
             // The toy has no task; MountainCar's reward depends on the hidden terrain.
-            EnvName::Toy(_) | EnvName::MountainCar | EnvName::Board(_) | EnvName::Ball => None,
+            EnvName::Toy(_) | EnvName::MountainCar | EnvName::Board(_) | EnvName::Embodied(..) | EnvName::Ball => None,
         }
     }
 
@@ -77,9 +92,16 @@ impl EnvName {
             EnvName::Toy(squash) => format!("toy:{}", squash.name()),
             EnvName::MountainCar => "mountaincar".into(),
             EnvName::Board(g) => g.name(),
+            EnvName::Embodied(g, e) => format!("{}:{}", g.name(), e.name()),
             EnvName::Ball => "ball".into(),
         }
     }
+}
+
+/// The game on its solved board, the manipulator at its default pose until reset.
+fn embodied<G: BoardGame>(game: G, embodiment: Embodiment) -> Box<dyn Env> {
+    let goal = game.goal();
+    Box::new(EmbodiedBoard::new(game, embodiment.build().0, goal))
 }
 
 /// The simulator for `env` with the hidden parameters that `instance_seed` names. Every subcommand that takes
@@ -115,9 +137,23 @@ mod tests {
             "lightsout",
             "lightsout:7x7",
             "tileswap",
+            "lightsout:cursor",
+            "lightsout:7x7:reacher",
+            "tileswap:reacher",
         ] {
             assert_eq!(parse_env(name).unwrap().canonical(), name);
         }
+    }
+
+    #[test]
+    fn embodied_boards_are_steppable_envs() {
+        let env = parse_env("tileswap:cursor").unwrap();
+        assert_eq!(env, EnvName::Embodied(GameSpec::TileSwap, Embodiment::Cursor));
+        let spec = env.build().unwrap().spec();
+        assert_eq!(spec.state_names[..2], ["cursor_x", "cursor_y"]);
+        assert_eq!(spec.state_dim(), 2 + 81 + 1);
+        let err = parse_env("lightsout:9x8:cursor").unwrap_err().to_string();
+        assert!(err.contains("lightsout:9x8"), "{err}");
     }
 
     #[test]

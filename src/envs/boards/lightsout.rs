@@ -170,6 +170,14 @@ impl BoardGame for LightsOut {
         field_at(point, self.n).map(|(r, c)| r * self.n + c)
     }
 
+    /// Each field pressed with probability 1/2: pressing is linear over GF(2), so a uniform press set gives
+    /// every reachable board with the same probability.
+    fn scramble(&self, rng: &mut rand_chacha::ChaCha8Rng) -> LightsOutState {
+        use rand::Rng;
+        let presses: Vec<usize> = (0..self.fields()).filter(|_| rng.random_bool(0.5)).collect();
+        self.pressed(&presses)
+    }
+
     fn move_name(&self, mv: usize) -> String {
         format!("push ({}, {})", mv / self.n, mv % self.n)
     }

@@ -8,8 +8,8 @@ use crate::error::{Error, Result};
 const SIDE: usize = 3;
 const FIELDS: usize = SIDE * SIDE;
 /// A push swaps a pair when it lands within this L1 distance of the pair's pivot (the shared edge's
-/// midpoint), as in the original Cursor environment.
-pub const PIVOT_RADIUS_L1: f64 = 1.0 / 6.0;
+/// midpoint): half a field, as in the original touch board.
+pub const PIVOT_RADIUS_L1: f64 = (1.0 / SIDE as f64) / 2.0;
 
 /// 4 bits per field: bits 4i..4i+3 hold the chip on field i.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -39,6 +39,8 @@ impl TileSwapState {
 pub struct TileSwap {
     /// The two fields each move swaps: horizontal pairs row by row, then vertical pairs.
     pairs: Vec<(usize, usize)>,
+    /// (pivot, move) in the authors' pivot order, which decides ties between equally near pivots.
+    pivots: Vec<(BoardPoint, usize)>,
 }
 
 impl Default for TileSwap {
@@ -60,12 +62,38 @@ impl TileSwap {
                 pairs.push((r * SIDE + c, (r + 1) * SIDE + c));
             }
         }
-        TileSwap { pairs }
+        let pivots = reference_pivots(&pairs);
+        TileSwap { pairs, pivots }
     }
 
     pub fn pair(&self, mv: usize) -> (usize, usize) {
         self.pairs[mv]
     }
+}
+
+/// The pivots as `TileSwapTouchBoard._compute_pivot_points` (seads_envs/hybrid/touch_board.py) lists them:
+/// fields in row-major order, for each first the pivot on its lower edge (a vertical swap), then the one
+/// on its right edge (a horizontal swap). The coordinates use the same floating-point expressions
+/// (`0.5·f + f·col`, `(row + 1)·f` with f = 1/3), so distances, and therefore ties, come out bit for bit as
+/// in the original.
+fn reference_pivots(pairs: &[(usize, usize)]) -> Vec<(BoardPoint, usize)> {
+    let f = 1.0 / SIDE as f64;
+    let move_of = |a: usize, b: usize| pairs.iter().position(|&p| p == (a, b)).expect("adjacent pair is a move");
+    let mut pivots = Vec::with_capacity(pairs.len());
+    for row in 0..SIDE {
+        for col in 0..SIDE {
+            let field = row * SIDE + col;
+            if row != SIDE - 1 {
+                let point = [0.5 * f + f * col as f64, (row + 1) as f64 * f];
+                pivots.push((point, move_of(field, field + SIDE)));
+            }
+            if col != SIDE - 1 {
+                let point = [f * (col + 1) as f64, 0.5 * f + row as f64 * f];
+                pivots.push((point, move_of(field, field + 1)));
+            }
+        }
+    }
+    pivots
 }
 
 impl BoardGame for TileSwap {
@@ -152,23 +180,34 @@ impl BoardGame for TileSwap {
     }
 
     fn move_target(&self, mv: usize) -> BoardPoint {
-        let (a, b) = self.pairs[mv];
-        let centre = |f: usize| [((f % SIDE) as f64 + 0.5) / SIDE as f64, ((f / SIDE) as f64 + 0.5) / SIDE as f64];
-        let (pa, pb) = (centre(a), centre(b));
-        [(pa[0] + pb[0]) / 2.0, (pa[1] + pb[1]) / 2.0]
+        self.pivots.iter().find(|(_, m)| *m == mv).map(|(p, _)| *p).expect("every move has a pivot")
     }
 
+    /// The nearest pivot in L1 (x distance + y distance, summed in that order as numpy does), if within
+    /// half a field. Equally near pivots resolve to the first in the reference order, as numpy's argmin
+    /// does; a strict `<` keeps the first.
     fn move_at(&self, point: BoardPoint) -> Option<usize> {
         if !(0.0..=1.0).contains(&point[0]) || !(0.0..=1.0).contains(&point[1]) {
             return None;
         }
-        let distance = |mv: usize| {
-            let p = self.move_target(mv);
-            (p[0] - point[0]).abs() + (p[1] - point[1]).abs()
-        };
-        (0..self.num_moves())
-            .min_by(|&a, &b| distance(a).total_cmp(&distance(b)))
-            .filter(|&mv| distance(mv) <= PIVOT_RADIUS_L1)
+        let mut best: Option<(f64, usize)> = None;
+        for &(p, mv) in &self.pivots {
+            let distance = (p[0] - point[0]).abs() + (p[1] - point[1]).abs();
+            if best.is_none_or(|(d, _)| distance < d) {
+                best = Some((distance, mv));
+            }
+        }
+        best.filter(|&(d, _)| d <= PIVOT_RADIUS_L1).map(|(_, mv)| mv)
+    }
+
+    /// A uniform permutation (Fisher-Yates): adjacent swaps generate every permutation of the chips.
+    fn scramble(&self, rng: &mut rand_chacha::ChaCha8Rng) -> TileSwapState {
+        use rand::Rng;
+        let mut chips: [usize; FIELDS] = std::array::from_fn(|i| i);
+        for i in (1..FIELDS).rev() {
+            chips.swap(i, rng.random_range(0..=i));
+        }
+        TileSwapState::from_chips(&chips)
     }
 
     fn move_name(&self, mv: usize) -> String {
@@ -226,5 +265,33 @@ mod tests {
             assert_eq!(game.move_at([p[0] + 0.08, p[1] + 0.08]), Some(mv));
         }
         assert_eq!(game.move_at([0.02, 0.02]), None, "a corner is farther than 1/6 from every pivot");
+    }
+
+    /// Exact float ties, and the authors' resolution (numpy argmin = first pivot in their order), checked
+    /// with numpy 2.4 against the pivot list of `TileSwapTouchBoard`.
+    #[test]
+    fn equally_near_pivots_resolve_in_the_reference_order() {
+        let game = TileSwap::new();
+        let f = 1.0 / 3.0;
+        // (1/6, 1/6): the pivots below field 0 and right of it are both exactly f/2 away; the reference
+        // lists field 0's lower edge first, so the push swaps fields 0 and 3, not 0 and 1.
+        let m = game.move_at([0.5 * f, 0.5 * f]).unwrap();
+        assert_eq!(game.pair(m), (0, 3));
+        // The corner shared by fields 0, 1, 3, 4: again an exact tie of the same two pivots.
+        assert_eq!(game.pair(game.move_at([f, f]).unwrap()), (0, 3));
+        // The centre field's middle: in floats the pivots below and right of field 4 (0.1666…63) beat the
+        // ones above and left (0.1666…69); of the two, the lower edge comes first: fields 4 and 7.
+        assert_eq!(game.pair(game.move_at([0.5, 0.5]).unwrap()), (4, 7));
+        // (5/6, 5/6) is 0.16666666666666685 from its nearest pivots: just outside the radius.
+        assert_eq!(game.move_at([5.0 / 6.0, 5.0 / 6.0]), None);
+    }
+
+    #[test]
+    fn pivots_follow_the_reference_order_and_coordinates() {
+        let game = TileSwap::new();
+        let order: Vec<(usize, usize)> = game.pivots.iter().map(|&(_, m)| game.pair(m)).collect();
+        assert_eq!(order[..4], [(0, 3), (0, 1), (1, 4), (1, 2)]);
+        assert_eq!(order.len(), 12);
+        assert_eq!(game.move_target(game.pivots[0].1), [1.0 / 6.0, 1.0 / 3.0]);
     }
 }

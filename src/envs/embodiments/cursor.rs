@@ -43,8 +43,21 @@ impl Manipulator for Cursor {
         self.position.to_vec()
     }
 
+    fn state_names(&self) -> Vec<&'static str> {
+        self.obs_names()
+    }
+
     fn state(&self) -> Vec<f64> {
         self.position.to_vec()
+    }
+
+    fn state_problem(&self, state: &[f64]) -> Option<String> {
+        let names = self.state_names();
+        state
+            .iter()
+            .zip(names)
+            .find(|(v, _)| !(0.0..=1.0).contains(*v))
+            .map(|(v, name)| format!("{name} = {v} is off the board; expected a value in [0, 1]"))
     }
 
     fn set_state(&mut self, state: &[f64]) {

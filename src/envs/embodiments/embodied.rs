@@ -46,6 +46,16 @@ impl<G: BoardGame> EmbodiedBoard<G> {
         self.manipulator.as_ref()
     }
 
+    /// Puts the manipulator in `state` (see [`Manipulator::state`]), leaving board and skill time.
+    pub fn set_manipulator_state(&mut self, state: &[f64]) {
+        self.manipulator.set_state(state);
+    }
+
+    /// A new skill attempt: full skill time again, the manipulator where it is.
+    pub fn start_skill(&mut self) {
+        self.skill_step = 0;
+    }
+
     fn remaining_time(&self) -> f64 {
         let limit = self.manipulator.skill_step_limit() as f64;
         (limit - self.skill_step as f64) / limit
@@ -104,9 +114,7 @@ impl<G: BoardGame> Env for EmbodiedBoard<G> {
         };
         EnvSpec {
             name: format!("{}:{name}", self.game.name()),
-            state_names: with_board_and_time(
-                (0..self.manipulator.state().len()).map(|i| format!("{name}_q{i}")).collect(),
-            ),
+            state_names: with_board_and_time(self.manipulator.state_names().iter().map(|s| s.to_string()).collect()),
             obs_names: with_board_and_time(self.manipulator.obs_names().iter().map(|s| s.to_string()).collect()),
             action_low: self.manipulator.action_low(),
             action_high: self.manipulator.action_high(),

@@ -14,8 +14,13 @@ pub trait Manipulator: Send {
     /// Names of the manipulator part of the observation.
     fn obs_names(&self) -> Vec<&'static str>;
     fn observe(&self) -> Vec<f64>;
+    /// Names of the full physical state, in [`state`](Self::state) order.
+    fn state_names(&self) -> Vec<&'static str>;
     /// Full physical state (for saving and restoring).
     fn state(&self) -> Vec<f64>;
+    /// Why `state` is not a state this manipulator can be put in (a value outside its workspace), if it
+    /// is not; the length and finiteness are checked by the caller.
+    fn state_problem(&self, state: &[f64]) -> Option<String>;
     fn set_state(&mut self, state: &[f64]);
     fn reset(&mut self, rng: &mut ChaCha8Rng);
     /// Applies one control action. Returns the board point of a push when this action pushed while the

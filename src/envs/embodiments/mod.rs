@@ -29,6 +29,13 @@ impl Embodiment {
         }
     }
 
+    pub fn name(self) -> &'static str {
+        match self {
+            Embodiment::Cursor => "cursor",
+            Embodiment::Reacher => "reacher",
+        }
+    }
+
     /// The manipulator and its scripted controller.
     pub fn build(self) -> (Box<dyn Manipulator>, Box<dyn ScriptedController>) {
         match self {

@@ -9,18 +9,22 @@ use rand_chacha::ChaCha8Rng;
 use super::{Reacher, ACTION_REPEAT, BOARD_HALF_EXTENT, PUSH_THRESHOLD, SKILL_STEP_LIMIT, TIMESTEP, WRIST_LIMIT};
 use crate::envs::embodiments::manipulator::{BoardPoint, Manipulator};
 
-/// Arm plane → board coordinates. Arm +x is board x (columns); arm +y is board *up*, so rows (board y)
-/// count downwards. (The authors' code uses (y + 0.15)/0.3 for rows, the mirror image; the arm is
-/// mirror-symmetric and its reset distribution too, so this only relabels the board.)
+/// Arm plane → board coordinates, as the authors' `ReacherEnv._get_finger_pos` normalizes MuJoCo's world
+/// x and y: both as (xy + 0.15)/0.3, so board columns grow with arm +x and board rows with arm +y.
+///
+/// An earlier version mirrored y (rows counted from arm +y downwards) on the argument that the arm is
+/// mirror-symmetric. Its reset is not: the wrist starts in [0°, 160°] only (a U(0, 2π) draw clamped at the
+/// stop), so a mirrored board pairs the fields with different start poses than the original and skill
+/// statistics would not match.
 pub fn arm_to_board(p: [f64; 2]) -> BoardPoint {
     let extent = 2.0 * BOARD_HALF_EXTENT;
-    [(p[0] + BOARD_HALF_EXTENT) / extent, (BOARD_HALF_EXTENT - p[1]) / extent]
+    [(p[0] + BOARD_HALF_EXTENT) / extent, (p[1] + BOARD_HALF_EXTENT) / extent]
 }
 
 /// Inverse of [`arm_to_board`].
 pub fn board_to_arm(b: BoardPoint) -> [f64; 2] {
     let extent = 2.0 * BOARD_HALF_EXTENT;
-    [b[0] * extent - BOARD_HALF_EXTENT, BOARD_HALF_EXTENT - b[1] * extent]
+    [b[0] * extent - BOARD_HALF_EXTENT, b[1] * extent - BOARD_HALF_EXTENT]
 }
 
 impl Manipulator for Reacher {
@@ -59,9 +63,21 @@ impl Manipulator for Reacher {
         vec![c1, s1, c2, s2, self.v[0], self.v[1], f[0], f[1]]
     }
 
+    fn state_names(&self) -> Vec<&'static str> {
+        vec!["shoulder_angle", "wrist_angle", "shoulder_velocity", "wrist_velocity"]
+    }
+
     /// [shoulder angle, wrist angle, shoulder velocity, wrist velocity].
     fn state(&self) -> Vec<f64> {
         vec![self.q[0], self.q[1], self.v[0], self.v[1]]
+    }
+
+    /// The shoulder turns freely; the wrist stays within its stops (radians).
+    fn state_problem(&self, state: &[f64]) -> Option<String> {
+        let wrist = state.get(1).copied()?;
+        (wrist.abs() > WRIST_LIMIT).then(|| {
+            format!("wrist_angle = {wrist} is beyond the wrist's stops; expected radians in [-{WRIST_LIMIT}, {WRIST_LIMIT}] (±160°)")
+        })
     }
 
     fn set_state(&mut self, state: &[f64]) {

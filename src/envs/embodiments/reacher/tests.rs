@@ -35,13 +35,14 @@ fn forward_kinematics_and_board_frame() {
         assert!(close(finger_position(q), p, 1e-12), "{q:?}");
     }
     assert!(close(arm_to_board([0.0, 0.0]), [0.5, 0.5], 1e-12));
-    assert!(close(arm_to_board([0.15, 0.15]), [1.0, 0.0], 1e-12), "arm +y is board up");
-    assert!(close(arm_to_board([-0.15, -0.15]), [0.0, 1.0], 1e-12));
+    assert!(close(arm_to_board([0.15, 0.15]), [1.0, 1.0], 1e-12), "arm +y is board down (rows grow)");
+    assert!(close(arm_to_board([-0.15, -0.15]), [0.0, 0.0], 1e-12));
+    assert!(close(arm_to_board([0.15, -0.15]), [1.0, 0.0], 1e-12));
     let b = [0.3, 0.8];
     assert!(close(arm_to_board(board_to_arm(b)), b, 1e-12));
     let mut arm = Reacher::new();
     arm.set_state(&[0.0, PI / 2.0, 0.0, 0.0]);
-    assert!(close(arm.effector(), [0.9, 0.1], 1e-12));
+    assert!(close(arm.effector(), [0.9, 0.9], 1e-12));
     assert_eq!(arm.observe().len(), arm.obs_names().len());
     // Finger velocity matches a finite difference.
     arm.set_state(&[0.3, 0.7, 1.3, -0.4]);
@@ -177,7 +178,25 @@ fn pushes_count_only_on_the_board_and_above_the_threshold() {
     arm.set_state(&[0.0, PI / 2.0, 0.0, 0.0]);
     assert_eq!(arm.step(&[0.0, 0.0, PUSH_THRESHOLD]), None, "threshold is strict");
     let p = arm.step(&[0.0, 0.0, 0.61]).expect("on the board");
-    assert!(close(p, [0.9, 0.1], 1e-12));
+    assert!(close(p, [0.9, 0.9], 1e-12));
+}
+
+/// The authors' map: finger at arm (x, y) → ((x + 0.15)/0.3, (y + 0.15)/0.3), then their LightsOut
+/// digitize. A finger at (0.12, 0.12) (shoulder 0, wrist 90°) is at board (0.9, 0.9): row 4, column 4;
+/// one at (0.12, −0.12) (shoulder −90°, wrist 90°) at (0.9, 0.1): row 0, column 4.
+#[test]
+fn finger_maps_to_the_authors_field() {
+    use crate::envs::boards::{BoardGame, LightsOut};
+    let game = LightsOut::new(5).unwrap();
+    let mut arm = Reacher::new();
+    arm.set_state(&[0.0, PI / 2.0, 0.0, 0.0]);
+    assert_eq!(game.move_at(arm.effector()), Some(4 * 5 + 4));
+    arm.set_state(&[-PI / 2.0, PI / 2.0, 0.0, 0.0]);
+    assert!(close(arm.finger(), [0.12, -0.12], 1e-12));
+    assert_eq!(game.move_at(arm.effector()), Some(4));
+    // Shoulder 90°, stretched: finger at (0, 0.24), beyond the board's +y edge (0.15): row index > 1.
+    arm.set_state(&[PI / 2.0, 0.0, 0.0, 0.0]);
+    assert!(arm.effector()[1] > 1.0);
 }
 
 /// Runs the controller from `start` to `target`; returns the push point and steps, if it pushed.
