@@ -11,6 +11,7 @@ use mbrl::eval::ball::{self, BallEvalSettings};
 use mbrl::eval::boards::{self, EmbodiedSettings};
 use mbrl::eval::dataset_report;
 use mbrl::eval::quick::run_quick;
+use mbrl::eval::seads::{seads_report, SeadsEvalSettings};
 use mbrl::eval::swingup::{self, SwingupSettings};
 use mbrl::models::ball::checkpoint::load_ball_model;
 use mbrl::run::dir::Provenance;
@@ -80,6 +81,11 @@ enum Protocol {
                             mbrl eval context --model models/context-pendulum-quadrant --env pendulum:quadrant --contexts 50 --transitions 30 --horizon 20 --swingup"
     )]
     Context(ContextArgs),
+    /// SEADS (thesis 7.4): skill coverage, boards solved per depth with and without replanning, planning time.
+    #[command(
+        after_help = "Example:\n  mbrl eval seads --model models/seads-tileswap-cursor --boards 20 --out reports/seads-tileswap"
+    )]
+    Seads(SeadsArgs),
     /// Pendulum swing-up with MPC: success rate, returns, angle plots.
     #[command(
         after_help = "Example:\n  mbrl eval pendulum-swingup --model true --episodes 10 --out reports/swingup\n  \
@@ -108,6 +114,31 @@ struct EmbodiedArgs {
     /// Report directory.
     #[arg(long, default_value = "reports/embodied")]
     out: PathBuf,
+}
+
+#[derive(Args, Debug)]
+struct SeadsArgs {
+    /// A SEADS checkpoint directory (`mbrl train --method seads`).
+    #[arg(long)]
+    model: PathBuf,
+    /// Boards of depth 1..=max-depth are solved.
+    #[arg(long, default_value_t = 5)]
+    max_depth: u8,
+    /// Boards per depth (thesis: 20).
+    #[arg(long, default_value_t = 20)]
+    boards: usize,
+    /// Boards every skill is executed from for the coverage table.
+    #[arg(long, default_value_t = 100)]
+    coverage_boards: usize,
+    /// Replans allowed per board (thesis: 10).
+    #[arg(long, default_value_t = 10)]
+    max_replans: usize,
+    /// Split the boards come from.
+    #[arg(long, value_enum, default_value_t = SplitChoice::Test)]
+    split: SplitChoice,
+    /// Report directory (default: reports/seads-<checkpoint name>).
+    #[arg(long)]
+    out: Option<PathBuf>,
 }
 
 #[derive(Args, Debug)]
@@ -163,6 +194,7 @@ pub fn run(global: &GlobalArgs, args: EvalArgs) -> anyhow::Result<()> {
             println!("report: {}", out.join("report.md").display());
         }
         Protocol::Context(a) => eval_context(global, &provenance, a)?,
+        Protocol::Seads(a) => eval_seads(global, &provenance, a)?,
         Protocol::Boards { out } => {
             let rows = run_job(global, "eval boards", |monitor| boards::depth_report(&provenance, &out, monitor))?;
             println!("game        depth   boards    train     test   thesis");
@@ -396,4 +428,36 @@ fn swingup_settings(variant: PendulumVariant, steps: usize, cem: &CemArgs) -> Sw
     settings.steps = steps;
     settings.cem = cem.config(&settings.cem.action_low, &settings.cem.action_high);
     settings
+}
+
+fn eval_seads(global: &GlobalArgs, provenance: &Provenance, a: SeadsArgs) -> anyhow::Result<()> {
+    if a.max_depth == 0 || a.max_depth > 10 || a.boards == 0 || a.coverage_boards == 0 {
+        bail!("--max-depth must be 1..=10 and --boards, --coverage-boards at least 1");
+    }
+    let loaded = mbrl::models::seads::planner::load(&a.model)?;
+    let out = a.out.clone().unwrap_or_else(|| {
+        PathBuf::from(format!("reports/seads-{}", a.model.file_name().and_then(|n| n.to_str()).unwrap_or("model")))
+    });
+    let settings = SeadsEvalSettings {
+        max_depth: a.max_depth,
+        boards_per_depth: a.boards,
+        coverage_boards: a.coverage_boards,
+        max_replans: a.max_replans,
+        split: a.split.into(),
+    };
+    let s = run_job(global, "eval seads", |monitor| seads_report(&loaded, &settings, provenance, &out, monitor))?;
+    println!("{}: the skills' most frequent moves cover {} of {} game moves", s.env, s.distinct_moves, s.moves);
+    for r in &s.depths {
+        let n = r.boards.max(1) as f64;
+        println!(
+            "depth {}: {:.1} % solved with ≤ {} replans, {:.1} % without; planning {:.4} s per board",
+            r.depth,
+            100.0 * r.solved_with_replanning as f64 / n,
+            a.max_replans,
+            100.0 * r.solved_without_replanning as f64 / n,
+            r.mean_planning_seconds
+        );
+    }
+    println!("report: {}", out.join("report.md").display());
+    Ok(())
 }

@@ -11,7 +11,9 @@ use mbrl::planning::bfs::SearchLimits;
 use mbrl::planning::solve_board::{execute_plan, layout, plan_board, SearchKind};
 use mbrl::util::seeding::rng_for;
 
-use crate::common::{run_job, GlobalArgs, ModelChoice};
+use mbrl::models::seads::planner::{load as load_seads, solve_with_skills, LoadedSeads};
+
+use crate::common::{run_job, GlobalArgs};
 
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
 pub enum SplitChoice {
@@ -61,13 +63,18 @@ Examples:
   mbrl solve-board --game lightsout --random-depth 9 --split test --model true
   mbrl solve-board --game tileswap --board 8,7,6,5,4,3,2,1,0 --model true --search bfs
   mbrl solve-board --game tileswap --random-depth 5 --model true --embodiment reacher
+  mbrl solve-board --model models/seads-tileswap-cursor --random-depth 3 --split test
+
+With a SEADS checkpoint as --model, the game and embodiment are the checkpoint's: its forward model plans
+(bidirectional search where the model proves self-inverse on every state it expands, else one-sided) and
+its skill policies play the plan, replanning when the board differs from the prediction.
 
 Boards are comma-separated field values, row-major: 0/1 lights for LightsOut (n*n values), the chip
 number 0-8 on each field for TileSwap (solved: 0,1,2,...,8).")]
 pub struct SolveBoardArgs {
-    /// Game: lightsout (5x5), lightsout:<n>x<n> (n = 2..13), tileswap.
+    /// Game: lightsout (5x5), lightsout:<n>x<n> (n = 2..13), tileswap (default with a SEADS --model: its game).
     #[arg(long)]
-    game: String,
+    game: Option<String>,
     /// The board to solve.
     #[arg(long, conflicts_with = "random_depth", required_unless_present = "random_depth")]
     board: Option<String>,
@@ -77,9 +84,13 @@ pub struct SolveBoardArgs {
     /// Draw the random board from this split only (thesis appendix D.1.4).
     #[arg(long, value_enum, requires = "random_depth")]
     split: Option<SplitChoice>,
-    /// Successor model used by the search.
-    #[arg(long, value_enum)]
-    model: ModelChoice,
+    /// Successor model: `true` (the game's rules) or a SEADS checkpoint directory (its learned forward model
+    /// and skill policies).
+    #[arg(long)]
+    model: String,
+    /// Replans allowed when a skill's outcome differs from the model's prediction (SEADS --model).
+    #[arg(long, default_value_t = 10)]
+    max_replans: usize,
     /// Play the plan with this manipulator's scripted controller.
     #[arg(long, value_enum)]
     embodiment: Option<EmbodimentChoice>,
@@ -98,11 +109,102 @@ pub struct SolveBoardArgs {
 }
 
 pub fn run(global: &GlobalArgs, args: SolveBoardArgs) -> anyhow::Result<()> {
-    let ModelChoice::True = args.model;
-    match GameSpec::parse(&args.game)? {
+    if args.model != "true" {
+        return run_learned(global, &args);
+    }
+    let game = args.game.as_deref().context("--game is required with --model true")?;
+    match GameSpec::parse(game)? {
         GameSpec::LightsOut(n) => solve(global, &args, LightsOut::new(n)?),
         GameSpec::TileSwap => solve(global, &args, TileSwap::new()),
     }
+}
+
+fn limits_of(args: &SolveBoardArgs) -> SearchLimits {
+    SearchLimits { max_depth: args.max_depth, max_nodes: args.max_nodes, max_memory_bytes: args.max_memory_mib << 20 }
+}
+
+fn board_of<G: DenseIndex>(args: &SolveBoardArgs, game: &G, seed: u64) -> anyhow::Result<G::State> {
+    Ok(match (&args.board, args.random_depth) {
+        (Some(text), _) => game.parse(text).with_context(|| format!("--board '{text}'"))?,
+        (None, Some(depth)) => {
+            let table = DepthTable::build(game)?;
+            sample_board(game, &table, depth, args.split.map(Split::from), &mut rng_for(seed, &[0]))?
+        }
+        (None, None) => bail!("give --board or --random-depth"),
+    })
+}
+
+fn run_learned(global: &GlobalArgs, args: &SolveBoardArgs) -> anyhow::Result<()> {
+    let dir = std::path::Path::new(&args.model);
+    if !dir.is_dir() {
+        bail!("--model '{}': expected `true` or a SEADS checkpoint directory", args.model);
+    }
+    let loaded = load_seads(dir)?;
+    if let Some(game) = &args.game {
+        if GameSpec::parse(game)? != loaded.env.game {
+            bail!("--game {game} differs from the checkpoint's game ({}); leave --game out", loaded.env.game.name());
+        }
+    }
+    if let Some(e) = args.embodiment {
+        if Embodiment::from(e) != loaded.env.embodiment {
+            bail!(
+                "--embodiment differs from the checkpoint's ({}); its skills play with their own embodiment",
+                loaded.env.name()
+            );
+        }
+    }
+    match loaded.env.game {
+        GameSpec::LightsOut(n) => solve_learned(global, args, LightsOut::new(n)?, &loaded),
+        GameSpec::TileSwap => solve_learned(global, args, TileSwap::new(), &loaded),
+    }
+}
+
+fn solve_learned<G: DenseIndex>(
+    global: &GlobalArgs,
+    args: &SolveBoardArgs,
+    game: G,
+    loaded: &LoadedSeads,
+) -> anyhow::Result<()> {
+    let board = board_of(args, &game, global.seed)?;
+    let limits = limits_of(args);
+    let bidirectional = args.search == SearchChoice::Bidirectional;
+    let title = format!("solve-board: {} with learned skills", loaded.env.name());
+    let outcome = run_job(global, &title, |monitor| {
+        monitor.emit(&layout(&title));
+        solve_with_skills(
+            &game,
+            loaded,
+            board,
+            bidirectional,
+            &limits,
+            args.max_replans,
+            &mut rng_for(global.seed, &[1]),
+            monitor,
+        )
+    })?;
+    println!("board {} ({}):\n{}", game.canonical_string(board), loaded.env.name(), game.render(board));
+    for (i, plan) in outcome.plans.iter().enumerate() {
+        println!("plan {} ({} skills): {:?}", i + 1, plan.len(), plan);
+    }
+    let moves: Vec<String> = outcome
+        .executed
+        .iter()
+        .map(|(k, m)| format!("skill {k} → {}", m.map(|m| game.move_name(m)).unwrap_or_else(|| "no move".into())))
+        .collect();
+    println!("executed: {}", moves.join(", "));
+    println!(
+        "search: {}, planning {:.3} s; {} replans; {} control steps; final board:\n{}\nsolved: {}",
+        if outcome.bidirectional { "bidirectional (model verified self-inverse)" } else { "breadth-first" },
+        outcome.planning_seconds,
+        outcome.plans.len().saturating_sub(1),
+        outcome.control_steps,
+        game.render(outcome.final_board),
+        if outcome.solved { "yes" } else { "no" }
+    );
+    if !outcome.solved {
+        bail!("the learned skills did not reach the goal board within {} replans", args.max_replans);
+    }
+    Ok(())
 }
 
 fn solve<G: DenseIndex>(global: &GlobalArgs, args: &SolveBoardArgs, game: G) -> anyhow::Result<()> {

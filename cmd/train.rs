@@ -10,6 +10,7 @@ use mbrl::models::ball::learn::TrainSettings;
 use mbrl::models::ball::BallModelParams;
 use mbrl::models::context::{self, ContextConfig};
 use mbrl::models::pets::{self, PetsConfig, Preset, RewardSource};
+use mbrl::models::seads::{self, EmbodiedGame, SeadsConfig};
 use mbrl::run::dir::{Provenance, METRICS_FILE};
 use mbrl::train::config::apply_toml_file;
 use mbrl::train::{loss_history, OpenedCheckpoint};
@@ -28,6 +29,10 @@ pub enum Method {
     /// Context-conditional GRU dynamics with a context encoder (Explore the Context, thesis ch. 4), trained
     /// on instance-pair datasets (`collect --instances N`); calibrate with `mbrl calibrate`.
     Context,
+    /// SEADS (thesis ch. 7): skill policies (SAC) and a symbolic forward model learned without reward in an
+    /// embodied board game (--env lightsout:cursor|tileswap:cursor|lightsout:reacher|tileswap:reacher); needs no
+    /// --data, it collects its own episodes.
+    Seads,
 }
 
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
@@ -60,6 +65,8 @@ Examples:
   mbrl train --method ball-ekf --data datasets/ball-train.mcap --out models/ball-ekf --steps 2000
   mbrl collect --env toy:inner --instances 1000 --steps 100 --out datasets/toy-inner.mcap
   mbrl train --method context --data datasets/toy-inner.mcap --preset small --out models/context-toy-inner
+  mbrl train --method seads --env tileswap:cursor --preset small --out models/seads-tileswap-cursor
+  mbrl train --method seads --env lightsout:cursor --preset medium --no-novelty --out models/seads-lo-nonov
 
 A config file (TOML) sets any key of the method's config.json `config` table; unknown keys are errors.
 Flags given explicitly override the file. `--resume DIR` continues a stopped run from its last checkpoint
@@ -69,8 +76,8 @@ pub struct TrainArgs {
     #[arg(long, value_enum, required_unless_present = "resume")]
     method: Option<Method>,
     /// Training data (repeatable). pets: rollout datasets (.mcap) of one env; ball-ekf: a ball dataset (.mcap)
-    /// or a .csv recording.
-    #[arg(long, required_unless_present = "resume")]
+    /// or a .csv recording. SEADS collects its own episodes and takes none.
+    #[arg(long)]
     data: Vec<PathBuf>,
     /// The env the data must come from (pets; default: the dataset's env).
     #[arg(long)]
@@ -79,7 +86,7 @@ pub struct TrainArgs {
     #[arg(long)]
     out: Option<PathBuf>,
     /// Continue the stopped run in this checkpoint directory.
-    #[arg(long, conflicts_with_all = ["method", "data", "env", "out", "config", "preset", "ensemble", "steps", "batch", "lr", "reward", "launcher_prior"])]
+    #[arg(long, conflicts_with_all = ["method", "data", "env", "out", "config", "preset", "ensemble", "steps", "batch", "lr", "reward", "launcher_prior", "skills", "env_steps", "no_relabel", "no_second_best", "no_novelty"])]
     resume: Option<PathBuf>,
     /// Hyperparameters from a TOML file (pets, context), over the preset's.
     #[arg(long)]
@@ -108,6 +115,21 @@ pub struct TrainArgs {
     /// Learn the spin prior from launcher settings (ball-ekf, thesis C.1.3); recordings need side information.
     #[arg(long)]
     launcher_prior: bool,
+    /// Number of skills K (seads; default: the game's move count, 25 LightsOut, 12 TileSwap).
+    #[arg(long)]
+    skills: Option<usize>,
+    /// Budget of environment steps (seads; default: the preset's, paper = 500k Cursor, 10M Reacher).
+    #[arg(long)]
+    env_steps: Option<u64>,
+    /// Ablation: no relabelling of skill labels (seads).
+    #[arg(long)]
+    no_relabel: bool,
+    /// Ablation: no second-best normalization of the reward (seads).
+    #[arg(long)]
+    no_second_best: bool,
+    /// Ablation: no novelty bonus in the reward (seads).
+    #[arg(long)]
+    no_novelty: bool,
 }
 
 pub fn run(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
@@ -121,6 +143,7 @@ pub fn run(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
         Method::Pets => train_pets(global, args),
         Method::BallEkf => train_ball(global, args),
         Method::Context => train_context(global, args),
+        Method::Seads => train_seads(global, args),
     }
 }
 
@@ -139,12 +162,17 @@ fn resume(global: &GlobalArgs, dir: &Path) -> anyhow::Result<()> {
             let report = run_job(global, "train context (resumed)", |monitor| context::resume(dir, monitor))?;
             print_context_report(&report, dir)
         }
+        seads::METHOD => {
+            let report = run_job(global, "train seads (resumed)", |monitor| seads::resume(dir, monitor))?;
+            print_seads_report(&report, dir)
+        }
         other => bail!(
-            "{}: '{other}' runs cannot be resumed; resumable methods: {}, {}, {}",
+            "{}: '{other}' runs cannot be resumed; resumable methods: {}, {}, {}, {}",
             dir.display(),
             pets::METHOD,
             ball_job::METHOD,
-            context::METHOD
+            context::METHOD,
+            seads::METHOD
         ),
     }
 }
@@ -396,4 +424,85 @@ fn write_loss_report(out: &Path, title: &str, y_label: &str) -> anyhow::Result<V
     let curve = Series { name: "batch loss".into(), points: losses.iter().map(|(k, l)| (*k as f64, *l)).collect() };
     line_plot(&out.join("loss.png"), title, "step", y_label, &[curve])?;
     Ok(losses)
+}
+
+fn seads_config(args: &TrainArgs, env: &EmbodiedGame) -> anyhow::Result<SeadsConfig> {
+    for (flag, given) in [
+        ("--data", !args.data.is_empty()),
+        ("--ensemble", args.ensemble.is_some()),
+        ("--reward", args.reward.is_some()),
+        ("--steps", args.steps.is_some()),
+        ("--batch", args.batch.is_some()),
+        ("--lr", args.lr.is_some()),
+        ("--launcher-prior", args.launcher_prior),
+    ] {
+        if given {
+            bail!(
+                "{flag} does not apply to seads; it takes --env, --out, --preset, --config, --skills, --env-steps, \
+                 --no-relabel, --no-second-best, --no-novelty (learning rates and batches via --config)"
+            );
+        }
+    }
+    let preset = match args.preset.unwrap_or(PresetChoice::Small) {
+        PresetChoice::Small => seads::Preset::Small,
+        PresetChoice::Medium => seads::Preset::Medium,
+        PresetChoice::Paper => seads::Preset::Paper,
+    };
+    let cursor = env.embodiment == mbrl::envs::embodiments::Embodiment::Cursor;
+    let mut config = SeadsConfig::preset(preset, env.moves(), cursor);
+    if let Some(path) = &args.config {
+        config = apply_toml_file(&config, path)?;
+    }
+    if let Some(k) = args.skills {
+        config.skills = k;
+    }
+    if let Some(n) = args.env_steps {
+        config.env_steps = n;
+    }
+    if args.no_relabel {
+        config.relabel = false;
+    }
+    if args.no_second_best {
+        config.reward.second_best = false;
+    }
+    if args.no_novelty {
+        config.reward.novelty = false;
+    }
+    config.validate()?;
+    Ok(config)
+}
+
+fn train_seads(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
+    let env_name = args.env.as_deref().context(format!("seads needs --env ({})", seads::ENV_HELP))?;
+    let env = EmbodiedGame::parse(env_name)?;
+    let config = seads_config(&args, &env)?;
+    let out = args.out.clone().unwrap_or_else(|| PathBuf::from(format!("models/seads-{}", file_stem(&env.name()))));
+    let request = seads::TrainRequest {
+        out: out.clone(),
+        env,
+        config,
+        seed: global.seed,
+        provenance: Provenance::new(command_line(), global.seed, global.thread_count()),
+    };
+    let report = run_job(global, "train seads", |monitor| seads::train(&request, false, monitor))?;
+    print_seads_report(&report, &out)
+}
+
+fn print_seads_report(report: &seads::TrainReport, out: &Path) -> anyhow::Result<()> {
+    write_loss_report(out, "SEADS forward-model NLL per bit on each epoch's new episodes", "nats per bit")?;
+    let run = &report.run;
+    let c = &run.config;
+    println!(
+        "trained SEADS on {}: {} skills, {} epochs, {} env steps (budget {}), SAC {:?}, forward model {} units",
+        run.env, c.skills, report.outcome.steps, report.env_steps, c.env_steps, c.sac_hidden, c.model_hidden
+    );
+    let last = &report.last;
+    println!(
+        "last epoch: the skills execute {} distinct game moves; forward-model NLL {:.4} nats per bit{}",
+        last.distinct_moves,
+        last.model_loss,
+        last.mean_final_reward.map(|r| format!("; mean intrinsic reward {r:.3}")).unwrap_or_default()
+    );
+    println!("checkpoint: {}", out.display());
+    Ok(())
 }

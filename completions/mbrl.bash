@@ -73,6 +73,9 @@ _mbrl() {
             mbrl__subcmd__eval,quick)
                 cmd="mbrl__subcmd__eval__subcmd__quick"
                 ;;
+            mbrl__subcmd__eval,seads)
+                cmd="mbrl__subcmd__eval__subcmd__seads"
+                ;;
             mbrl__subcmd__eval__subcmd__help,ball)
                 cmd="mbrl__subcmd__eval__subcmd__help__subcmd__ball"
                 ;;
@@ -96,6 +99,9 @@ _mbrl() {
                 ;;
             mbrl__subcmd__eval__subcmd__help,quick)
                 cmd="mbrl__subcmd__eval__subcmd__help__subcmd__quick"
+                ;;
+            mbrl__subcmd__eval__subcmd__help,seads)
+                cmd="mbrl__subcmd__eval__subcmd__help__subcmd__seads"
                 ;;
             mbrl__subcmd__help,calibrate)
                 cmd="mbrl__subcmd__help__subcmd__calibrate"
@@ -150,6 +156,9 @@ _mbrl() {
                 ;;
             mbrl__subcmd__help__subcmd__eval,quick)
                 cmd="mbrl__subcmd__help__subcmd__eval__subcmd__quick"
+                ;;
+            mbrl__subcmd__help__subcmd__eval,seads)
+                cmd="mbrl__subcmd__help__subcmd__eval__subcmd__seads"
                 ;;
             *)
                 ;;
@@ -358,7 +367,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval)
-            opts="-q -h -V --seed --threads --tui --no-tui --quiet --help --version quick dataset boards embodied ball context pendulum-swingup help"
+            opts="-q -h -V --seed --threads --tui --no-tui --quiet --help --version quick dataset boards embodied ball context seads pendulum-swingup help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -610,7 +619,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__help)
-            opts="quick dataset boards embodied ball context pendulum-swingup help"
+            opts="quick dataset boards embodied ball context seads pendulum-swingup help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -735,6 +744,20 @@ _mbrl() {
             COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
             return 0
             ;;
+        mbrl__subcmd__eval__subcmd__help__subcmd__seads)
+            opts=""
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 4 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
         mbrl__subcmd__eval__subcmd__pendulum__subcmd__swingup)
             opts="-q -h -V --model --particles --propagation --context --episodes --env --steps --horizon --candidates --elites --iters --noise --beta --no-warm-start --out --seed --threads --tui --no-tui --quiet --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
@@ -820,6 +843,56 @@ _mbrl() {
                 return 0
             fi
             case "${prev}" in
+                --out)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --seed)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mbrl__subcmd__eval__subcmd__seads)
+            opts="-q -h -V --model --max-depth --boards --coverage-boards --max-replans --split --out --seed --threads --tui --no-tui --quiet --help --version"
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                --model)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --max-depth)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --boards)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --coverage-boards)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --max-replans)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --split)
+                    COMPREPLY=($(compgen -W "train test" -- "${cur}"))
+                    return 0
+                    ;;
                 --out)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
@@ -934,7 +1007,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__help__subcmd__eval)
-            opts="quick dataset boards embodied ball context pendulum-swingup"
+            opts="quick dataset boards embodied ball context seads pendulum-swingup"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1032,6 +1105,20 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__help__subcmd__eval__subcmd__quick)
+            opts=""
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 4 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mbrl__subcmd__help__subcmd__eval__subcmd__seads)
             opts=""
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 4 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
@@ -1268,7 +1355,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__solve__subcmd__board)
-            opts="-q -h -V --game --board --random-depth --split --model --embodiment --search --max-depth --max-nodes --max-memory-mib --seed --threads --tui --no-tui --quiet --help --version"
+            opts="-q -h -V --game --board --random-depth --split --model --max-replans --embodiment --search --max-depth --max-nodes --max-memory-mib --seed --threads --tui --no-tui --quiet --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1291,7 +1378,11 @@ _mbrl() {
                     return 0
                     ;;
                 --model)
-                    COMPREPLY=($(compgen -W "true" -- "${cur}"))
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --max-replans)
+                    COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
                 --embodiment)
@@ -1330,14 +1421,14 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__train)
-            opts="-q -h -V --method --data --env --out --resume --config --preset --ensemble --steps --batch --lr --reward --chunk --launcher-prior --seed --threads --tui --no-tui --quiet --help --version"
+            opts="-q -h -V --method --data --env --out --resume --config --preset --ensemble --steps --batch --lr --reward --chunk --launcher-prior --skills --env-steps --no-relabel --no-second-best --no-novelty --seed --threads --tui --no-tui --quiet --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
             fi
             case "${prev}" in
                 --method)
-                    COMPREPLY=($(compgen -W "pets ball-ekf context" -- "${cur}"))
+                    COMPREPLY=($(compgen -W "pets ball-ekf context seads" -- "${cur}"))
                     return 0
                     ;;
                 --data)
@@ -1385,6 +1476,14 @@ _mbrl() {
                     return 0
                     ;;
                 --chunk)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --skills)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --env-steps)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;

@@ -94,8 +94,9 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -s h -l help -d 'Print h
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -s V -l version -d 'Print version'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l method -d 'What to train' -r -f -a "pets\t'Probabilistic ensemble of MLPs on (state, action) → state change (PETS, Chua et al. 2018), for any env that `collect` rolls out; plan with it via `mbrl plan --model DIR`'
 ball-ekf\t'Gray-box table-tennis ball EKF: learn the impact matrix, noise levels and initial values by maximizing the filter\'s marginal likelihood (thesis 6.4.4, eq. 6.24)'
-context\t'Context-conditional GRU dynamics with a context encoder (Explore the Context, thesis ch. 4), trained on instance-pair datasets (`collect --instances N`); calibrate with `mbrl calibrate`'"
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l data -d 'Training data (repeatable). pets: rollout datasets (.mcap) of one env; ball-ekf: a ball dataset (.mcap) or a .csv recording' -r -F
+context\t'Context-conditional GRU dynamics with a context encoder (Explore the Context, thesis ch. 4), trained on instance-pair datasets (`collect --instances N`); calibrate with `mbrl calibrate`'
+seads\t'SEADS (thesis ch. 7): skill policies (SAC) and a symbolic forward model learned without reward in an embodied board game (--env lightsout:cursor|tileswap:cursor|lightsout:reacher|tileswap:reacher); needs no --data, it collects its own episodes'"
+complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l data -d 'Training data (repeatable). pets: rollout datasets (.mcap) of one env; ball-ekf: a ball dataset (.mcap) or a .csv recording. SEADS collects its own episodes and takes none' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l env -d 'The env the data must come from (pets; default: the dataset\'s env)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l out -d 'Checkpoint directory (default: models/<method>-<env>, models/ball-ekf)' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l resume -d 'Continue the stopped run in this checkpoint directory' -r -F
@@ -110,9 +111,14 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l lr -d 'Adam learning
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l reward -d 'Where the model\'s reward comes from (pets; default: known where the env has a closed form)' -r -f -a "known\t'The env\'s closed-form reward (pendulum variants without hidden actuators)'
 learned\t'An extra output of the network, trained on the dataset\'s rewards'"
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l chunk -d 'Frames per chunk (ball-ekf; thesis: 50)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l skills -d 'Number of skills K (seads; default: the game\'s move count, 25 LightsOut, 12 TileSwap)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l env-steps -d 'Budget of environment steps (seads; default: the preset\'s, paper = 500k Cursor, 10M Reacher)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l launcher-prior -d 'Learn the spin prior from launcher settings (ball-ekf, thesis C.1.3); recordings need side information'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l no-relabel -d 'Ablation: no relabelling of skill labels (seads)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l no-second-best -d 'Ablation: no second-best normalization of the reward (seads)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l no-novelty -d 'Ablation: no novelty bonus in the reward (seads)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -s q -l quiet -d 'Print only results and errors'
@@ -163,12 +169,13 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -l no-tui -d 'Print p
 complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -s V -l version -d 'Print version'
-complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l game -d 'Game: lightsout (5x5), lightsout:<n>x<n> (n = 2..13), tileswap' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l game -d 'Game: lightsout (5x5), lightsout:<n>x<n> (n = 2..13), tileswap (default with a SEADS --model: its game)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l board -d 'The board to solve' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l random-depth -d 'Draw a random board whose shortest solution has this many moves (5x5 LightsOut, TileSwap)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l split -d 'Draw the random board from this split only (thesis appendix D.1.4)' -r -f -a "train\t''
 test\t''"
-complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l model -d 'Successor model used by the search' -r -f -a "true\t'The game\'s own rules (ground truth)'"
+complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l model -d 'Successor model: `true` (the game\'s rules) or a SEADS checkpoint directory (its learned forward model and skill policies)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l max-replans -d 'Replans allowed when a skill\'s outcome differs from the model\'s prediction (SEADS --model)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l embodiment -d 'Play the plan with this manipulator\'s scripted controller' -r -f -a "cursor\t'A point moved by steps of at most 0.2, pushing where it stands (10 steps per move)'
 reacher\t'A torque-driven two-link arm over a 0.3 m board (50 steps per move)'"
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l search -d 'Search algorithm' -r -f -a "bidirectional\t'From both ends (moves undo themselves); far fewer states'
@@ -183,21 +190,22 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l no-tui -d 'Pri
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -s V -l version -d 'Print version'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context pendulum-swingup help" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context pendulum-swingup help" -l threads -d 'Worker threads (0 = one per core)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context pendulum-swingup help" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context pendulum-swingup help" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context pendulum-swingup help" -s q -l quiet -d 'Print only results and errors'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context pendulum-swingup help" -s h -l help -d 'Print help'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context pendulum-swingup help" -s V -l version -d 'Print version'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context pendulum-swingup help" -f -a "quick" -d 'Small reproduction of every implemented method (about a minute)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context pendulum-swingup help" -f -a "dataset" -d 'Summarise a dataset: rollouts, returns, state ranges, plots'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context pendulum-swingup help" -f -a "boards" -d 'Depth and train/test split tables of LightsOut 5x5 and TileSwap (thesis Tables 7.1, 7.2)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context pendulum-swingup help" -f -a "embodied" -d 'A manipulator\'s scripted controller plays optimal plans of boards of depth 1..D'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context pendulum-swingup help" -f -a "ball" -d 'Ball prediction error vs horizon on simulated shots, default and unseen launcher poses (thesis 6.5)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context pendulum-swingup help" -f -a "context" -d 'Explore the Context (thesis 4.5): calibration strategies compared by prediction error after calibration'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context pendulum-swingup help" -f -a "pendulum-swingup" -d 'Pendulum swing-up with MPC: success rate, returns, angle plots'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context pendulum-swingup help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads pendulum-swingup help" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads pendulum-swingup help" -l threads -d 'Worker threads (0 = one per core)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads pendulum-swingup help" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads pendulum-swingup help" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads pendulum-swingup help" -s q -l quiet -d 'Print only results and errors'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads pendulum-swingup help" -s h -l help -d 'Print help'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads pendulum-swingup help" -s V -l version -d 'Print version'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads pendulum-swingup help" -f -a "quick" -d 'Small reproduction of every implemented method (about a minute)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads pendulum-swingup help" -f -a "dataset" -d 'Summarise a dataset: rollouts, returns, state ranges, plots'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads pendulum-swingup help" -f -a "boards" -d 'Depth and train/test split tables of LightsOut 5x5 and TileSwap (thesis Tables 7.1, 7.2)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads pendulum-swingup help" -f -a "embodied" -d 'A manipulator\'s scripted controller plays optimal plans of boards of depth 1..D'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads pendulum-swingup help" -f -a "ball" -d 'Ball prediction error vs horizon on simulated shots, default and unseen launcher poses (thesis 6.5)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads pendulum-swingup help" -f -a "context" -d 'Explore the Context (thesis 4.5): calibration strategies compared by prediction error after calibration'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads pendulum-swingup help" -f -a "seads" -d 'SEADS (thesis 7.4): skill coverage, boards solved per depth with and without replanning, planning time'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads pendulum-swingup help" -f -a "pendulum-swingup" -d 'Pendulum swing-up with MPC: success rate, returns, angle plots'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads pendulum-swingup help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from quick" -l out -d 'Report directory' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from quick" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from quick" -l threads -d 'Worker threads (0 = one per core)' -r
@@ -276,6 +284,21 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -s V -l version -d 'Print version'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l model -d 'A SEADS checkpoint directory (`mbrl train --method seads`)' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l max-depth -d 'Boards of depth 1..=max-depth are solved' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l boards -d 'Boards per depth (thesis: 20)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l coverage-boards -d 'Boards every skill is executed from for the coverage table' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l max-replans -d 'Replans allowed per board (thesis: 10)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l split -d 'Split the boards come from' -r -f -a "train\t''
+test\t''"
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l out -d 'Report directory (default: reports/seads-<checkpoint name>)' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l threads -d 'Worker threads (0 = one per core)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -s q -l quiet -d 'Print only results and errors'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -s h -l help -d 'Print help'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -s V -l version -d 'Print version'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l model -d 'Dynamics the planner uses: `true` (the simulator\'s equations) or a checkpoint directory written by `mbrl train` (e.g. models/pets-pendulum)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l particles -d 'Particles per candidate for stochastic learned models (PETS: trajectory sampling)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l propagation -d 'How particles use the ensemble members' -r -f -a "ts1\t'TS-1: each particle draws an ensemble member anew at every step'
@@ -307,6 +330,7 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from help" -f -a "embodied" -d 'A manipulator\'s scripted controller plays optimal plans of boards of depth 1..D'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from help" -f -a "ball" -d 'Ball prediction error vs horizon on simulated shots, default and unseen launcher poses (thesis 6.5)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from help" -f -a "context" -d 'Explore the Context (thesis 4.5): calibration strategies compared by prediction error after calibration'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from help" -f -a "seads" -d 'SEADS (thesis 7.4): skill coverage, boards solved per depth with and without replanning, planning time'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from help" -f -a "pendulum-swingup" -d 'Pendulum swing-up with MPC: success rate, returns, angle plots'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
@@ -340,4 +364,5 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from eval" -f -a "embodied" -d 'A manipulator\'s scripted controller plays optimal plans of boards of depth 1..D'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from eval" -f -a "ball" -d 'Ball prediction error vs horizon on simulated shots, default and unseen launcher poses (thesis 6.5)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from eval" -f -a "context" -d 'Explore the Context (thesis 4.5): calibration strategies compared by prediction error after calibration'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from eval" -f -a "seads" -d 'SEADS (thesis 7.4): skill coverage, boards solved per depth with and without replanning, planning time'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from eval" -f -a "pendulum-swingup" -d 'Pendulum swing-up with MPC: success rate, returns, angle plots'

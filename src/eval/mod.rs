@@ -6,5 +6,6 @@ pub mod context;
 pub mod dataset_report;
 pub mod plot;
 pub mod quick;
+pub mod seads;
 pub mod stats;
 pub mod swingup;

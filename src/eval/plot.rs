@@ -75,8 +75,20 @@ fn xy_chart<'a, 'b>(
 }
 
 pub fn line_plot(path: &Path, title: &str, x_label: &str, y_label: &str, series: &[Series]) -> Result<()> {
+    let y = bounds(series.iter().flat_map(|s| s.points.iter().map(|p| p.1)));
+    line_plot_in(path, title, x_label, y_label, series, y)
+}
+
+/// A line plot on a fixed y range: rates in percent read wrong when the axis zooms in on 95-100.
+pub fn line_plot_in(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    series: &[Series],
+    (y0, y1): (f64, f64),
+) -> Result<()> {
     let (x0, x1) = bounds(series.iter().flat_map(|s| s.points.iter().map(|p| p.0)));
-    let (y0, y1) = bounds(series.iter().flat_map(|s| s.points.iter().map(|p| p.1)));
     render_atomic(path, |tmp| {
         let root = BitMapBackend::new(tmp, SIZE).into_drawing_area();
         let mut chart = xy_chart(&root, path, title, (x_label, y_label), x0..x1, y0..y1)?;

@@ -1,6 +1,7 @@
 pub mod ball;
 pub mod context;
 pub mod pets;
+pub mod seads;
 
 use std::path::Path;
 

@@ -30,6 +30,15 @@ pub trait TrainingMethod {
     fn artifacts(&self) -> Result<Vec<(String, Vec<u8>)>> {
         Ok(Vec::new())
     }
+    /// Whether a budget counted in something other than steps is used up (SEADS counts environment steps); the
+    /// run then ends after this step, complete, with `total_steps` only an upper bound.
+    fn budget_spent(&self) -> bool {
+        false
+    }
+    /// Figures of the step just taken beyond its loss, charted and logged under these names.
+    fn step_scalars(&self) -> Vec<(&'static str, f64)> {
+        Vec::new()
+    }
 }
 
 #[derive(Clone, Debug)]
@@ -85,6 +94,7 @@ pub fn fit(
     };
     let mut last_checkpoint = start;
     let mut last_loss = None;
+    let mut steps_done = start;
     for step in start + 1..=settings.total_steps {
         if monitor.is_cancelled() {
             return Err(Error::Cancelled);
@@ -95,7 +105,10 @@ pub fn fit(
         }
         last_loss = Some(loss);
         monitor.scalar("train/loss", step, loss);
-        let last = step == settings.total_steps;
+        for (name, value) in method.step_scalars() {
+            monitor.scalar(name, step, value);
+        }
+        let last = step == settings.total_steps || method.budget_spent();
         if step % every(settings.validate_every) == 0 || last {
             if let Some(valid) = method.validate()? {
                 if !valid.is_finite() {
@@ -109,16 +122,15 @@ pub fn fit(
         }
         monitor.progress("train", step, settings.total_steps);
         if step % every(settings.checkpoint_every) == 0 || last {
-            save(method, settings, dir, config_entry, &best, step, metrics)?;
+            save(method, settings, dir, config_entry, &best, step, last, metrics)?;
             last_checkpoint = step;
         }
+        if last {
+            steps_done = step;
+            break;
+        }
     }
-    Ok(FitOutcome {
-        steps: settings.total_steps,
-        best_step: best.step,
-        best_valid_loss: best.loss,
-        last_train_loss: last_loss,
-    })
+    Ok(FitOutcome { steps: steps_done, best_step: best.step, best_valid_loss: best.loss, last_train_loss: last_loss })
 }
 
 fn diverged(settings: &FitSettings, step: u64, what: &str, value: f64, checkpoint: u64) -> Error {
@@ -140,6 +152,7 @@ fn save(
     config_entry: &FileEntry,
     best: &Best,
     step: u64,
+    complete: bool,
     metrics: &JsonlMonitor,
 ) -> Result<()> {
     let mut files = BTreeMap::new();
@@ -159,7 +172,7 @@ fn save(
         env: settings.env.clone(),
         step,
         total_steps: settings.total_steps,
-        complete: step == settings.total_steps,
+        complete,
         best_step: best.step,
         best_valid_loss: best.loss,
         metrics_bytes,

@@ -1,0 +1,311 @@
+//! `mbrl eval seads`: what a trained SEADS checkpoint can do (thesis 7.4): which game move each skill executes
+//! from test-split boards (skill coverage, Table 7.3), how often boards of depth 1..D are solved by planning
+//! over the forward model and executing with the skills, with and without replanning (Fig. 7.9/7.10), how long
+//! skills take, and planning time.
+
+use std::path::Path;
+
+use rand::seq::IndexedRandom;
+use serde::Serialize;
+
+use crate::envs::boards::{BoardGame, GameSpec, LightsOut, Split, TileSwap};
+use crate::error::Result;
+use crate::eval::plot::{line_plot_in, Series};
+use crate::models::seads::boards::BoardPool;
+use crate::models::seads::collect::{Collector, Starts};
+use crate::models::seads::planner::{solve_with_skills, LoadedSeads};
+use crate::planning::bfs::SearchLimits;
+use crate::run::dir::{Provenance, RunDir};
+use crate::run::{Event, Monitor, NullMonitor, Tee};
+use crate::util::atomic::write_text;
+use crate::util::seeding::rng_for;
+use crate::util::table::write_csv;
+
+#[derive(Clone, Debug, Serialize)]
+pub struct SeadsEvalSettings {
+    pub max_depth: u8,
+    pub boards_per_depth: usize,
+    /// Boards each skill is executed from for the coverage table.
+    pub coverage_boards: usize,
+    pub max_replans: usize,
+    pub split: Split,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct SkillRow {
+    pub skill: usize,
+    /// The game move this skill performs most often, if it performs any.
+    pub mode_move: Option<usize>,
+    pub mode_share: f64,
+    /// Share of executions that changed nothing before the step limit.
+    pub no_move_share: f64,
+    pub mean_steps: f64,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct DepthRow {
+    pub depth: usize,
+    pub boards: usize,
+    pub solved_with_replanning: usize,
+    pub solved_without_replanning: usize,
+    pub mean_planning_seconds: f64,
+    pub mean_control_steps: f64,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct SeadsEvalSummary {
+    pub env: String,
+    pub skills: Vec<SkillRow>,
+    /// Distinct game moves among the skills' most frequent moves (Table 7.3's figure).
+    pub distinct_moves: usize,
+    pub moves: usize,
+    pub depths: Vec<DepthRow>,
+}
+
+fn coverage<G: BoardGame>(
+    game: &G,
+    loaded: &LoadedSeads,
+    boards: &[G::State],
+    seed: u64,
+    monitor: &dyn Monitor,
+) -> Vec<SkillRow> {
+    let k = loaded.run.config.skills;
+    let mut collector = Collector::new(game, loaded.env.embodiment, boards.len().clamp(1, 64), k);
+    let layout = collector.layout;
+    (0..k)
+        .map(|skill| {
+            let mut rng = rng_for(seed, &[10, skill as u64]);
+            let labels = vec![skill; boards.len()];
+            let episodes = collector.collect(&labels, Starts::Boards(boards), &mut rng, |inputs, rows, rng| {
+                loaded.policy.act(inputs, rows, true, rng)
+            });
+            let mut counts = vec![0usize; game.num_moves()];
+            let mut none = 0;
+            for e in &episodes {
+                match e.performed {
+                    Some(m) => counts[m] += 1,
+                    None => none += 1,
+                }
+            }
+            let best =
+                counts.iter().enumerate().max_by_key(|&(m, &c)| (c, std::cmp::Reverse(m))).filter(|(_, &c)| c > 0);
+            let n = episodes.len().max(1) as f64;
+            monitor.progress("skill coverage", skill as u64 + 1, k as u64);
+            SkillRow {
+                skill,
+                mode_move: best.map(|(m, _)| m),
+                mode_share: best.map_or(0.0, |(_, &c)| c as f64 / n),
+                no_move_share: none as f64 / n,
+                mean_steps: episodes.iter().map(|e| layout.steps(e) as f64).sum::<f64>() / n,
+            }
+        })
+        .collect()
+}
+
+fn success_rows<G: BoardGame>(
+    game: &G,
+    loaded: &LoadedSeads,
+    pool: &BoardPool<G>,
+    settings: &SeadsEvalSettings,
+    seed: u64,
+    monitor: &dyn Monitor,
+) -> Result<Vec<DepthRow>> {
+    let limits = SearchLimits::default();
+    let mut rows = Vec::new();
+    for depth in 1..=pool.max_depth() {
+        let mut rng = rng_for(seed, &[20, depth as u64]);
+        let boards: Vec<G::State> =
+            pool.layer(depth).choose_multiple(&mut rng, settings.boards_per_depth).copied().collect();
+        let mut row = DepthRow {
+            depth,
+            boards: boards.len(),
+            solved_with_replanning: 0,
+            solved_without_replanning: 0,
+            mean_planning_seconds: 0.0,
+            mean_control_steps: 0.0,
+        };
+        for (i, &board) in boards.iter().enumerate() {
+            for replans in [settings.max_replans, 0] {
+                let mut episode_rng = rng_for(seed, &[21, depth as u64, i as u64]);
+                let out =
+                    solve_with_skills(game, loaded, board, true, &limits, replans, &mut episode_rng, &NullMonitor)?;
+                if replans == 0 {
+                    row.solved_without_replanning += out.solved as usize;
+                } else {
+                    row.solved_with_replanning += out.solved as usize;
+                    row.mean_planning_seconds += out.planning_seconds;
+                    row.mean_control_steps += out.control_steps as f64;
+                }
+            }
+            monitor.progress(&format!("depth {depth} boards"), i as u64 + 1, boards.len() as u64);
+        }
+        let n = row.boards.max(1) as f64;
+        row.mean_planning_seconds /= n;
+        row.mean_control_steps /= n;
+        monitor.scalar("seads/success_rate", depth as u64, row.solved_with_replanning as f64 / n);
+        rows.push(row);
+    }
+    Ok(rows)
+}
+
+/// Runs the protocol on a loaded checkpoint and writes report.md, skills.csv, success.csv and success.png.
+pub fn seads_report(
+    loaded: &LoadedSeads,
+    settings: &SeadsEvalSettings,
+    provenance: &Provenance,
+    out_dir: &Path,
+    monitor: &dyn Monitor,
+) -> Result<SeadsEvalSummary> {
+    match loaded.env.game {
+        GameSpec::TileSwap => report_game(&TileSwap::new(), loaded, settings, provenance, out_dir, monitor),
+        GameSpec::LightsOut(n) => report_game(&LightsOut::new(n)?, loaded, settings, provenance, out_dir, monitor),
+    }
+}
+
+fn report_game<G: BoardGame>(
+    game: &G,
+    loaded: &LoadedSeads,
+    settings: &SeadsEvalSettings,
+    provenance: &Provenance,
+    out_dir: &Path,
+    monitor: &dyn Monitor,
+) -> Result<SeadsEvalSummary> {
+    let run = RunDir::create(out_dir)?;
+    run.write_config(&serde_json::json!({
+        "job": "eval seads", "env": loaded.env.name(), "settings": settings, "provenance": provenance,
+        "model": loaded.run,
+    }))?;
+    let metrics = run.metrics()?;
+    let monitor = Tee { first: monitor, second: &metrics };
+    let seed = provenance.seed;
+    let pool = BoardPool::new(game, settings.max_depth, settings.split)?;
+    // Coverage boards: an even mix of the evaluated depths.
+    let mut rng = rng_for(seed, &[30]);
+    let coverage_boards: Vec<G::State> = (0..settings.coverage_boards).map(|_| pool.sample(&mut rng)).collect();
+    let skills = coverage(game, loaded, &coverage_boards, seed, &monitor);
+    let mut modes: Vec<usize> = skills.iter().filter_map(|s| s.mode_move).collect();
+    modes.sort_unstable();
+    modes.dedup();
+    let depths = success_rows(game, loaded, &pool, settings, seed, &monitor)?;
+    let summary = SeadsEvalSummary {
+        env: loaded.env.name(),
+        distinct_moves: modes.len(),
+        moves: game.num_moves(),
+        skills,
+        depths,
+    };
+    write_files(game, &summary, settings, &run)?;
+    metrics.emit(&Event::Finished { ok: true });
+    Ok(summary)
+}
+
+fn write_files<G: BoardGame>(game: &G, s: &SeadsEvalSummary, settings: &SeadsEvalSettings, run: &RunDir) -> Result<()> {
+    let skill_rows: Vec<Vec<String>> = s
+        .skills
+        .iter()
+        .map(|r| {
+            vec![
+                r.skill.to_string(),
+                r.mode_move.map(|m| game.move_name(m)).unwrap_or_else(|| "none".into()),
+                format!("{:.4}", r.mode_share),
+                format!("{:.4}", r.no_move_share),
+                format!("{:.2}", r.mean_steps),
+            ]
+        })
+        .collect();
+    write_csv(
+        &run.file("skills.csv"),
+        &["skill", "most_frequent_move", "share", "no_move_share", "mean_steps"],
+        &skill_rows,
+    )?;
+    let depth_rows: Vec<Vec<String>> = s
+        .depths
+        .iter()
+        .map(|r| {
+            vec![
+                r.depth.to_string(),
+                r.boards.to_string(),
+                r.solved_with_replanning.to_string(),
+                r.solved_without_replanning.to_string(),
+                format!("{:.5}", r.mean_planning_seconds),
+                format!("{:.2}", r.mean_control_steps),
+            ]
+        })
+        .collect();
+    write_csv(
+        &run.file("success.csv"),
+        &[
+            "depth",
+            "boards",
+            "solved_with_replanning",
+            "solved_without_replanning",
+            "mean_planning_s",
+            "mean_control_steps",
+        ],
+        &depth_rows,
+    )?;
+    let rate = |f: fn(&DepthRow) -> usize| -> Vec<(f64, f64)> {
+        s.depths.iter().map(|r| (r.depth as f64, 100.0 * f(r) as f64 / r.boards.max(1) as f64)).collect()
+    };
+    line_plot_in(
+        &run.file("success.png"),
+        &format!("{}: boards solved by planning with learned skills", s.env),
+        "solution depth",
+        "solved (%)",
+        &[
+            Series {
+                name: format!("≤ {} replans", settings.max_replans), points: rate(|r| r.solved_with_replanning)
+            },
+            Series { name: "no replanning".into(), points: rate(|r| r.solved_without_replanning) },
+        ],
+        (0.0, 105.0),
+    )?;
+    let mut md = format!(
+        "# SEADS on {}\n\nSkill coverage (thesis Table 7.3): {} of {} game moves are the most frequent move of some skill, \
+         each skill executed with its deterministic policy from {} {}-split boards of depth 1-{}. \
+         Thesis (Cursor, 500k steps): 24.94 / 25 LightsOut, 11.99 / 12 TileSwap.\n\n\
+         | skill | most frequent move | share | no move | mean steps |\n|---|---|---|---|---|\n",
+        s.env,
+        s.distinct_moves,
+        s.moves,
+        settings.coverage_boards,
+        settings.split.as_str(),
+        settings.max_depth
+    );
+    for (r, cells) in s.skills.iter().zip(&skill_rows) {
+        md.push_str(&format!(
+            "| {} | {} | {:.1} % | {:.1} % | {:.1} |\n",
+            r.skill,
+            cells[1],
+            100.0 * r.mode_share,
+            100.0 * r.no_move_share,
+            r.mean_steps
+        ));
+    }
+    md.push_str(&format!(
+        "\n## Solving boards (thesis Fig. 7.9/7.10; Cursor: 100 %)\n\n{} boards per depth from the {} split; BFS over the \
+         forward model's most likely successors (bidirectional where the model proves self-inverse on every state it \
+         expands), each skill executed by the policy until the board changes or the step limit, a new plan when the \
+         board differs from the prediction.\n\n\
+         | depth | boards | solved (≤ {} replans) | solved (no replanning) | planning s / board | control steps / board |\n\
+         |---|---|---|---|---|---|\n",
+        settings.boards_per_depth,
+        settings.split.as_str(),
+        settings.max_replans
+    ));
+    for r in &s.depths {
+        let n = r.boards.max(1) as f64;
+        md.push_str(&format!(
+            "| {} | {} | {:.1} % | {:.1} % | {:.4} | {:.1} |\n",
+            r.depth,
+            r.boards,
+            100.0 * r.solved_with_replanning as f64 / n,
+            100.0 * r.solved_without_replanning as f64 / n,
+            r.mean_planning_seconds,
+            r.mean_control_steps
+        ));
+    }
+    md.push_str("\n![success](success.png)\n");
+    write_text(&run.file("report.md"), &md)?;
+    Ok(())
+}

@@ -1,0 +1,255 @@
+//! Solving boards with what SEADS learned (thesis Alg. 3 and 4): breadth-first search over the forward model's
+//! most likely successors, each planned skill executed by the skill policy in the embodiment, and a new plan
+//! whenever the board turns out differently from the model's prediction (up to a replanning budget).
+
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+use rand_chacha::ChaCha8Rng;
+
+use super::collect::policy_input;
+use super::forward_model::{FlipModel, FlipScratch};
+use super::trainer::MODEL_PREFIX;
+use super::{read_run, EmbodiedGame, SeadsRun, METHOD};
+use crate::envs::boards::BoardGame;
+use crate::envs::embodiments::embodied::EmbodiedBoard;
+use crate::envs::Env;
+use crate::error::{Error, Result};
+use crate::nn::ParamSet;
+use crate::planning::bfs::{bidirectional, breadth_first, SearchLimits, SearchResult, SuccessorModel};
+use crate::rl::sac::{Sac, SacConfig};
+use crate::run::{Event, Monitor};
+use crate::train::{OpenedCheckpoint, MODEL_FILE};
+
+/// A trained SEADS checkpoint: the skill policy and the forward model.
+pub struct LoadedSeads {
+    pub run: SeadsRun,
+    pub env: EmbodiedGame,
+    pub policy: Sac,
+    pub model: FlipModel,
+}
+
+pub fn load(dir: &Path) -> Result<LoadedSeads> {
+    let opened = OpenedCheckpoint::open(dir)?;
+    if opened.manifest.method != METHOD {
+        return Err(Error::bad_file(
+            dir,
+            format!(
+                "is a '{}' checkpoint; solving boards with skills needs a '{METHOD}' checkpoint",
+                opened.manifest.method
+            ),
+        ));
+    }
+    let run = read_run(&opened)?;
+    let env = EmbodiedGame::parse(&run.env)?;
+    let weights = opened.tensors(MODEL_FILE)?;
+    let (model_tensors, policy_tensors): (Vec<_>, Vec<_>) =
+        weights.into_iter().partition(|t| t.name.starts_with(MODEL_PREFIX));
+    let c = &run.config;
+    let (low, high) = action_bounds(env)?;
+    let sac_config = SacConfig {
+        obs_dim: run.policy_input,
+        action_dim: run.action_dim,
+        hidden: c.sac_hidden.clone(),
+        gamma: c.gamma,
+        tau: c.tau,
+        learning_rate: c.sac_learning_rate,
+        alpha: c.alpha,
+        batch_size: c.sac_batch,
+        ..SacConfig::new(run.policy_input, low, high)
+    };
+    let policy = Sac::from_weights(sac_config, &policy_tensors)
+        .map_err(|e| Error::bad_file(&dir.join(MODEL_FILE), e.to_string()))?;
+    let mut params = ParamSet::<f32>::default();
+    for t in model_tensors {
+        let values = match t.data {
+            crate::train::tensors::TensorData::F32(v) => v,
+            _ => return Err(Error::bad_file(&dir.join(MODEL_FILE), format!("'{}' is not f32", t.name))),
+        };
+        params.tensors.push(crate::nn::NamedTensor {
+            name: t.name.trim_start_matches(MODEL_PREFIX).to_string(),
+            shape: t.shape,
+            values,
+        });
+    }
+    let model = FlipModel::from_params(&params, run.board_bits, c.skills)
+        .map_err(|e| Error::bad_file(&dir.join(MODEL_FILE), e.to_string()))?;
+    Ok(LoadedSeads { run, env, policy, model })
+}
+
+fn action_bounds(env: EmbodiedGame) -> Result<(Vec<f64>, Vec<f64>)> {
+    let (manipulator, _) = env.embodiment.build();
+    Ok((manipulator.action_low(), manipulator.action_high()))
+}
+
+/// The learned forward model as a successor model: a skill leads to the most likely next board; a prediction
+/// that is no board of the game counts as "nothing changes". Bidirectional search assumes skills undo
+/// themselves; `check_inverse` verifies that on every state the search expands and records a violation.
+pub struct LearnedSuccessors<'a, G: BoardGame> {
+    pub game: &'a G,
+    pub model: &'a FlipModel,
+    pub check_inverse: bool,
+    violated: AtomicBool,
+}
+
+impl<'a, G: BoardGame> LearnedSuccessors<'a, G> {
+    pub fn new(game: &'a G, model: &'a FlipModel, check_inverse: bool) -> Self {
+        LearnedSuccessors { game, model, check_inverse, violated: AtomicBool::new(false) }
+    }
+
+    pub fn inverse_violated(&self) -> bool {
+        self.violated.load(Ordering::Relaxed)
+    }
+
+    fn successors(&self, states: &[G::State]) -> Vec<G::State> {
+        let bits: Vec<f32> = states.iter().flat_map(|&s| self.game.symbolic(s).into_iter().map(|b| b as f32)).collect();
+        let mut predicted = Vec::new();
+        self.model.mode_successors(&bits, &mut predicted, &mut FlipScratch::default());
+        let (k, n_bits) = (self.model.skills, self.model.bits);
+        predicted
+            .chunks(n_bits)
+            .enumerate()
+            .map(|(row, z)| {
+                let z: Vec<f64> = z.iter().map(|&b| b as f64).collect();
+                self.game.decode_symbolic(&z).unwrap_or(states[row / k])
+            })
+            .collect()
+    }
+
+    /// The model's prediction for one state and skill.
+    pub fn predict(&self, state: G::State, skill: usize) -> G::State {
+        self.successors(&[state])[skill]
+    }
+}
+
+impl<G: BoardGame> SuccessorModel for LearnedSuccessors<'_, G> {
+    type State = G::State;
+
+    fn num_actions(&self) -> usize {
+        self.model.skills
+    }
+
+    fn expand(&self, states: &[G::State], out: &mut Vec<G::State>) {
+        let next = self.successors(states);
+        if self.check_inverse {
+            let k = self.model.skills;
+            let back = self.successors(&next);
+            for (i, &s) in next.iter().enumerate() {
+                let skill = i % k;
+                if back[i * k + skill] != states[i / k] && s != states[i / k] {
+                    self.violated.store(true, Ordering::Relaxed);
+                }
+            }
+        }
+        out.extend(next);
+    }
+
+    fn self_inverse(&self) -> bool {
+        self.check_inverse
+    }
+}
+
+/// How a board was solved (or not) with skills.
+#[derive(Clone, Debug)]
+pub struct SkillSolve<S> {
+    /// Every plan made, the first and each replan.
+    pub plans: Vec<Vec<usize>>,
+    /// Skills executed and the game move each performed.
+    pub executed: Vec<(usize, Option<usize>)>,
+    pub final_board: S,
+    pub solved: bool,
+    pub control_steps: usize,
+    pub planning_seconds: f64,
+    /// Whether bidirectional search was used (the model was self-inverse on every state it met).
+    pub bidirectional: bool,
+}
+
+/// Plans with the learned model (bidirectional where verified, else one-sided) from `board`.
+pub fn plan_with_model<G: BoardGame>(
+    game: &G,
+    model: &FlipModel,
+    board: G::State,
+    bidirectional_allowed: bool,
+    limits: &SearchLimits,
+) -> Result<(SearchResult, bool)> {
+    if bidirectional_allowed {
+        let checked = LearnedSuccessors::new(game, model, true);
+        let result = bidirectional(&checked, board, game.goal(), limits, |_| {})?;
+        if !checked.inverse_violated() {
+            return Ok((result, true));
+        }
+    }
+    let one_sided = LearnedSuccessors::new(game, model, false);
+    Ok((breadth_first(&one_sided, board, |s| *s == game.goal(), limits, |_| {})?, false))
+}
+
+/// Algorithm 4: plan, execute skill by skill with the deterministic policy, replan when the board differs from
+/// the prediction, at most `max_replans` times.
+#[allow(clippy::too_many_arguments)]
+pub fn solve_with_skills<G: BoardGame>(
+    game: &G,
+    loaded: &LoadedSeads,
+    board: G::State,
+    bidirectional_allowed: bool,
+    limits: &SearchLimits,
+    max_replans: usize,
+    rng: &mut ChaCha8Rng,
+    monitor: &dyn Monitor,
+) -> Result<SkillSolve<G::State>> {
+    let (manipulator, _) = loaded.env.embodiment.build();
+    let mut env = EmbodiedBoard::new(game.clone(), manipulator, board);
+    env.reset(rng);
+    let k = loaded.run.config.skills;
+    let successors = LearnedSuccessors::new(game, &loaded.model, false);
+    let mut out = SkillSolve {
+        plans: Vec::new(),
+        executed: Vec::new(),
+        final_board: board,
+        solved: board == game.goal(),
+        control_steps: 0,
+        planning_seconds: 0.0,
+        bidirectional: false,
+    };
+    let mut input = Vec::new();
+    while !out.solved && out.plans.len() <= max_replans {
+        let started = Instant::now();
+        let (result, bi) = plan_with_model(game, &loaded.model, env.board(), bidirectional_allowed, limits)?;
+        out.planning_seconds += started.elapsed().as_secs_f64();
+        out.bidirectional |= bi;
+        let Some(plan) = result.plan else { break };
+        monitor.emit(&Event::text("plan", format!("plan {}: skills {:?}", out.plans.len() + 1, plan)));
+        out.plans.push(plan.clone());
+        for &skill in &plan {
+            let before = env.board();
+            let expected = successors.predict(before, skill);
+            env.set_board(before);
+            let mut performed = None;
+            loop {
+                if monitor.is_cancelled() {
+                    return Err(Error::Cancelled);
+                }
+                input.clear();
+                let obs: Vec<f32> = env.observe().iter().map(|&x| x as f32).collect();
+                policy_input(&obs, skill, k, &mut input);
+                let action: Vec<f64> = loaded.policy.act(&input, 1, true, rng).iter().map(|&a| a as f64).collect();
+                let step = env.step(&action);
+                out.control_steps += 1;
+                if env.board() != before {
+                    performed = (0..game.num_moves()).find(|&m| game.apply(before, m) == env.board());
+                }
+                if step.done {
+                    break;
+                }
+            }
+            out.executed.push((skill, performed));
+            monitor.emit(&Event::text("board", game.render(env.board())));
+            if env.board() != expected {
+                break;
+            }
+        }
+        out.solved = env.board() == game.goal();
+    }
+    out.final_board = env.board();
+    Ok(out)
+}

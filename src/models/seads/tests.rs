@@ -1,0 +1,67 @@
+use rand::SeedableRng;
+
+use super::collect::Starts;
+use super::*;
+use crate::envs::boards::TileSwap;
+use crate::train::TrainingMethod;
+
+fn tiny(skills: usize) -> SeadsConfig {
+    let mut c = SeadsConfig::preset(Preset::Small, skills, true);
+    c.episodes_per_epoch = 16;
+    c.sampled_episodes = 32;
+    c.episode_memory = 64;
+    c.model_hidden = 16;
+    c.sac_hidden = vec![16, 16];
+    c.sac_batch = 32;
+    c.sac_updates = 2;
+    c.env_steps = 2_000;
+    c
+}
+
+#[test]
+fn parses_embodied_games() {
+    let g = EmbodiedGame::parse("tileswap:cursor").unwrap();
+    assert_eq!((g.game, g.embodiment, g.moves()), (GameSpec::TileSwap, Embodiment::Cursor, 12));
+    assert_eq!(EmbodiedGame::parse("lightsout:reacher").unwrap().name(), "lightsout:reacher");
+    for bad in ["lightsout", "tileswap:arm", "lightsout:7x7:cursor", "chess:cursor"] {
+        assert!(EmbodiedGame::parse(bad).is_err(), "{bad}");
+    }
+}
+
+#[test]
+fn epochs_fill_the_memory_then_train_and_resume_bit_for_bit() {
+    let game = TileSwap::new();
+    let mut a = SeadsTrainer::new(tiny(12), game.clone(), Embodiment::Cursor, 4).unwrap();
+    for epoch in 1..=3 {
+        let loss = a.step(epoch).unwrap();
+        assert!(loss.is_finite() && loss > 0.0, "epoch {epoch}: {loss}");
+    }
+    // Updates began once 32 episodes were in memory.
+    assert!(a.last.critic_loss.is_some() && a.last.mean_final_reward.is_some());
+    let floor = reward::reward_floor(12);
+    assert!(a.last.mean_final_reward.unwrap() >= floor);
+    assert!(a.env_steps() > 0 && a.env_steps() <= 3 * 16 * 10);
+
+    let mut b = SeadsTrainer::new(tiny(12), game, Embodiment::Cursor, 4).unwrap();
+    b.restore(&a.state()).unwrap();
+    a.step(4).unwrap();
+    b.step(4).unwrap();
+    assert_eq!(a.state(), b.state(), "a restored trainer must continue exactly as the original");
+}
+
+#[test]
+fn deterministic_collection_from_given_boards() {
+    let game = TileSwap::new();
+    let mut t = SeadsTrainer::new(tiny(12), game.clone(), Embodiment::Cursor, 1).unwrap();
+    let boards = vec![game.goal(); 3];
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
+    let episodes = t.collect(&[0, 5, 11], Starts::Boards(&boards), true, &mut rng);
+    assert_eq!(episodes.len(), 3);
+    let layout = t.layout();
+    for e in &episodes {
+        let steps = layout.steps(e);
+        assert!((1..=10).contains(&steps));
+        assert_eq!(e.obs.len(), (steps + 1) * layout.obs_dim);
+        assert_eq!(layout.changed(e), e.performed.is_some());
+    }
+}
