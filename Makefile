@@ -4,7 +4,7 @@
 MBRL := target/release/mbrl
 SEED ?= 0
 
-.PHONY: build test bench completions repro-quick repro-swingup repro-pendulum-data repro-boards repro-ball repro-pets repro-pets-loop repro-context clean-reports
+.PHONY: build test bench completions repro-quick repro-swingup repro-pendulum-data repro-boards repro-ball repro-pets repro-pets-loop repro-context repro-seads clean-reports
 
 build:
 	cargo build --release
@@ -88,6 +88,17 @@ repro-context: build
 	$(MBRL) train --method context --data datasets/context/mountaincar.mcap --preset $(CONTEXT_PRESET) --seed $(SEED) --no-tui -q --out models/context/mountaincar
 	$(MBRL) eval context --model models/context/mountaincar --env mountaincar --transitions 50 --horizon 30 \
 		--contexts $(CONTEXT_CONTEXTS) $(CONTEXT_CEM) --seed $(SEED) --no-tui -q --out reports/context/mountaincar
+
+# Thesis chapter 7: SEADS skills and forward model on both Cursor games, then skill coverage and boards solved
+# per depth with and without replanning (Table 7.3, Fig. 7.9/7.10 analogues).
+SEADS_PRESET ?= paper
+repro-seads: build
+	for game in lightsout tileswap; do \
+		$(MBRL) train --method seads --env $$game:cursor --preset $(SEADS_PRESET) --seed $(SEED) --no-tui -q \
+			--out models/seads-$$game-cursor || exit 1; \
+		$(MBRL) eval seads --model models/seads-$$game-cursor --boards 20 --seed $(SEED) --no-tui -q \
+			--out reports/seads-$$game-cursor || exit 1; \
+	done
 
 # Thesis chapter 7 environments: depth/split tables, board sets, embodied play with scripted controllers.
 repro-boards: build

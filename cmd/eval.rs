@@ -136,6 +136,10 @@ struct SeadsArgs {
     /// Split the boards come from.
     #[arg(long, value_enum, default_value_t = SplitChoice::Test)]
     split: SplitChoice,
+    /// A search storing more states than this counts as a failure (a model lacking a move can make the goal
+    /// unreachable).
+    #[arg(long, default_value_t = 2_000_000)]
+    max_nodes: usize,
     /// Report directory (default: reports/seads-<checkpoint name>).
     #[arg(long)]
     out: Option<PathBuf>,
@@ -444,6 +448,7 @@ fn eval_seads(global: &GlobalArgs, provenance: &Provenance, a: SeadsArgs) -> any
         coverage_boards: a.coverage_boards,
         max_replans: a.max_replans,
         split: a.split.into(),
+        max_search_nodes: a.max_nodes,
     };
     let s = run_job(global, "eval seads", |monitor| seads_report(&loaded, &settings, provenance, &out, monitor))?;
     println!("{}: the skills' most frequent moves cover {} of {} game moves", s.env, s.distinct_moves, s.moves);

@@ -171,23 +171,6 @@ fn hdf5_input_without_the_feature_says_how_to_get_it() {
     assert_one_line_error(&out, &["release.hdf5", "--features hdf5", "libhdf5-dev"]);
 }
 
-/// Stops a training run after `stop_after` steps, as quitting the live view does.
-struct StopAfter(u64, std::sync::atomic::AtomicU64);
-
-impl mbrl::run::Monitor for StopAfter {
-    fn emit(&self, event: &mbrl::run::Event) {
-        if let mbrl::run::Event::Progress { phase, done, .. } = event {
-            if phase == "train" {
-                self.1.store(*done, std::sync::atomic::Ordering::Relaxed);
-            }
-        }
-    }
-
-    fn is_cancelled(&self) -> bool {
-        self.1.load(std::sync::atomic::Ordering::Relaxed) >= self.0
-    }
-}
-
 #[test]
 fn ball_training_resumes_to_the_same_bytes_and_stopped_runs_are_not_models() {
     use mbrl::models::ball::learn::job::{train_checkpointed, BallTrainRequest, CHECKPOINT_EVERY};
@@ -204,7 +187,7 @@ fn ball_training_resumes_to_the_same_bytes_and_stopped_runs_are_not_models() {
         provenance: mbrl::run::dir::Provenance::new("mbrl train …".into(), 3, 1),
     };
     train_checkpointed(&request("whole"), false, &mbrl::run::NullMonitor).unwrap();
-    let stop = StopAfter(CHECKPOINT_EVERY + 10, 0.into());
+    let stop = StopAfter::new(CHECKPOINT_EVERY + 10);
     assert!(matches!(train_checkpointed(&request("stopped"), false, &stop), Err(mbrl::Error::Cancelled)));
     let out = mbrl(dir.path()).args(["predict", "--model", "stopped", "--input", "t.mcap", "-q"]).output().unwrap();
     assert!(!out.status.success() && stderr_of(&out).contains("--resume"), "{}", stderr_of(&out));

@@ -8,7 +8,6 @@ use common::*;
 use mbrl::data::{read_dataset, write_dataset};
 use mbrl::models::pets::{self, PetsConfig, Preset};
 use mbrl::run::dir::Provenance;
-use mbrl::run::{Event, Monitor};
 
 /// A network small enough to train in a second; checkpoints every 20 steps.
 const TINY: &str = "hidden_layers = 2\nhidden_units = 16\nvalidate_every = 10\ncheckpoint_every = 20\n";
@@ -59,37 +58,6 @@ fn collect_train_plan_round_trip() {
     assert_eq!(read_dataset(&dir.path().join("plan.mcap")).unwrap().steps.len(), 10);
 }
 
-/// Stops the run after `stop_after` training steps, as quitting the live view does.
-struct StopAfter {
-    stop_after: u64,
-    seen: std::sync::atomic::AtomicU64,
-}
-
-impl Monitor for StopAfter {
-    fn emit(&self, event: &Event) {
-        if let Event::Progress { phase, done, .. } = event {
-            if phase == "train" {
-                self.seen.store(*done, std::sync::atomic::Ordering::Relaxed);
-            }
-        }
-    }
-
-    fn is_cancelled(&self) -> bool {
-        self.seen.load(std::sync::atomic::Ordering::Relaxed) >= self.stop_after
-    }
-}
-
-/// Every file of a run directory but the loss table and plot, which only the command line draws.
-fn dir_bytes(dir: &Path) -> Vec<(String, Vec<u8>)> {
-    let mut names: Vec<_> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().into_string().unwrap())
-        .filter(|n| n != "loss.png" && n != "losses.csv")
-        .collect();
-    names.sort();
-    names.into_iter().map(|n| (n.clone(), std::fs::read(dir.join(&n)).unwrap())).collect()
-}
-
 #[test]
 fn resume_ends_with_the_bytes_of_an_uninterrupted_run() {
     let dir = tempfile::tempdir().unwrap();
@@ -108,7 +76,7 @@ fn resume_ends_with_the_bytes_of_an_uninterrupted_run() {
     };
     pets::train(&request("whole"), false, &mbrl::run::NullMonitor).unwrap();
     // Stopped after step 50: the last checkpoint is step 40, so steps 41–50 are redone after resuming.
-    let stop = StopAfter { stop_after: 50, seen: 0.into() };
+    let stop = StopAfter::new(50);
     let err = pets::train(&request("stopped"), false, &stop).err().unwrap();
     assert!(matches!(err, mbrl::Error::Cancelled), "{err}");
     let manifest: serde_json::Value =

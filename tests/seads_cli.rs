@@ -9,7 +9,6 @@ use std::path::Path;
 use common::*;
 use mbrl::models::seads::{self, EmbodiedGame, Preset, SeadsConfig};
 use mbrl::run::dir::Provenance;
-use mbrl::run::{Event, Monitor};
 
 fn run_ok(dir: &Path, args: &[&str]) -> String {
     let out = mbrl(dir).args(args).arg("--no-tui").output().unwrap();
@@ -62,36 +61,6 @@ fn small_preset_learns_tileswap_moves_and_solves_test_boards() {
     assert!(solved.contains("solved: yes"), "{solved}");
 }
 
-/// Stops the run after `stop_after` epochs, as quitting the live view does.
-struct StopAfter {
-    stop_after: u64,
-    seen: std::sync::atomic::AtomicU64,
-}
-
-impl Monitor for StopAfter {
-    fn emit(&self, event: &Event) {
-        if let Event::Progress { phase, done, .. } = event {
-            if phase == "train" {
-                self.seen.store(*done, std::sync::atomic::Ordering::Relaxed);
-            }
-        }
-    }
-
-    fn is_cancelled(&self) -> bool {
-        self.seen.load(std::sync::atomic::Ordering::Relaxed) >= self.stop_after
-    }
-}
-
-fn dir_bytes(dir: &Path) -> Vec<(String, Vec<u8>)> {
-    let mut names: Vec<_> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().into_string().unwrap())
-        .filter(|n| n != "loss.png" && n != "losses.csv")
-        .collect();
-    names.sort();
-    names.into_iter().map(|n| (n.clone(), std::fs::read(dir.join(&n)).unwrap())).collect()
-}
-
 #[test]
 fn resume_ends_with_the_bytes_of_an_uninterrupted_run() {
     let dir = tempfile::tempdir().unwrap();
@@ -114,7 +83,7 @@ fn resume_ends_with_the_bytes_of_an_uninterrupted_run() {
     let whole = seads::train(&request("whole"), false, &mbrl::run::NullMonitor).unwrap();
     assert!(whole.outcome.steps > 7, "too few epochs to test resuming: {}", whole.outcome.steps);
     // Stopped after epoch 6: the last checkpoint is epoch 4, so epochs 5 and 6 are redone after resuming.
-    let stop = StopAfter { stop_after: 6, seen: 0.into() };
+    let stop = StopAfter::new(6);
     let err = seads::train(&request("stopped"), false, &stop).err().unwrap();
     assert!(matches!(err, mbrl::Error::Cancelled), "{err}");
     let out = mbrl(dir.path()).args(["train", "--resume", "stopped", "--no-tui"]).output().unwrap();

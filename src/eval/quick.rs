@@ -6,6 +6,7 @@ use std::path::Path;
 use super::ball::{self, BallEvalSettings};
 use super::boards::{self, EmbodiedSettings};
 use super::context::{self as context_eval, ContextEvalSettings};
+use super::seads::{seads_report, SeadsEvalSettings};
 use super::swingup::{self, SwingupSettings};
 use crate::data::collect::{collect_instance_pairs, collect_random, CollectSettings, InstancePairSettings};
 use crate::data::collect_ball::{collect_ball, BallCollectSettings};
@@ -24,6 +25,7 @@ use crate::models::context;
 use crate::models::context::calibration::{CalibrationSettings, Strategy};
 use crate::models::context::{ContextConfig, EnvFamily, Preset as ContextPreset};
 use crate::models::pets::{self, PetsConfig, Preset, Propagation};
+use crate::models::seads;
 use crate::run::dir::Provenance;
 use crate::run::Monitor;
 use crate::util::atomic::write_text;
@@ -48,6 +50,10 @@ pub const QUICK_PETS_PARTICLES: usize = 5;
 pub const QUICK_CONTEXT_INSTANCES: usize = 1000;
 pub const QUICK_CONTEXT_CONTEXTS: usize = 30;
 pub const QUICK_CONTEXT_CANDIDATES: usize = 200;
+
+/// The SEADS slice: tileswap:cursor with the small preset, then coverage and boards of depth 1-3.
+pub const QUICK_SEADS_BOARDS: usize = 10;
+pub const QUICK_SEADS_DEPTH: u8 = 3;
 
 pub struct QuickSummary {
     pub lines: Vec<String>,
@@ -90,6 +96,7 @@ pub fn run_quick(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor)
     for squash in [Squash::Inner, Squash::Outer] {
         lines.push(context_slice(squash, provenance, out_dir, monitor)?);
     }
+    lines.push(seads_slice(provenance, out_dir, monitor)?);
     let mut md = String::from("# mbrl quick reproduction\n\nSmall-scale runs of each implemented method.\n\n");
     for line in &lines {
         md.push_str(&format!("- {line}\n"));
@@ -257,5 +264,36 @@ fn context_slice(squash: Squash, provenance: &Provenance, out_dir: &Path, monito
         summary.mean_mse[0],
         summary.mean_mse[1],
         name.replace(':', "-"),
+    ))
+}
+
+/// SEADS on tileswap:cursor: skills and forward model learned without reward (small preset), then the skills'
+/// coverage of the 12 moves and test boards of depth 1-3 solved by planning over the learned model.
+fn seads_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) -> Result<String> {
+    let env = seads::EmbodiedGame::parse("tileswap:cursor")?;
+    let dir = out_dir.join("seads-tileswap-cursor");
+    let request = seads::TrainRequest {
+        out: dir.join("model"),
+        env,
+        config: seads::SeadsConfig::preset(seads::Preset::Small, env.moves(), true),
+        seed: provenance.seed,
+        provenance: provenance.clone(),
+    };
+    let report = seads::train(&request, false, monitor)?;
+    let loaded = seads::planner::load(&request.out)?;
+    let settings = SeadsEvalSettings {
+        max_depth: QUICK_SEADS_DEPTH,
+        boards_per_depth: QUICK_SEADS_BOARDS,
+        coverage_boards: 40,
+        max_replans: 10,
+        split: Split::Test,
+        max_search_nodes: 2_000_000,
+    };
+    let summary = seads_report(&loaded, &settings, provenance, &dir.join("eval"), monitor)?;
+    let (boards, solved) = summary.depths.iter().fold((0, 0), |(b, s), r| (b + r.boards, s + r.solved_with_replanning));
+    Ok(format!(
+        "SEADS, tileswap:cursor (small preset, {} env steps, no game reward): the skills cover {}/{} moves; {solved}/{boards} \
+         test boards of depth 1-{} solved by planning over the learned forward model; see seads-tileswap-cursor/eval/report.md",
+        report.env_steps, summary.distinct_moves, summary.moves, QUICK_SEADS_DEPTH
     ))
 }

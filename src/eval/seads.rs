@@ -9,7 +9,7 @@ use rand::seq::IndexedRandom;
 use serde::Serialize;
 
 use crate::envs::boards::{BoardGame, GameSpec, LightsOut, Split, TileSwap};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::eval::plot::{line_plot_in, Series};
 use crate::models::seads::boards::BoardPool;
 use crate::models::seads::collect::{Collector, Starts};
@@ -29,6 +29,9 @@ pub struct SeadsEvalSettings {
     pub coverage_boards: usize,
     pub max_replans: usize,
     pub split: Split,
+    /// Stored search states after which a board counts as unsolved: a model that lacks a move can leave the
+    /// goal unreachable, and the search would then walk the whole reachable space (2²³ LightsOut boards).
+    pub max_search_nodes: usize,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -50,6 +53,8 @@ pub struct DepthRow {
     pub solved_without_replanning: usize,
     pub mean_planning_seconds: f64,
     pub mean_control_steps: f64,
+    /// Searches (with and without replanning) that hit the node budget; their boards count as unsolved.
+    pub search_budget_exhausted: usize,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -110,7 +115,7 @@ fn success_rows<G: BoardGame>(
     seed: u64,
     monitor: &dyn Monitor,
 ) -> Result<Vec<DepthRow>> {
-    let limits = SearchLimits::default();
+    let limits = SearchLimits { max_nodes: settings.max_search_nodes, ..SearchLimits::default() };
     let mut rows = Vec::new();
     for depth in 1..=pool.max_depth() {
         let mut rng = rng_for(seed, &[20, depth as u64]);
@@ -123,12 +128,28 @@ fn success_rows<G: BoardGame>(
             solved_without_replanning: 0,
             mean_planning_seconds: 0.0,
             mean_control_steps: 0.0,
+            search_budget_exhausted: 0,
         };
         for (i, &board) in boards.iter().enumerate() {
             for replans in [settings.max_replans, 0] {
                 let mut episode_rng = rng_for(seed, &[21, depth as u64, i as u64]);
-                let out =
-                    solve_with_skills(game, loaded, board, true, &limits, replans, &mut episode_rng, &NullMonitor)?;
+                let out = match solve_with_skills(
+                    game,
+                    loaded,
+                    board,
+                    true,
+                    &limits,
+                    replans,
+                    &mut episode_rng,
+                    &NullMonitor,
+                ) {
+                    Ok(out) => out,
+                    Err(Error::Budget(_)) => {
+                        row.search_budget_exhausted += 1;
+                        continue;
+                    }
+                    Err(e) => return Err(e),
+                };
                 if replans == 0 {
                     row.solved_without_replanning += out.solved as usize;
                 } else {
@@ -229,6 +250,7 @@ fn write_files<G: BoardGame>(game: &G, s: &SeadsEvalSummary, settings: &SeadsEva
                 r.solved_without_replanning.to_string(),
                 format!("{:.5}", r.mean_planning_seconds),
                 format!("{:.2}", r.mean_control_steps),
+                r.search_budget_exhausted.to_string(),
             ]
         })
         .collect();
@@ -241,6 +263,7 @@ fn write_files<G: BoardGame>(game: &G, s: &SeadsEvalSummary, settings: &SeadsEva
             "solved_without_replanning",
             "mean_planning_s",
             "mean_control_steps",
+            "searches_over_budget",
         ],
         &depth_rows,
     )?;
@@ -286,23 +309,25 @@ fn write_files<G: BoardGame>(game: &G, s: &SeadsEvalSummary, settings: &SeadsEva
         "\n## Solving boards (thesis Fig. 7.9/7.10; Cursor: 100 %)\n\n{} boards per depth from the {} split; BFS over the \
          forward model's most likely successors (bidirectional where the model proves self-inverse on every state it \
          expands), each skill executed by the policy until the board changes or the step limit, a new plan when the \
-         board differs from the prediction.\n\n\
-         | depth | boards | solved (≤ {} replans) | solved (no replanning) | planning s / board | control steps / board |\n\
-         |---|---|---|---|---|---|\n",
+         board differs from the prediction. A search that stores more than {} states counts as a failure.\n\n\
+         | depth | boards | solved (≤ {} replans) | solved (no replanning) | planning s / board | control steps / board | searches over budget |\n\
+         |---|---|---|---|---|---|---|\n",
         settings.boards_per_depth,
         settings.split.as_str(),
+        settings.max_search_nodes,
         settings.max_replans
     ));
     for r in &s.depths {
         let n = r.boards.max(1) as f64;
         md.push_str(&format!(
-            "| {} | {} | {:.1} % | {:.1} % | {:.4} | {:.1} |\n",
+            "| {} | {} | {:.1} % | {:.1} % | {:.4} | {:.1} | {} |\n",
             r.depth,
             r.boards,
             100.0 * r.solved_with_replanning as f64 / n,
             100.0 * r.solved_without_replanning as f64 / n,
             r.mean_planning_seconds,
-            r.mean_control_steps
+            r.mean_control_steps,
+            r.search_budget_exhausted
         ));
     }
     md.push_str("\n![success](success.png)\n");

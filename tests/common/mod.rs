@@ -48,3 +48,43 @@ pub fn assert_one_line_error(output: &std::process::Output, needles: &[&str]) {
         assert!(lines[0].contains(needle), "error should mention '{needle}': {err}");
     }
 }
+
+/// Stops a training run after `stop_after` steps, as quitting the live view does.
+#[allow(dead_code)]
+pub struct StopAfter {
+    stop_after: u64,
+    seen: std::sync::atomic::AtomicU64,
+}
+
+#[allow(dead_code)]
+impl StopAfter {
+    pub fn new(stop_after: u64) -> Self {
+        StopAfter { stop_after, seen: 0.into() }
+    }
+}
+
+impl mbrl::run::Monitor for StopAfter {
+    fn emit(&self, event: &mbrl::run::Event) {
+        if let mbrl::run::Event::Progress { phase, done, .. } = event {
+            if phase == "train" {
+                self.seen.store(*done, std::sync::atomic::Ordering::Relaxed);
+            }
+        }
+    }
+
+    fn is_cancelled(&self) -> bool {
+        self.seen.load(std::sync::atomic::Ordering::Relaxed) >= self.stop_after
+    }
+}
+
+/// Every file of a run directory but the loss table and plot, which only the command line draws.
+#[allow(dead_code)]
+pub fn dir_bytes(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut names: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .filter(|n| n != "loss.png" && n != "losses.csv")
+        .collect();
+    names.sort();
+    names.into_iter().map(|n| (n.clone(), std::fs::read(dir.join(&n)).unwrap())).collect()
+}

@@ -200,6 +200,38 @@ impl FlipModel {
         }
     }
 
+    /// The most likely successor of board i under skill `skills[i]` only: n × bits → n × bits. What verifying
+    /// that a skill undoes itself needs, at 1/K of [`Self::mode_successors`]' cost.
+    pub fn mode_successors_of_pairs(
+        &self,
+        boards: &[f32],
+        skills: &[usize],
+        out: &mut Vec<f32>,
+        scratch: &mut FlipScratch,
+    ) {
+        let (bits, h) = (self.bits, self.hidden);
+        let n = skills.len();
+        scratch.board_part.clear();
+        scratch.board_part.resize(n * h, 0.0);
+        faer::linalg::matmul::matmul(
+            MatMut::from_row_major_slice_mut(&mut scratch.board_part, n, h),
+            Accum::Replace,
+            MatRef::from_row_major_slice(boards, n, bits),
+            MatRef::from_row_major_slice(&self.board_weight, bits, h),
+            1.0f32,
+            Par::Seq,
+        );
+        scratch.hidden.clear();
+        scratch.hidden.reserve(n * h);
+        for (row, &skill) in scratch.board_part.chunks(h).zip(skills) {
+            let column = &self.skill_weight[skill * h..(skill + 1) * h];
+            scratch.hidden.extend(row.iter().zip(column).zip(&self.first_bias).map(|((a, b), c)| (a + b + c).max(0.0)));
+        }
+        self.rest.forward(&scratch.hidden, n, &mut scratch.logits, &mut scratch.stack);
+        out.clear();
+        out.extend(scratch.logits.iter().zip(boards).map(|(&l, &z)| if l > 0.0 { 1.0 - z } else { z }));
+    }
+
     pub fn flops_per_board(&self) -> usize {
         2 * self.bits * self.hidden + self.skills * self.rest.flops_per_row()
     }
@@ -208,4 +240,43 @@ impl FlipModel {
 /// log σ(s) = −softplus(−s), without overflow for large |s|.
 pub fn log_sigmoid(s: f64) -> f64 {
     -((-s).max(0.0) + (-s.abs()).exp().ln_1p())
+}
+
+/// A forward model of the paper's shape whose weights encode LightsOut's rules exactly (a push flips the same
+/// bits whatever the board): skill k switches on hidden unit k, which drives the logits of the fields move k
+/// toggles to +15 and leaves the rest at −15. Benchmarks time searches through it, since a perfectly trained
+/// model costs the same per query and meets every reachable board; tests use it as a model known to be right.
+pub fn lightsout_rules_model(game: &crate::envs::boards::LightsOut, hidden: usize) -> Result<FlipModel> {
+    use crate::envs::boards::BoardGame;
+    let (bits, k) = (game.fields(), game.num_moves());
+    if hidden < k {
+        return Err(Error::config(format!("the rules model needs at least {k} hidden units, got {hidden}")));
+    }
+    let goal = game.symbolic(game.goal());
+    let mut first = vec![0.0f32; hidden * (bits + k)];
+    let mut second = vec![0.0f32; hidden * hidden];
+    let mut out = vec![0.0f32; bits * hidden];
+    for skill in 0..k {
+        first[skill * (bits + k) + bits + skill] = 1.0;
+        second[skill * hidden + skill] = 1.0;
+        let flipped = game.symbolic(game.apply(game.goal(), skill));
+        for bit in 0..bits {
+            if flipped[bit] != goal[bit] {
+                out[bit * hidden + skill] = 2.0 * LOGIT_BOUND;
+            }
+        }
+    }
+    let tensor =
+        |name: &str, shape: Vec<usize>, values: Vec<f32>| crate::nn::NamedTensor { name: name.into(), shape, values };
+    let params = ParamSet {
+        tensors: vec![
+            tensor("_flip_prob_mlp.0.weight", vec![hidden, bits + k], first),
+            tensor("_flip_prob_mlp.0.bias", vec![hidden], vec![0.0; hidden]),
+            tensor("_flip_prob_mlp.2.weight", vec![hidden, hidden], second),
+            tensor("_flip_prob_mlp.2.bias", vec![hidden], vec![0.0; hidden]),
+            tensor("_flip_prob_mlp.4.weight", vec![bits, hidden], out),
+            tensor("_flip_prob_mlp.4.bias", vec![bits], vec![-LOGIT_BOUND; bits]),
+        ],
+    };
+    FlipModel::from_params(&params, bits, k)
 }

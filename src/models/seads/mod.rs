@@ -21,6 +21,7 @@ pub use trainer::{EpochStats, SeadsTrainer};
 use crate::envs::boards::spec::GAME_HELP;
 use crate::envs::boards::{BoardGame, GameSpec, LightsOut, TileSwap};
 use crate::envs::embodiments::{Embodiment, EMBODIMENT_HELP};
+use crate::envs::EnvName;
 use crate::error::{Error, Result};
 use crate::run::dir::Provenance;
 use crate::run::{Monitor, PanelSpec};
@@ -37,11 +38,12 @@ pub struct EmbodiedGame {
 }
 
 impl EmbodiedGame {
+    /// The registry's embodied env names, restricted to the games SEADS plays.
     pub fn parse(name: &str) -> Result<Self> {
         let bad = || Error::config(format!("'{name}' is not an embodied board game; supported: {ENV_HELP}"));
-        let (game, embodiment) = name.rsplit_once(':').ok_or_else(bad)?;
-        let embodiment = Embodiment::parse(embodiment).map_err(|_| bad())?;
-        let game = GameSpec::parse(game).map_err(|_| bad())?;
+        let Ok(EnvName::Embodied(game, embodiment)) = crate::envs::parse_env(name) else {
+            return Err(bad());
+        };
         if game != GameSpec::LightsOut(5) && game != GameSpec::TileSwap {
             return Err(Error::config(format!(
                 "SEADS plays lightsout (5x5) and tileswap; '{}' is not supported (games: {GAME_HELP}; embodiments: {EMBODIMENT_HELP})",
@@ -52,7 +54,7 @@ impl EmbodiedGame {
     }
 
     pub fn name(&self) -> String {
-        format!("{}:{}", self.game.name(), if self.embodiment == Embodiment::Cursor { "cursor" } else { "reacher" })
+        format!("{}:{}", self.game.name(), self.embodiment.name())
     }
 
     pub fn moves(&self) -> usize {
