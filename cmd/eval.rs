@@ -11,7 +11,7 @@ use mbrl::eval::ball::{self, BallEvalSettings};
 use mbrl::eval::boards::{self, EmbodiedSettings};
 use mbrl::eval::dataset_report;
 use mbrl::eval::quick::run_quick;
-use mbrl::eval::seads::{seads_report, SeadsEvalSettings};
+use mbrl::eval::seads::{compare_runs, seads_report, variant_label, ComparedRun, SeadsEvalSettings};
 use mbrl::eval::swingup::{self, SwingupSettings};
 use mbrl::models::ball::checkpoint::load_ball_model;
 use mbrl::run::dir::Provenance;
@@ -118,9 +118,10 @@ struct EmbodiedArgs {
 
 #[derive(Args, Debug)]
 struct SeadsArgs {
-    /// A SEADS checkpoint directory (`mbrl train --method seads`).
-    #[arg(long)]
-    model: PathBuf,
+    /// A SEADS checkpoint directory (`mbrl train --method seads`); repeat it to compare runs (seeds of the full
+    /// method and of ablations: one-sided Mann-Whitney U tests of each ablation against `full`).
+    #[arg(long, required = true)]
+    model: Vec<PathBuf>,
     /// Boards of depth 1..=max-depth are solved.
     #[arg(long, default_value_t = 5)]
     max_depth: u8,
@@ -438,10 +439,20 @@ fn eval_seads(global: &GlobalArgs, provenance: &Provenance, a: SeadsArgs) -> any
     if a.max_depth == 0 || a.max_depth > 10 || a.boards == 0 || a.coverage_boards == 0 {
         bail!("--max-depth must be 1..=10 and --boards, --coverage-boards at least 1");
     }
-    let loaded = mbrl::models::seads::planner::load(&a.model)?;
+    let name_of = |dir: &std::path::Path| dir.file_name().and_then(|n| n.to_str()).unwrap_or("model").to_string();
     let out = a.out.clone().unwrap_or_else(|| {
-        PathBuf::from(format!("reports/seads-{}", a.model.file_name().and_then(|n| n.to_str()).unwrap_or("model")))
+        PathBuf::from(if a.model.len() == 1 {
+            format!("reports/seads-{}", name_of(&a.model[0]))
+        } else {
+            "reports/seads-compare".into()
+        })
     });
+    let mut names: Vec<String> = a.model.iter().map(|m| name_of(m)).collect();
+    names.sort();
+    if a.model.len() > 1 && names.windows(2).any(|w| w[0] == w[1]) {
+        bail!("--model directories to compare need distinct names (each gets a report subdirectory of that name)");
+    }
+    let loaded: Vec<_> = a.model.iter().map(|m| mbrl::models::seads::planner::load(m)).collect::<Result<_, _>>()?;
     let settings = SeadsEvalSettings {
         max_depth: a.max_depth,
         boards_per_depth: a.boards,
@@ -450,18 +461,47 @@ fn eval_seads(global: &GlobalArgs, provenance: &Provenance, a: SeadsArgs) -> any
         split: a.split.into(),
         max_search_nodes: a.max_nodes,
     };
-    let s = run_job(global, "eval seads", |monitor| seads_report(&loaded, &settings, provenance, &out, monitor))?;
-    println!("{}: the skills' most frequent moves cover {} of {} game moves", s.env, s.distinct_moves, s.moves);
-    for r in &s.depths {
-        let n = r.boards.max(1) as f64;
+    let mut runs = Vec::new();
+    for (dir, model) in a.model.iter().zip(&loaded) {
+        let report_dir = if a.model.len() == 1 { out.clone() } else { out.join(name_of(dir)) };
+        let s =
+            run_job(global, "eval seads", |monitor| seads_report(model, &settings, provenance, &report_dir, monitor))?;
         println!(
-            "depth {}: {:.1} % solved with ≤ {} replans, {:.1} % without; planning {:.4} s per board",
-            r.depth,
-            100.0 * r.solved_with_replanning as f64 / n,
-            a.max_replans,
-            100.0 * r.solved_without_replanning as f64 / n,
-            r.mean_planning_seconds
+            "{} ({}): the skills' most frequent moves cover {} of {} game moves",
+            name_of(dir),
+            s.env,
+            s.distinct_moves,
+            s.moves
         );
+        for r in &s.depths {
+            let n = r.boards.max(1) as f64;
+            println!(
+                "  depth {}: {:.1} % solved with ≤ {} replans, {:.1} % without; planning {:.4} s per board",
+                r.depth,
+                100.0 * r.solved_with_replanning as f64 / n,
+                a.max_replans,
+                100.0 * r.solved_without_replanning as f64 / n,
+                r.mean_planning_seconds
+            );
+        }
+        runs.push(ComparedRun {
+            name: name_of(dir),
+            variant: variant_label(&model.run.config),
+            seed: model.run.seed,
+            summary: s,
+        });
+    }
+    if runs.len() > 1 {
+        let envs: Vec<&str> = runs.iter().map(|r| r.summary.env.as_str()).collect();
+        if envs.iter().any(|e| *e != envs[0]) {
+            bail!("runs to compare must share one env, got {}", envs.join(", "));
+        }
+        for t in compare_runs(&runs, &out)? {
+            println!(
+                "{} > {} on {}: Mann-Whitney U = {}, one-sided p = {:.3e}",
+                t.better, t.worse, t.metric, t.u, t.p_value
+            );
+        }
     }
     println!("report: {}", out.join("report.md").display());
     Ok(())

@@ -130,3 +130,52 @@ fn bad_input_is_one_line() {
     let err = run_err(d, &["plan", "--env", "pendulum", "--model", "s"]);
     assert!(err.trim().lines().count() == 1, "{err}");
 }
+
+#[test]
+fn ablation_runs_are_compared_with_mann_whitney() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(
+        d.join("tiny.toml"),
+        "episodes_per_epoch = 4\nsampled_episodes = 8\nepisode_memory = 8\nmodel_hidden = 8\nsac_hidden = [8]\nsac_batch = 8\n",
+    )
+    .unwrap();
+    let mut models = Vec::new();
+    for (name, seed, extra) in [
+        ("full-1", "1", None),
+        ("full-2", "2", None),
+        ("nonov-1", "1", Some("--no-novelty")),
+        ("nonov-2", "2", Some("--no-novelty")),
+    ] {
+        let mut args = vec![
+            "--seed",
+            seed,
+            "train",
+            "--method",
+            "seads",
+            "--env",
+            "tileswap:cursor",
+            "--config",
+            "tiny.toml",
+            "--env-steps",
+            "150",
+            "--out",
+            name,
+        ];
+        args.extend(extra);
+        run_ok(d, &args);
+        models.extend(["--model", name]);
+    }
+    let mut args = vec!["eval", "seads", "--max-depth", "1", "--boards", "2", "--coverage-boards", "2", "--out", "cmp"];
+    args.extend(models);
+    let out = run_ok(d, &args);
+    assert!(out.contains("full > no-novelty on success_rate"), "{out}");
+    let tests = std::fs::read_to_string(d.join("cmp/tests.csv")).unwrap();
+    assert_eq!(tests.lines().count(), 3, "{tests}");
+    assert!(tests.lines().nth(1).unwrap().starts_with("full,no-novelty,success_rate,"), "{tests}");
+    for name in ["full-1", "nonov-2"] {
+        assert!(d.join("cmp").join(name).join("report.md").exists());
+    }
+    let runs = std::fs::read_to_string(d.join("cmp/runs.csv")).unwrap();
+    assert!(runs.contains("nonov-1,no-novelty,1,"), "{runs}");
+}
