@@ -863,7 +863,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__seads)
-            opts="-q -h -V --model --max-depth --boards --coverage-boards --max-replans --split --out --seed --threads --tui --no-tui --quiet --help --version"
+            opts="-q -h -V --model --max-depth --boards --coverage-boards --max-replans --split --max-nodes --out --seed --threads --tui --no-tui --quiet --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -891,6 +891,10 @@ _mbrl() {
                     ;;
                 --split)
                     COMPREPLY=($(compgen -W "train test" -- "${cur}"))
+                    return 0
+                    ;;
+                --max-nodes)
+                    COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
                 --out)
