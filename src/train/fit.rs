@@ -39,6 +39,10 @@ pub trait TrainingMethod {
     fn step_scalars(&self) -> Vec<(&'static str, f64)> {
         Vec::new()
     }
+    /// Text panels of the step just taken (SEADS: a board before and after a skill).
+    fn step_texts(&self) -> Vec<(&'static str, String)> {
+        Vec::new()
+    }
 }
 
 #[derive(Clone, Debug)]
@@ -107,6 +111,9 @@ pub fn fit(
         monitor.scalar("train/loss", step, loss);
         for (name, value) in method.step_scalars() {
             monitor.scalar(name, step, value);
+        }
+        for (name, text) in method.step_texts() {
+            monitor.emit(&crate::run::Event::text(name, text));
         }
         let last = step == settings.total_steps || method.budget_spent();
         if step % every(settings.validate_every) == 0 || last {

@@ -45,6 +45,16 @@ pub fn rewards_for_all_skills(log_likelihoods: &[f64], terms: RewardTerms) -> Ve
     rewards
 }
 
+/// The reward on an episode's final transition under `label`: the floor for every label when the board did not
+/// change (nothing was done, so no skill can be credited), otherwise [`rewards_for_all_skills`] at the label.
+pub fn episode_reward(changed: bool, log_likelihoods: &[f64], label: usize, terms: RewardTerms) -> f64 {
+    if changed {
+        rewards_for_all_skills(log_likelihoods, terms)[label]
+    } else {
+        reward_floor(log_likelihoods.len())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -68,6 +78,19 @@ mod tests {
                 for r in rewards_for_all_skills(&lls, terms) {
                     assert!(r >= reward_floor(k) - 1e-12, "{r} < {} for {lls:?}", reward_floor(k));
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn episodes_that_change_nothing_earn_exactly_the_floor() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        for _ in 0..200 {
+            let k = rng.random_range(2..30);
+            let lls: Vec<f64> = (0..k).map(|_| -rng.random_range(0.0..50.0)).collect();
+            for label in 0..k {
+                assert_eq!(episode_reward(false, &lls, label, ALL), reward_floor(k));
+                assert!(episode_reward(true, &lls, label, ALL) >= reward_floor(k) - 1e-12);
             }
         }
     }

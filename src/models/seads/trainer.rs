@@ -13,7 +13,7 @@ use super::config::SeadsConfig;
 use super::forward_model::{model_inputs, torch_name, FlipModel, FlipNet, FlipScratch};
 use super::memory::{Episode, EpisodeMemory, ObsLayout};
 use super::relabel::relabel_by_assignment;
-use super::reward::{clipped_posterior, reward_floor, rewards_for_all_skills};
+use super::reward::{clipped_posterior, episode_reward};
 use crate::envs::boards::{BoardGame, Split};
 use crate::envs::embodiments::Embodiment;
 use crate::error::{Error, Result};
@@ -45,6 +45,8 @@ pub struct EpochStats {
     pub actor_loss: Option<f64>,
     /// Distinct game moves the skills execute: for each skill, the move its recent episodes performed most often.
     pub distinct_moves: usize,
+    /// One of the epoch's new episodes as text: its skill, the move it made, the board before and after.
+    pub board: String,
 }
 
 pub struct SeadsTrainer<G: BoardGame> {
@@ -217,20 +219,12 @@ impl<G: BoardGame> SeadsTrainer<G> {
     ) -> Result<(f64, f64, f64)> {
         let layout = self.collector.layout;
         let k = self.config.skills;
-        let floor = reward_floor(k);
         // (episode, step) of every transition, and the final rewards.
-        let finals: Vec<f64> =
-            judged
-                .iter()
-                .zip(labels)
-                .map(|(j, &label)| {
-                    if j.changed {
-                        rewards_for_all_skills(&j.log_likelihoods, self.config.reward)[label]
-                    } else {
-                        floor
-                    }
-                })
-                .collect();
+        let finals: Vec<f64> = judged
+            .iter()
+            .zip(labels)
+            .map(|(j, &label)| episode_reward(j.changed, &j.log_likelihoods, label, self.config.reward))
+            .collect();
         let index: Vec<(usize, usize)> =
             episodes.iter().enumerate().flat_map(|(e, ep)| (0..layout.steps(ep)).map(move |t| (e, t))).collect();
         let (mut critic, mut actor) = (0.0, 0.0);
@@ -303,6 +297,22 @@ impl<G: BoardGame> SeadsTrainer<G> {
     pub fn budget_spent(&self) -> bool {
         self.env_steps >= self.config.env_steps
     }
+
+    fn describe(&self, episode: &Episode) -> String {
+        let layout = self.collector.layout;
+        let render = |bits: &[f32]| {
+            let bits: Vec<f64> = bits.iter().map(|&b| b as f64).collect();
+            self.game.decode_symbolic(&bits).map(|b| self.game.render(b)).unwrap_or_default()
+        };
+        format!(
+            "skill {} → {} in {} steps\nbefore:\n{}\nafter:\n{}",
+            episode.label,
+            episode.performed.map(|m| self.game.move_name(m)).unwrap_or_else(|| "no move".into()),
+            layout.steps(episode),
+            render(layout.first_board(episode)),
+            render(layout.last_board(episode))
+        )
+    }
 }
 
 fn action_bounds<G: BoardGame>(collector: &Collector<G>) -> (Vec<f64>, Vec<f64>) {
@@ -357,6 +367,7 @@ impl<G: BoardGame> TrainingMethod for SeadsTrainer<G> {
             sac.act(inputs, rows, false, rng)
         });
         let loss = self.held_out_model_loss(&new);
+        stats.board = new.first().map(|e| self.describe(e)).unwrap_or_default();
         let layout = self.collector.layout;
         self.env_steps += new.iter().map(|e| layout.steps(e) as u64).sum::<u64>();
         for episode in new {
@@ -427,6 +438,10 @@ impl<G: BoardGame> TrainingMethod for SeadsTrainer<G> {
 
     fn budget_spent(&self) -> bool {
         SeadsTrainer::budget_spent(self)
+    }
+
+    fn step_texts(&self) -> Vec<(&'static str, String)> {
+        vec![("board", self.last.board.clone())]
     }
 
     fn step_scalars(&self) -> Vec<(&'static str, f64)> {
