@@ -127,6 +127,13 @@ fn bad_input_is_one_line() {
     assert!(err.contains("differs from the checkpoint") && err.trim().lines().count() == 1, "{err}");
     let err = run_err(d, &["solve-board", "--model", "s", "--board", "0,1"]);
     assert!(err.contains("--board") && err.trim().lines().count() == 1, "{err}");
+    // A stopped run is not a model.
+    let manifest = d.join("s/checkpoint.json");
+    let text = std::fs::read_to_string(&manifest).unwrap();
+    std::fs::write(&manifest, text.replace("\"complete\": true", "\"complete\": false")).unwrap();
+    let err = run_err(d, &["solve-board", "--model", "s", "--random-depth", "1"]);
+    assert!(err.contains("--resume") && err.trim().lines().count() == 1, "{err}");
+    std::fs::write(&manifest, text).unwrap();
     let err = run_err(d, &["plan", "--env", "pendulum", "--model", "s"]);
     assert!(err.trim().lines().count() == 1, "{err}");
 }

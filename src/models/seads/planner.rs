@@ -41,6 +41,7 @@ pub fn load(dir: &Path) -> Result<LoadedSeads> {
             ),
         ));
     }
+    opened.expect_finished(METHOD)?;
     let run = read_run(&opened)?;
     let env = EmbodiedGame::parse(&run.env)?;
     let weights = opened.tensors(MODEL_FILE)?;
