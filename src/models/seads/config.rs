@@ -4,6 +4,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
+use crate::rl::sac::SacConfig;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -157,6 +158,19 @@ impl SeadsConfig {
             return bad("checkpoint_every must be at least 1".into());
         }
         Ok(())
+    }
+
+    /// The skill policy's SAC settings for a network input of `policy_input` values and actions in [low, high].
+    pub fn sac_config(&self, policy_input: usize, action_low: Vec<f64>, action_high: Vec<f64>) -> SacConfig {
+        SacConfig {
+            hidden: self.sac_hidden.clone(),
+            gamma: self.gamma,
+            tau: self.tau,
+            learning_rate: self.sac_learning_rate,
+            alpha: self.alpha,
+            batch_size: self.sac_batch,
+            ..SacConfig::new(policy_input, action_low, action_high)
+        }
     }
 
     /// Epochs the budget allows at most (every episode takes at least one step); the run ends after the epoch

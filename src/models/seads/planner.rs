@@ -18,7 +18,7 @@ use crate::envs::Env;
 use crate::error::{Error, Result};
 use crate::nn::ParamSet;
 use crate::planning::bfs::{bidirectional, breadth_first, SearchLimits, SearchResult, SuccessorModel};
-use crate::rl::sac::{Sac, SacConfig};
+use crate::rl::sac::Sac;
 use crate::run::{Event, Monitor};
 use crate::train::{OpenedCheckpoint, MODEL_FILE};
 
@@ -47,19 +47,8 @@ pub fn load(dir: &Path) -> Result<LoadedSeads> {
     let weights = opened.tensors(MODEL_FILE)?;
     let (model_tensors, policy_tensors): (Vec<_>, Vec<_>) =
         weights.into_iter().partition(|t| t.name.starts_with(MODEL_PREFIX));
-    let c = &run.config;
-    let (low, high) = action_bounds(env)?;
-    let sac_config = SacConfig {
-        obs_dim: run.policy_input,
-        action_dim: run.action_dim,
-        hidden: c.sac_hidden.clone(),
-        gamma: c.gamma,
-        tau: c.tau,
-        learning_rate: c.sac_learning_rate,
-        alpha: c.alpha,
-        batch_size: c.sac_batch,
-        ..SacConfig::new(run.policy_input, low, high)
-    };
+    let (manipulator, _) = env.embodiment.build();
+    let sac_config = run.config.sac_config(run.policy_input, manipulator.action_low(), manipulator.action_high());
     let policy = Sac::from_weights(sac_config, &policy_tensors)
         .map_err(|e| Error::bad_file(&dir.join(MODEL_FILE), e.to_string()))?;
     let mut params = ParamSet::<f32>::default();
@@ -74,14 +63,9 @@ pub fn load(dir: &Path) -> Result<LoadedSeads> {
             values,
         });
     }
-    let model = FlipModel::from_params(&params, run.board_bits, c.skills)
+    let model = FlipModel::from_params(&params, run.board_bits, run.config.skills)
         .map_err(|e| Error::bad_file(&dir.join(MODEL_FILE), e.to_string()))?;
     Ok(LoadedSeads { run, env, policy, model })
-}
-
-fn action_bounds(env: EmbodiedGame) -> Result<(Vec<f64>, Vec<f64>)> {
-    let (manipulator, _) = env.embodiment.build();
-    Ok((manipulator.action_low(), manipulator.action_high()))
 }
 
 /// The learned forward model as a successor model: a skill leads to the most likely next board; a prediction
@@ -125,15 +109,7 @@ impl<'a, G: BoardGame> LearnedSuccessors<'a, G> {
                     part.iter().flat_map(|&s| self.game.symbolic(s).into_iter().map(|b| b as f32)).collect();
                 let mut predicted = Vec::new();
                 self.model.mode_successors_of_pairs(&bits, part_skills, &mut predicted, &mut FlipScratch::default());
-                let mut z = vec![0.0f64; self.model.bits];
-                predicted
-                    .chunks(self.model.bits)
-                    .zip(part)
-                    .map(|(bits, &state)| {
-                        z.iter_mut().zip(bits).for_each(|(a, &b)| *a = b as f64);
-                        self.game.decode_symbolic(&z).unwrap_or(state)
-                    })
-                    .collect()
+                self.decode(&predicted, |row| part[row])
             })
             .collect();
         parts.concat()
@@ -143,14 +119,19 @@ impl<'a, G: BoardGame> LearnedSuccessors<'a, G> {
         let bits: Vec<f32> = states.iter().flat_map(|&s| self.game.symbolic(s).into_iter().map(|b| b as f32)).collect();
         let mut predicted = Vec::new();
         self.model.mode_successors(&bits, &mut predicted, &mut FlipScratch::default());
-        let (k, n_bits) = (self.model.skills, self.model.bits);
-        let mut z = vec![0.0f64; n_bits];
+        let k = self.model.skills;
+        self.decode(&predicted, |row| states[row / k])
+    }
+
+    /// Boards from predicted bit rows; a row that is no board of the game becomes `unchanged(row)`.
+    fn decode(&self, predicted: &[f32], unchanged: impl Fn(usize) -> G::State) -> Vec<G::State> {
+        let mut z = vec![0.0f64; self.model.bits];
         predicted
-            .chunks(n_bits)
+            .chunks(self.model.bits)
             .enumerate()
             .map(|(row, bits)| {
                 z.iter_mut().zip(bits).for_each(|(a, &b)| *a = b as f64);
-                self.game.decode_symbolic(&z).unwrap_or(states[row / k])
+                self.game.decode_symbolic(&z).unwrap_or_else(|| unchanged(row))
             })
             .collect()
     }

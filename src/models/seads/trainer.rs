@@ -19,7 +19,7 @@ use crate::envs::embodiments::Embodiment;
 use crate::error::{Error, Result};
 use crate::nn::tensor::{scalar, tensor, training_device};
 use crate::nn::{Adam, AdamConfig, ParamSet};
-use crate::rl::sac::{Sac, SacConfig, TransitionBatch};
+use crate::rl::sac::{Sac, TransitionBatch};
 use crate::train::tensors::{StoredTensor, TensorData};
 use crate::train::{state, TrainingMethod};
 use crate::util::seeding::{derive_seed, rng_for};
@@ -73,17 +73,8 @@ impl<G: BoardGame> SeadsTrainer<G> {
         let collector = Collector::new(&game, embodiment, config.episodes_per_epoch, config.skills);
         let layout = collector.layout;
         let mut rng = rng_for(seed, &[INIT_STREAM]);
-        let sac_config = SacConfig {
-            obs_dim: layout.obs_dim + config.skills,
-            action_dim: layout.action_dim,
-            hidden: config.sac_hidden.clone(),
-            gamma: config.gamma,
-            tau: config.tau,
-            learning_rate: config.sac_learning_rate,
-            alpha: config.alpha,
-            batch_size: config.sac_batch,
-            ..SacConfig::new(layout.obs_dim + config.skills, action_bounds(&collector).0, action_bounds(&collector).1)
-        };
+        let (low, high) = collector.action_bounds();
+        let sac_config = config.sac_config(layout.obs_dim + config.skills, low, high);
         let sac = Sac::new(sac_config, &mut rng)?;
         let device = training_device();
         let net = FlipNet::init(layout.bits, config.skills, config.model_hidden, &device, &mut rng);
@@ -313,10 +304,6 @@ impl<G: BoardGame> SeadsTrainer<G> {
             render(layout.last_board(episode))
         )
     }
-}
-
-fn action_bounds<G: BoardGame>(collector: &Collector<G>) -> (Vec<f64>, Vec<f64>) {
-    collector.action_bounds()
 }
 
 fn model_adam_config(config: &SeadsConfig) -> AdamConfig {
