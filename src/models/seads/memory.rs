@@ -212,4 +212,36 @@ mod tests {
         broken.retain(|t| t.name != "memory.obs");
         assert!(EpisodeMemory::from_stored(&broken, "memory", 4, layout, 6).is_err());
     }
+
+    /// Every count and length in a saved memory is checked against the values present: corrupted ones are
+    /// errors, never a panic or a huge allocation.
+    #[test]
+    fn corrupted_counts_and_lengths_are_errors() {
+        let layout = ObsLayout { obs_dim: 3, action_dim: 2, bits_offset: 1, bits: 1 };
+        let mut memory = EpisodeMemory::new(4);
+        for k in 0..3 {
+            memory.add(episode(k));
+        }
+        let saved = memory.to_stored("memory");
+        for (name, index, value) in [
+            ("memory.count", 0, 1e18),
+            ("memory.count", 0, 2.0),
+            ("memory.position", 0, -1.0),
+            ("memory.obs_len", 1, 1e12),
+            ("memory.obs_len", 0, 5.0),
+            ("memory.action_len", 2, f64::NAN),
+            ("memory.labels", 0, 6.0),
+            ("memory.performed", 0, 0.5),
+        ] {
+            let mut broken = saved.clone();
+            let tensor = broken.iter_mut().find(|t| t.name == name).unwrap();
+            if let TensorData::F64(v) = &mut tensor.data {
+                v[index] = value;
+            }
+            assert!(
+                EpisodeMemory::from_stored(&broken, "memory", 4, layout, 6).is_err(),
+                "{name}[{index}] = {value} was accepted"
+            );
+        }
+    }
 }
