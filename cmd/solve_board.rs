@@ -189,7 +189,10 @@ fn solve_learned<G: DenseIndex>(
     let moves: Vec<String> = outcome
         .executed
         .iter()
-        .map(|(k, m)| format!("skill {k} → {}", m.map(|m| game.move_name(m)).unwrap_or_else(|| "no move".into())))
+        .map(|e| {
+            let performed = e.performed.map(|m| game.move_name(m)).unwrap_or_else(|| "no move".into());
+            format!("skill {} → {performed} ({} steps)", e.skill, e.steps)
+        })
         .collect();
     println!("executed: {}", moves.join(", "));
     println!(

@@ -157,6 +157,95 @@ pub fn band_plot(path: &Path, title: &str, x_label: &str, y_label: &str, bands: 
     })
 }
 
+/// The five figures a box of a box plot draws, matplotlib's convention (thesis Fig. 7.9): quartiles by
+/// linear interpolation, whiskers at the farthest values within 1.5 interquartile ranges of the box, every
+/// value beyond them an outlier.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BoxStats {
+    pub q1: f64,
+    pub median: f64,
+    pub q3: f64,
+    pub whisker_low: f64,
+    pub whisker_high: f64,
+    pub outliers: Vec<f64>,
+}
+
+impl BoxStats {
+    /// `None` for a group without finite values.
+    pub fn of(values: &[f64]) -> Option<BoxStats> {
+        let finite: Vec<f64> = values.iter().copied().filter(|v| v.is_finite()).collect();
+        let q = |p| crate::eval::stats::quantile(&finite, p);
+        let (q1, median, q3) = (q(0.25)?, q(0.5)?, q(0.75)?);
+        let reach = 1.5 * (q3 - q1);
+        let inside = finite.iter().copied().filter(|&v| v >= q1 - reach && v <= q3 + reach);
+        let (whisker_low, whisker_high) = inside.fold((q1, q3), |(lo, hi), v| (lo.min(v), hi.max(v)));
+        let outliers = finite.iter().copied().filter(|&v| v < q1 - reach || v > q3 + reach).collect();
+        Some(BoxStats { q1, median, q3, whisker_low, whisker_high, outliers })
+    }
+}
+
+/// One box per named group, left to right; groups without values leave their slot empty.
+pub fn box_plot(path: &Path, title: &str, x_label: &str, y_label: &str, groups: &[(String, Vec<f64>)]) -> Result<()> {
+    let stats: Vec<Option<BoxStats>> = groups.iter().map(|(_, v)| BoxStats::of(v)).collect();
+    let (_, y1) = bounds(stats.iter().flatten().flat_map(|b| b.outliers.iter().copied().chain([b.whisker_high])));
+    let n = groups.len().max(1);
+    let names: Vec<String> = groups.iter().map(|(name, _)| name.clone()).collect();
+    render_atomic(path, |tmp| {
+        let root = BitMapBackend::new(tmp, SIZE).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| plot_err(path, e))?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 24))
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(60)
+            .build_cartesian_2d(-0.5..n as f64 - 0.5, 0.0..y1.max(1.0))
+            .map_err(|e| plot_err(path, e))?;
+        chart
+            .configure_mesh()
+            .x_labels(n)
+            .x_label_formatter(&|x| {
+                let i = x.round();
+                if (x - i).abs() < 1e-6 && i >= 0.0 {
+                    names.get(i as usize).cloned().unwrap_or_default()
+                } else {
+                    String::new()
+                }
+            })
+            .x_desc(x_label)
+            .y_desc(y_label)
+            .draw()
+            .map_err(|e| plot_err(path, e))?;
+        let (line, median_color) = (BLACK.stroke_width(1), RGBColor(0, 128, 0).stroke_width(3));
+        for (i, b) in stats.iter().enumerate() {
+            let Some(b) = b else { continue };
+            let (x, half) = (i as f64, 0.25);
+            chart
+                .draw_series(std::iter::once(Rectangle::new(
+                    [(x - half, b.q1), (x + half, b.q3)],
+                    RGBColor(70, 110, 190).mix(0.35).filled(),
+                )))
+                .map_err(|e| plot_err(path, e))?;
+            let outline = vec![
+                PathElement::new(
+                    vec![(x - half, b.q1), (x + half, b.q1), (x + half, b.q3), (x - half, b.q3), (x - half, b.q1)],
+                    line,
+                ),
+                PathElement::new(vec![(x, b.q3), (x, b.whisker_high)], line),
+                PathElement::new(vec![(x, b.q1), (x, b.whisker_low)], line),
+                PathElement::new(vec![(x - half / 2.0, b.whisker_high), (x + half / 2.0, b.whisker_high)], line),
+                PathElement::new(vec![(x - half / 2.0, b.whisker_low), (x + half / 2.0, b.whisker_low)], line),
+                PathElement::new(vec![(x - half, b.median), (x + half, b.median)], median_color),
+            ];
+            chart.draw_series(outline).map_err(|e| plot_err(path, e))?;
+            chart
+                .draw_series(b.outliers.iter().map(|&v| Circle::new((x, v), 4, BLACK.stroke_width(1))))
+                .map_err(|e| plot_err(path, e))?;
+        }
+        root.present().map_err(|e| plot_err(path, e))?;
+        Ok(())
+    })
+}
+
 pub fn histogram(path: &Path, title: &str, x_label: &str, values: &[f64], bins: usize) -> Result<()> {
     let finite: Vec<f64> = values.iter().copied().filter(|v| v.is_finite()).collect();
     let (lo, hi) = bounds(finite.iter().copied());
@@ -206,6 +295,20 @@ mod tests {
         assert_eq!(&bytes[1..4], b"PNG");
         assert_eq!(bytes, std::fs::read(&b).unwrap());
         histogram(&dir.path().join("h.png"), "h", "v", &[1.0, 2.0, 2.5, f64::NAN], 5).unwrap();
-        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 3, "no temporary files left");
+        let groups = vec![("a".to_string(), vec![1.0, 2.0, 3.0, 40.0]), ("empty".to_string(), vec![])];
+        box_plot(&dir.path().join("box.png"), "b", "group", "v", &groups).unwrap();
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 4, "no temporary files left");
+    }
+
+    #[test]
+    fn box_stats_follow_matplotlib() {
+        // numpy quartiles of 1..=9 and 30: q1 3.25, median 5.5, q3 7.75; 1.5 IQR reaches 14.5, so 30 is an
+        // outlier and the upper whisker stops at 9, the farthest value inside.
+        let mut values: Vec<f64> = (1..=9).map(f64::from).collect();
+        values.push(30.0);
+        let b = BoxStats::of(&values).unwrap();
+        assert_eq!((b.q1, b.median, b.q3), (3.25, 5.5, 7.75));
+        assert_eq!((b.whisker_low, b.whisker_high, b.outliers.clone()), (1.0, 9.0, vec![30.0]));
+        assert!(BoxStats::of(&[f64::NAN]).is_none());
     }
 }

@@ -10,7 +10,7 @@ use serde::Serialize;
 
 use crate::envs::boards::{BoardGame, GameSpec, LightsOut, Split, TileSwap};
 use crate::error::{Error, Result};
-use crate::eval::plot::{line_plot_in, Series};
+use crate::eval::plot::{box_plot, line_plot_in, Series};
 use crate::models::seads::boards::BoardPool;
 use crate::models::seads::collect::{Collector, Starts};
 use crate::models::seads::planner::{solve_with_skills, LoadedSeads};
@@ -55,6 +55,8 @@ pub struct DepthRow {
     pub mean_control_steps: f64,
     /// Searches (with and without replanning) that hit the node budget; their boards count as unsolved.
     pub search_budget_exhausted: usize,
+    /// Manipulator steps of every skill executed on the boards solved with replanning (Fig. 7.9).
+    pub skill_lengths: Vec<usize>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -129,6 +131,7 @@ fn success_rows<G: BoardGame>(
             mean_planning_seconds: 0.0,
             mean_control_steps: 0.0,
             search_budget_exhausted: 0,
+            skill_lengths: Vec::new(),
         };
         for (i, &board) in boards.iter().enumerate() {
             for replans in [settings.max_replans, 0] {
@@ -154,6 +157,9 @@ fn success_rows<G: BoardGame>(
                     row.solved_without_replanning += out.solved as usize;
                 } else {
                     row.solved_with_replanning += out.solved as usize;
+                    if out.solved {
+                        row.skill_lengths.extend(out.executed.iter().map(|e| e.steps));
+                    }
                     row.mean_planning_seconds += out.planning_seconds;
                     row.mean_control_steps += out.control_steps as f64;
                 }
@@ -169,7 +175,8 @@ fn success_rows<G: BoardGame>(
     Ok(rows)
 }
 
-/// Runs the protocol on a loaded checkpoint and writes report.md, skills.csv, success.csv and success.png.
+/// Runs the protocol on a loaded checkpoint and writes report.md, skills.csv, success.csv, success.png,
+/// skill_lengths.csv and skill_lengths.png.
 pub fn seads_report(
     loaded: &LoadedSeads,
     settings: &SeadsEvalSettings,
@@ -286,6 +293,22 @@ fn write_files<G: BoardGame>(game: &G, s: &SeadsEvalSummary, settings: &SeadsEva
         ],
         (0.0, 105.0),
     )?;
+    let length_rows: Vec<Vec<String>> = s
+        .depths
+        .iter()
+        .flat_map(|r| r.skill_lengths.iter().map(move |l| vec![r.depth.to_string(), l.to_string()]))
+        .collect();
+    write_csv(&run.file("skill_lengths.csv"), &["depth", "steps"], &length_rows)?;
+    let lengths = |r: &DepthRow| r.skill_lengths.iter().map(|&l| l as f64).collect::<Vec<f64>>();
+    let mut groups: Vec<(String, Vec<f64>)> = s.depths.iter().map(|r| (format!("depth {}", r.depth), lengths(r))).collect();
+    groups.push(("all".into(), s.depths.iter().flat_map(lengths).collect()));
+    box_plot(
+        &run.file("skill_lengths.png"),
+        &format!("{}: skill lengths on solved boards", s.env),
+        "solution depth of the board",
+        "manipulator steps per skill",
+        &groups,
+    )?;
     let mut md = format!(
         "# SEADS on {}\n\nSkill coverage (thesis Table 7.3): {} of {} game moves are the most frequent move of some skill, \
          each skill executed with its deterministic policy from {} {}-split boards of depth 1-{}. \
@@ -334,8 +357,22 @@ fn write_files<G: BoardGame>(game: &G, s: &SeadsEvalSummary, settings: &SeadsEva
         ));
     }
     md.push_str("\n![success](success.png)\n");
+    let all = &groups.last().expect("the all group is pushed above").1;
+    md.push_str(&format!(
+        "\n## Skill lengths (thesis Fig. 7.9)\n\nManipulator steps per executed skill on the boards solved with \
+         replanning: median {}, quartiles {} / {} over {} skill executions (skill_lengths.csv). Thesis medians: 3 \
+         LightsOutCursor, 2 TileSwapCursor, 11 LightsOutReacher, 9 TileSwapReacher.\n\n![skill lengths](skill_lengths.png)\n",
+        fmt_quantile(all, 0.5),
+        fmt_quantile(all, 0.25),
+        fmt_quantile(all, 0.75),
+        all.len()
+    ));
     write_text(&run.file("report.md"), &md)?;
     Ok(())
+}
+
+fn fmt_quantile(values: &[f64], q: f64) -> String {
+    crate::eval::stats::quantile(values, q).map_or_else(|| "–".into(), |v| format!("{v:.1}"))
 }
 
 /// The ablation a run belongs to, from its config: `full`, or the reward terms and relabelling it switched off.

@@ -30,10 +30,11 @@ pub trait TrainingMethod {
     fn artifacts(&self) -> Result<Vec<(String, Vec<u8>)>> {
         Ok(Vec::new())
     }
-    /// Whether a budget counted in something other than steps is used up (SEADS counts environment steps); the
-    /// run then ends after this step, complete, with `total_steps` only an upper bound.
-    fn budget_spent(&self) -> bool {
-        false
+    /// A budget counted in something other than steps (SEADS counts environment steps): how much is used and
+    /// the total. The run ends, complete, after the step that uses it up, so `total_steps` is only an upper
+    /// bound, and progress (with its rate and ETA) is reported in the budget's unit under the phase `unit`.
+    fn budget(&self) -> Option<Budget> {
+        None
     }
     /// Figures of the step just taken beyond its loss, charted and logged under these names.
     fn step_scalars(&self) -> Vec<(&'static str, f64)> {
@@ -42,6 +43,19 @@ pub trait TrainingMethod {
     /// Text panels of the step just taken (SEADS: a board before and after a skill).
     fn step_texts(&self) -> Vec<(&'static str, String)> {
         Vec::new()
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Budget {
+    pub unit: &'static str,
+    pub used: u64,
+    pub total: u64,
+}
+
+impl Budget {
+    pub fn spent(&self) -> bool {
+        self.used >= self.total
     }
 }
 
@@ -115,7 +129,8 @@ pub fn fit(
         for (name, text) in method.step_texts() {
             monitor.emit(&crate::run::Event::text(name, text));
         }
-        let last = step == settings.total_steps || method.budget_spent();
+        let budget = method.budget();
+        let last = step == settings.total_steps || budget.is_some_and(|b| b.spent());
         if step % every(settings.validate_every) == 0 || last {
             if let Some(valid) = method.validate()? {
                 if !valid.is_finite() {
@@ -127,7 +142,10 @@ pub fn fit(
                 }
             }
         }
-        monitor.progress("train", step, settings.total_steps);
+        match budget {
+            Some(b) => monitor.progress(b.unit, b.used.min(b.total), b.total),
+            None => monitor.progress("train", step, settings.total_steps),
+        }
         if step % every(settings.checkpoint_every) == 0 || last {
             save(method, settings, dir, config_entry, &best, step, last, metrics)?;
             last_checkpoint = step;
@@ -197,6 +215,8 @@ mod tests {
     struct Counter {
         w: f32,
         nan_at: u64,
+        /// Units of an outside budget each step uses (0: no such budget).
+        budget_per_step: u64,
     }
 
     impl TrainingMethod for Counter {
@@ -223,15 +243,61 @@ mod tests {
             }
             Ok(())
         }
+
+        fn budget(&self) -> Option<Budget> {
+            (self.budget_per_step > 0).then(|| Budget {
+                unit: "units",
+                used: self.w as u64 * self.budget_per_step,
+                total: 10,
+            })
+        }
     }
 
-    fn run(nan_at: u64, dir: &std::path::Path) -> Result<FitOutcome> {
+    #[derive(Default)]
+    struct Recorder(std::sync::Mutex<Vec<crate::run::Event>>);
+
+    impl Monitor for Recorder {
+        fn emit(&self, event: &crate::run::Event) {
+            self.0.lock().unwrap().push(event.clone());
+        }
+    }
+
+    fn run_counter(counter: &mut Counter, dir: &std::path::Path, monitor: &dyn Monitor) -> Result<FitOutcome> {
         let settings =
             FitSettings { method: "counter".into(), env: None, total_steps: 8, validate_every: 1, checkpoint_every: 2 };
         let ckpt = CheckpointDir::start(dir)?;
         let entry = ckpt.write_file(CONFIG_FILE, b"{}")?;
         let metrics = JsonlMonitor::create(&dir.join("metrics.jsonl")).unwrap();
-        fit(&mut Counter { w: 0.0, nan_at }, &settings, &ckpt, &entry, None, &metrics, &NullMonitor)
+        fit(counter, &settings, &ckpt, &entry, None, &metrics, monitor)
+    }
+
+    fn run(nan_at: u64, dir: &std::path::Path) -> Result<FitOutcome> {
+        run_counter(&mut Counter { w: 0.0, nan_at, budget_per_step: 0 }, dir, &NullMonitor)
+    }
+
+    #[test]
+    fn an_outside_budget_ends_the_run_complete_and_carries_the_progress() {
+        let dir = tempfile::tempdir().unwrap();
+        let recorder = Recorder::default();
+        let mut counter = Counter { w: 0.0, nan_at: u64::MAX, budget_per_step: 3 };
+        let outcome = run_counter(&mut counter, dir.path(), &recorder).unwrap();
+        assert_eq!(outcome.steps, 4, "3 units per step use up 10 in the fourth step");
+        let progress: Vec<(String, u64, u64)> = recorder
+            .0
+            .lock()
+            .unwrap()
+            .iter()
+            .filter_map(|e| match e {
+                crate::run::Event::Progress { phase, done, total } => Some((phase.clone(), *done, *total)),
+                _ => None,
+            })
+            .collect();
+        let expected: Vec<(String, u64, u64)> =
+            [3, 6, 9, 10].iter().map(|&done| ("units".to_string(), done, 10)).collect();
+        assert_eq!(progress, expected, "progress counts the budget, capped at its total");
+        let manifest: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(dir.path().join("checkpoint.json")).unwrap()).unwrap();
+        assert_eq!((manifest["step"].as_u64(), manifest["complete"].as_bool()), (Some(4), Some(true)));
     }
 
     #[test]

@@ -65,9 +65,11 @@ impl StopAfter {
 
 impl mbrl::run::Monitor for StopAfter {
     fn emit(&self, event: &mbrl::run::Event) {
-        if let mbrl::run::Event::Progress { phase, done, .. } = event {
-            if phase == "train" {
-                self.seen.store(*done, std::sync::atomic::Ordering::Relaxed);
+        // The training loss is logged once per step under every method; progress may count other units
+        // (SEADS reports environment steps).
+        if let mbrl::run::Event::Scalar { name, step, .. } = event {
+            if name == "train/loss" {
+                self.seen.store(*step, std::sync::atomic::Ordering::Relaxed);
             }
         }
     }

@@ -167,13 +167,22 @@ impl<G: BoardGame> SuccessorModel for LearnedSuccessors<'_, G> {
     }
 }
 
+/// One skill run by its policy until the board changed or its step limit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ExecutedSkill {
+    pub skill: usize,
+    /// The game move it performed, if the board changed by one.
+    pub performed: Option<usize>,
+    /// Manipulator steps it took (thesis Fig. 7.9's skill length).
+    pub steps: usize,
+}
+
 /// How a board was solved (or not) with skills.
 #[derive(Clone, Debug)]
 pub struct SkillSolve<S> {
     /// Every plan made, the first and each replan.
     pub plans: Vec<Vec<usize>>,
-    /// Skills executed and the game move each performed.
-    pub executed: Vec<(usize, Option<usize>)>,
+    pub executed: Vec<ExecutedSkill>,
     pub final_board: S,
     pub solved: bool,
     pub control_steps: usize,
@@ -242,6 +251,7 @@ pub fn solve_with_skills<G: BoardGame>(
             let expected = successors.predict(before, skill);
             env.set_board(before);
             let mut performed = None;
+            let mut steps = 0;
             loop {
                 if monitor.is_cancelled() {
                     return Err(Error::Cancelled);
@@ -251,7 +261,7 @@ pub fn solve_with_skills<G: BoardGame>(
                 policy_input(&obs, skill, k, &mut input);
                 let action: Vec<f64> = loaded.policy.act(&input, 1, true, rng).iter().map(|&a| a as f64).collect();
                 let step = env.step(&action);
-                out.control_steps += 1;
+                steps += 1;
                 if env.board() != before {
                     performed = (0..game.num_moves()).find(|&m| game.apply(before, m) == env.board());
                 }
@@ -259,7 +269,8 @@ pub fn solve_with_skills<G: BoardGame>(
                     break;
                 }
             }
-            out.executed.push((skill, performed));
+            out.control_steps += steps;
+            out.executed.push(ExecutedSkill { skill, performed, steps });
             monitor.emit(&Event::text("board", game.render(env.board())));
             if env.board() != expected {
                 break;

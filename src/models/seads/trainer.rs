@@ -10,6 +10,7 @@ use rand_chacha::ChaCha8Rng;
 use super::boards::BoardPool;
 use super::collect::{policy_input, Collector, Starts};
 use super::config::SeadsConfig;
+use crate::train::Budget;
 use super::forward_model::{model_inputs, torch_name, FlipModel, FlipNet, FlipScratch};
 use super::memory::{Episode, EpisodeMemory, ObsLayout};
 use super::relabel::relabel_by_assignment;
@@ -285,10 +286,6 @@ impl<G: BoardGame> SeadsTrainer<G> {
         self.collector.collect(labels, starts, rng, |inputs, rows, rng| sac.act(inputs, rows, deterministic, rng))
     }
 
-    pub fn budget_spent(&self) -> bool {
-        self.env_steps >= self.config.env_steps
-    }
-
     fn describe(&self, episode: &Episode) -> String {
         let layout = self.collector.layout;
         let render = |bits: &[f32]| {
@@ -423,8 +420,8 @@ impl<G: BoardGame> TrainingMethod for SeadsTrainer<G> {
         Ok(())
     }
 
-    fn budget_spent(&self) -> bool {
-        SeadsTrainer::budget_spent(self)
+    fn budget(&self) -> Option<Budget> {
+        Some(Budget { unit: "env steps", used: self.env_steps, total: self.config.env_steps })
     }
 
     fn step_texts(&self) -> Vec<(&'static str, String)> {

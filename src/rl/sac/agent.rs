@@ -157,7 +157,7 @@ impl Sac {
             mean.iter_mut().for_each(|m| *m = m.tanh());
             mean
         } else {
-            self.policy_fast.sample(obs, rows, rng).0
+            self.policy_fast.sample(obs, rows, &self.scale, rng).0
         };
         Ok(self.to_env(&squashed))
     }
@@ -188,7 +188,9 @@ impl Sac {
         let (gamma, alpha) = (self.config.gamma as f32, self.config.alpha as f32);
 
         // Critic target y = r + γ(1 − done)(min Q_target(s', a') − α log π(a'|s')), without gradients.
-        let (next_actions, next_log_prob) = self.policy_fast.sample(&batch.next_obs, n, rng);
+        // The critics see actions in env units, as stored in the replay memory.
+        let (next_squashed, next_log_prob) = self.policy_fast.sample(&batch.next_obs, n, &self.scale, rng);
+        let next_actions = self.to_env(&next_squashed);
         let next_q = self.target_fast.min_q(&concat_rows(&batch.next_obs, od, &next_actions, ad, n), n);
         let y: Vec<f32> = (0..n)
             .map(|i| {
@@ -197,9 +199,7 @@ impl Sac {
             })
             .collect();
 
-        let actions: Vec<f32> =
-            batch.actions.iter().enumerate().map(|(i, a)| (a - self.bias[i % ad]) / self.scale[i % ad]).collect();
-        let input = tensor(concat_rows(&batch.obs, od, &actions, ad, n), [n, od + ad], &self.device);
+        let input = tensor(concat_rows(&batch.obs, od, &batch.actions, ad, n), [n, od + ad], &self.device);
         let target = tensor(y, [n, 1], &self.device);
         let (q1, q2) = self.critic_module().forward(input);
         let mean_q = scalar(&((q1.clone() + q2.clone()).mean() / 2.0));
@@ -218,9 +218,12 @@ impl Sac {
         let (mean, log_std) = self.policy_module().forward(obs.clone());
         let eps = tensor(eps, [n, ad], &self.device);
         let squashed = (mean + log_std.clone().exp() * eps.clone()).tanh();
-        let log_prob = log_prob(eps, log_std, squashed.clone());
+        let scale = tensor(self.scale.clone(), [1, ad], &self.device);
+        let bias = tensor(self.bias.clone(), [1, ad], &self.device);
+        let log_prob = log_prob(eps, log_std, squashed.clone(), scale.clone());
+        let actions = squashed * scale + bias;
         let frozen = self.critic_module().clone().no_grad();
-        let (q1, q2) = frozen.forward(Tensor::cat(vec![obs, squashed], 1));
+        let (q1, q2) = frozen.forward(Tensor::cat(vec![obs, actions], 1));
         let entropy = -scalar(&log_prob.clone().mean());
         let actor_loss = (log_prob * alpha - q1.min_pair(q2)).mean();
         let actor_value = scalar(&actor_loss);
@@ -262,10 +265,11 @@ impl Sac {
     }
 }
 
-/// log π of tanh-squashed Gaussian samples u = mean + σ·ε, summed over action dims → [batch, 1]. Written with
-/// ε itself rather than (u − mean)/σ: the same value, and the gradient torch's rsample gives.
-pub fn log_prob(eps: Tensor<2>, log_std: Tensor<2>, squashed: Tensor<2>) -> Tensor<2> {
+/// log π of the env actions tanh(u)·scale + bias for Gaussian samples u = mean + σ·ε, summed over action dims →
+/// [batch, 1] (see [`super::inference::squash`] for why the scale's Jacobian is in it). `scale` is [1, dims].
+/// Written with ε itself rather than (u − mean)/σ: the same value, and the gradient torch's rsample gives.
+pub fn log_prob(eps: Tensor<2>, log_std: Tensor<2>, squashed: Tensor<2>, scale: Tensor<2>) -> Tensor<2> {
     let gaussian = eps.square().mul_scalar(-0.5) - log_std - HALF_LN_2PI;
-    let correction = squashed.square().neg().add_scalar(1.0 + TANH_EPSILON).log();
+    let correction = (squashed.square().neg().add_scalar(1.0) * scale).add_scalar(TANH_EPSILON).log();
     (gaussian - correction).sum_dim(1)
 }

@@ -53,24 +53,34 @@ impl PolicyFast {
         (mean, log_std)
     }
 
-    /// Squashed samples in [−1, 1] (`rows × action_dim`, noise drawn row-major from `rng`) and their
-    /// log-probabilities (one per row).
-    pub fn sample<R: Rng + ?Sized>(&self, obs: &[f32], rows: usize, rng: &mut R) -> (Vec<f32>, Vec<f32>) {
+    /// Squashed samples in [−1, 1] (`rows × action_dim`, noise drawn row-major from `rng`) and the
+    /// log-probabilities (one per row) of the actions they map to in env units, `scale` per dimension.
+    pub fn sample<R: Rng + ?Sized>(
+        &self,
+        obs: &[f32],
+        rows: usize,
+        scale: &[f32],
+        rng: &mut R,
+    ) -> (Vec<f32>, Vec<f32>) {
         let (mean, log_std) = self.forward(obs, rows, true);
         let eps: Vec<f32> = (0..mean.len()).map(|_| rng.sample(StandardNormal)).collect();
-        squash(&mean, &log_std, &eps, self.action_dim())
+        squash(&mean, &log_std, &eps, scale)
     }
 }
 
-/// u = mean + σ·ε, a = tanh(u), log π(a) = Σ_dims [log N(u; mean, σ) − log(1 − a² + ε)].
-pub fn squash(mean: &[f32], log_std: &[f32], eps: &[f32], action_dim: usize) -> (Vec<f32>, Vec<f32>) {
+/// u = mean + σ·ε, a = tanh(u), and the density of the env action a·scale + bias:
+/// log π = Σ_dims [log N(u; mean, σ) − log(scale·(1 − a²) + ε)]. The scale's Jacobian belongs in it: it sets
+/// how much entropy a step is worth against the reward, and with the Cursor's ±0.2 moves it makes every extra
+/// step of a skill cost rather than pay (the authors' correction).
+pub fn squash(mean: &[f32], log_std: &[f32], eps: &[f32], scale: &[f32]) -> (Vec<f32>, Vec<f32>) {
+    let action_dim = scale.len();
     let mut actions = Vec::with_capacity(mean.len());
     let mut log_prob = Vec::with_capacity(mean.len() / action_dim.max(1));
     for ((m, s), e) in mean.chunks(action_dim).zip(log_std.chunks(action_dim)).zip(eps.chunks(action_dim)) {
         let mut lp = 0.0f32;
         for k in 0..action_dim {
             let a = (m[k] + s[k].exp() * e[k]).tanh();
-            lp += -0.5 * e[k] * e[k] - s[k] - HALF_LN_2PI - (1.0 - a * a + TANH_EPSILON).ln();
+            lp += -0.5 * e[k] * e[k] - s[k] - HALF_LN_2PI - (scale[k] * (1.0 - a * a) + TANH_EPSILON).ln();
             actions.push(a);
         }
         log_prob.push(lp);

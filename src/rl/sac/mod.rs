@@ -1,9 +1,9 @@
 //! Soft Actor-Critic (Haarnoja et al. 2018) as the SEADS code runs it: tanh-Gaussian actor, twin Q critics
 //! with Polyak-averaged targets, fixed temperature α, Adam for both.
 //!
-//! The networks work in actions scaled to [−1, 1]: the actor's tanh output is rescaled to the env bounds for
-//! acting, and batch actions (stored in env units) are mapped back before they enter the critics. Log-probs
-//! are densities over that [−1, 1] space.
+//! As in the authors' code, the actor's tanh output in [−1, 1] is rescaled to the env bounds, the critics take
+//! actions in env units (as the replay memory stores them), and log-probs are densities over env units: the
+//! rescaling's Jacobian is part of them, which decides how much a step's entropy is worth.
 //!
 //! Training uses burn's autodiff for the two gradient passes; acting and the critic target go through the
 //! plain-buffer fast path (`inference`), rebuilt from the parameters after every update.

@@ -112,6 +112,8 @@ fn tanh_gaussian_log_prob_matches_the_direct_formula() {
         vec![-1.0f32, 0.5, -3.0, 0.0, 1.5, -0.4],
         vec![0.7f32, -1.2, 0.1, 2.3, -0.4, 0.0],
     );
+    // The Cursor's bounds: the scale's Jacobian enters the density.
+    let scale = [0.2f32, 0.2, 1.0];
     let expected: Vec<f64> = (0..2)
         .map(|r| {
             (0..3)
@@ -120,7 +122,7 @@ fn tanh_gaussian_log_prob_matches_the_direct_formula() {
                     let (m, s, e) = (mean[i] as f64, log_std[i] as f64, eps[i] as f64);
                     let u = m + s.exp() * e;
                     let normal = -0.5 * ((u - m) / s.exp()).powi(2) - s - 0.5 * (2.0 * std::f64::consts::PI).ln();
-                    normal - (1.0 - u.tanh().powi(2) + 1e-6).ln()
+                    normal - (scale[k] as f64 * (1.0 - u.tanh().powi(2)) + 1e-6).ln()
                 })
                 .sum()
         })
@@ -131,8 +133,9 @@ fn tanh_gaussian_log_prob_matches_the_direct_formula() {
         tensor(eps.clone(), [2, 3], &device),
         tensor(log_std.clone(), [2, 3], &device),
         tensor(squashed.clone(), [2, 3], &device),
+        tensor(scale.to_vec(), [1, 3], &device),
     ));
-    let (fast_actions, fast) = squash(&mean, &log_std, &eps, 3);
+    let (fast_actions, fast) = squash(&mean, &log_std, &eps, &scale);
     for r in 0..2 {
         assert!((burn[r] as f64 - expected[r]).abs() < 1e-3, "burn row {r}: {} vs {}", burn[r], expected[r]);
         assert!((fast[r] as f64 - expected[r]).abs() < 1e-3, "fast row {r}: {} vs {}", fast[r], expected[r]);
