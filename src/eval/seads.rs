@@ -300,7 +300,8 @@ fn write_files<G: BoardGame>(game: &G, s: &SeadsEvalSummary, settings: &SeadsEva
         .collect();
     write_csv(&run.file("skill_lengths.csv"), &["depth", "steps"], &length_rows)?;
     let lengths = |r: &DepthRow| r.skill_lengths.iter().map(|&l| l as f64).collect::<Vec<f64>>();
-    let mut groups: Vec<(String, Vec<f64>)> = s.depths.iter().map(|r| (format!("depth {}", r.depth), lengths(r))).collect();
+    let mut groups: Vec<(String, Vec<f64>)> =
+        s.depths.iter().map(|r| (format!("depth {}", r.depth), lengths(r))).collect();
     groups.push(("all".into(), s.depths.iter().flat_map(lengths).collect()));
     box_plot(
         &run.file("skill_lengths.png"),

@@ -10,7 +10,6 @@ use rand_chacha::ChaCha8Rng;
 use super::boards::BoardPool;
 use super::collect::{policy_input, Collector, Starts};
 use super::config::SeadsConfig;
-use crate::train::Budget;
 use super::forward_model::{model_inputs, torch_name, FlipModel, FlipNet, FlipScratch};
 use super::memory::{Episode, EpisodeMemory, ObsLayout};
 use super::relabel::relabel_by_assignment;
@@ -22,6 +21,7 @@ use crate::nn::tensor::{scalar, tensor, training_device};
 use crate::nn::{Adam, AdamConfig, ParamSet};
 use crate::rl::sac::{Sac, TransitionBatch};
 use crate::train::tensors::{StoredTensor, TensorData};
+use crate::train::Budget;
 use crate::train::{state, TrainingMethod};
 use crate::util::seeding::{derive_seed, rng_for};
 
