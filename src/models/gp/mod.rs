@@ -4,10 +4,12 @@
 
 pub mod constraint;
 pub mod exact;
+pub mod hypers;
 pub mod kernel;
 #[cfg(test)]
 mod tests;
 
 pub use constraint::{GammaPrior, GreaterThan};
 pub use exact::{ConditionedGp, NllGradients, Prediction};
+pub use hypers::{GpHypers, HyperInit, ObjectiveGradients};
 pub use kernel::SeArd;

@@ -158,3 +158,41 @@ fn constraints_round_trip_and_the_gamma_prior_has_the_right_slope() {
     let numeric = (prior.log_density(0.3 + h) - prior.log_density(0.3 - h)) / (2.0 * h);
     assert!((prior.d_log_density(0.3) - numeric).abs() < 1e-6);
 }
+
+#[test]
+fn the_objective_differentiates_through_constraints_and_prior() {
+    let p = problem(20, 3);
+    let mut hypers = GpHypers::new(&HyperInit::dlgpd(4, 0.9)).unwrap();
+    hypers.raw_lengthscales = vec![0.2, -0.4, 1.1, 0.0];
+    // A signal-to-noise ratio of several hundred, where the penalty is of order 10 and its slope large.
+    hypers.raw_outputscale = 3.0;
+    hypers.raw_noise = -5.0;
+    let value_at = |h: &GpHypers| h.objective(&p.inputs, &p.targets, &p.prior_mean).unwrap().0;
+    let (_, g, _) = hypers.objective(&p.inputs, &p.targets, &p.prior_mean).unwrap();
+    let step = 1e-6;
+    let fd = |poke: &dyn Fn(&mut GpHypers, f64)| {
+        let (mut a, mut b) = (hypers.clone(), hypers.clone());
+        poke(&mut a, step);
+        poke(&mut b, -step);
+        (value_at(&a) - value_at(&b)) / (2.0 * step)
+    };
+    for c in 0..4 {
+        close(&format!("raw lengthscale {c}"), g.raw_lengthscales[c], fd(&|h, d| h.raw_lengthscales[c] += d));
+    }
+    close("raw outputscale", g.raw_outputscale, fd(&|h, d| h.raw_outputscale += d));
+    close("raw noise", g.raw_noise, fd(&|h, d| h.raw_noise += d));
+    let (penalty, d_signal, d_noise) = hypers.snr_penalty();
+    assert!(penalty > 1.0, "penalty {penalty}");
+    let snr_fd = |poke: &dyn Fn(&mut GpHypers, f64)| {
+        let (mut a, mut b) = (hypers.clone(), hypers.clone());
+        poke(&mut a, step);
+        poke(&mut b, -step);
+        (a.snr_penalty().0 - b.snr_penalty().0) / (2.0 * step)
+    };
+    close("snr / raw outputscale", d_signal, snr_fd(&|h, d| h.raw_outputscale += d));
+    close("snr / raw noise", d_noise, snr_fd(&|h, d| h.raw_noise += d));
+    // The bounds hold whatever the raw values.
+    hypers.raw_noise = -500.0;
+    assert!(hypers.noise() >= 0.9e-3);
+    assert!(GpHypers::new(&HyperInit::dlgpd(4, 0.0)).is_err(), "zero target variance leaves no valid start");
+}
