@@ -10,6 +10,7 @@ pub mod collect;
 pub mod collect_ball;
 pub mod collect_embodied;
 pub mod dataset;
+pub mod frames_png;
 pub mod mcap_io;
 pub mod rollout;
 pub mod schema;

@@ -2,6 +2,7 @@
 
 pub mod dynamics;
 pub mod params;
+pub mod render;
 pub mod variant;
 
 use rand::Rng;
