@@ -14,6 +14,7 @@ use mbrl::data::collect_ball::{collect_ball, BallCollectSettings};
 use mbrl::data::collect_embodied::{
     collect_embodied, parse_manipulator_state, replay_embodied, EmbodiedCollectSettings, EmbodiedReplaySettings,
 };
+use mbrl::data::collect_frames::{add_pendulum_frames, check_frames_size};
 use mbrl::data::{write_dataset, Dataset};
 use mbrl::envs::ball::Orientation;
 use mbrl::envs::boards::depth::{DenseIndex, DepthTable};
@@ -36,6 +37,7 @@ pub enum Policy {
 Examples:
   mbrl collect --env pendulum --rollouts 500 --steps 30 --out datasets/pendulum.mcap
   mbrl collect --env pendulum:quadrant --rollouts 100 --steps 50 --seed 3
+  mbrl collect --env pendulum:inverted --images --rollouts 500 --steps 29 --out datasets/pendulum-inverted-images.mcap
   mbrl collect --env toy:inner --instances 5000 --steps 100 --out datasets/toy-inner-train.mcap
   mbrl collect --env mountaincar --instances 1000 --steps 100 --seed 1
   mbrl collect --env pendulum --actions actions.csv --init-state 3.14,0 --out datasets/replay.mcap
@@ -93,6 +95,10 @@ pub struct CollectArgs {
     /// Steps per rollout.
     #[arg(long, default_value_t = 30)]
     steps: usize,
+    /// Pendulum: also store a 64 × 64 RGB frame of every state (gym's rendering, DLGPD's observations), shown
+    /// by Foxglove's Image panel on /frames.
+    #[arg(long, conflicts_with_all = ["trajectories", "boards", "episodes"])]
+    images: bool,
     /// Behaviour policy.
     #[arg(long, value_enum, default_value_t = Policy::Random)]
     policy: Policy,
@@ -122,6 +128,9 @@ pub struct CollectArgs {
 
 pub fn run(global: &GlobalArgs, args: CollectArgs) -> anyhow::Result<()> {
     let env = parse_env(&args.env)?;
+    if args.images {
+        check_frames_size(&env, 0.0)?;
+    }
     if env == EnvName::Ball {
         let Some(trajectories) = args.trajectories else {
             bail!("'ball' is recorded as camera trajectories: give --trajectories N");
@@ -155,8 +164,12 @@ pub fn run(global: &GlobalArgs, args: CollectArgs) -> anyhow::Result<()> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from(format!("datasets/{}-{mode}.mcap", file_stem(&env.canonical()))));
+    if args.images {
+        let rollouts = args.instances.map_or(args.rollouts, |n| 2 * n);
+        check_frames_size(&env, rollouts as f64 * (args.steps as f64 + 1.0))?;
+    }
     let dataset = run_job(global, "collect", |monitor| {
-        let data = match (args.instances, args.policy) {
+        let mut data = match (args.instances, args.policy) {
             (Some(instances), Policy::Random) => {
                 let settings = InstancePairSettings {
                     env,
@@ -178,6 +191,9 @@ pub fn run(global: &GlobalArgs, args: CollectArgs) -> anyhow::Result<()> {
                 collect_random(&settings, monitor)?
             }
         };
+        if args.images {
+            add_pendulum_frames(&mut data, monitor)?;
+        }
         write_dataset(&out, &data)?;
         Ok(data)
     })?;
@@ -186,7 +202,14 @@ pub fn run(global: &GlobalArgs, args: CollectArgs) -> anyhow::Result<()> {
         Some(n) => format!("{rollouts} rollouts ({n} instance pairs)"),
         None => format!("{rollouts} rollouts"),
     };
-    println!("wrote {} transitions in {grouping} of {} to {}", dataset.steps.len(), dataset.meta.env, out.display());
+    let frames =
+        if dataset.frames.is_empty() { String::new() } else { format!(" with {} frames", dataset.frames.len()) };
+    println!(
+        "wrote {} transitions in {grouping} of {}{frames} to {}",
+        dataset.steps.len(),
+        dataset.meta.env,
+        out.display()
+    );
     Ok(())
 }
 
@@ -206,7 +229,11 @@ fn replay_actions(global: &GlobalArgs, env: EnvName, actions: &Path, args: &Coll
         seed: global.seed,
         command_line: command_line(),
     };
-    let data: Dataset = replay(&settings)?;
+    let mut data: Dataset = replay(&settings)?;
+    if args.images {
+        check_frames_size(&settings.env, data.steps.len() as f64 + 1.0)?;
+        add_pendulum_frames(&mut data, &mbrl::run::NullMonitor)?;
+    }
     write_dataset(&out, &data)?;
     println!("wrote a replay of {} actions in {} to {}", data.steps.len(), data.meta.env, out.display());
     Ok(())

@@ -259,7 +259,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__collect)
-            opts="-q -h -V --env --rollouts --instances --actions --init-state --instance-seed --board --episodes --steps --policy --out --trajectories --orientation --augment-rotations --boards --max-depth --split --seed --threads --tui --no-tui --quiet --help --version"
+            opts="-q -h -V --env --rollouts --instances --actions --init-state --instance-seed --board --episodes --steps --images --policy --out --trajectories --orientation --augment-rotations --boards --max-depth --split --seed --threads --tui --no-tui --quiet --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0

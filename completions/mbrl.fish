@@ -61,6 +61,7 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l split -d 'Only boa
 test\t''"
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l threads -d 'Worker threads (0 = one per core)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l images -d 'Pendulum: also store a 64 × 64 RGB frame of every state (gym\'s rendering, DLGPD\'s observations), shown by Foxglove\'s Image panel on /frames'
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l boards -d 'For board games: write the set of all boards of solution depth 1..=--max-depth with their split'
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'

@@ -171,3 +171,25 @@ fn bad_init_states_are_explained() {
         &["'zero' is not a number"],
     );
 }
+
+#[test]
+fn images_store_a_rendered_frame_of_every_state() {
+    let dir = tempfile::tempdir().unwrap();
+    succeed(
+        dir.path(),
+        &["--env", "pendulum:inverted", "--images", "--rollouts", "3", "--steps", "4", "--out", "i.mcap"],
+    );
+    let data = read_dataset(&dir.path().join("i.mcap")).unwrap();
+    let info = data.meta.frames.clone().expect("frames declared in the metadata");
+    assert_eq!((info.width, info.height), (64, 64));
+    assert_eq!(data.frames.len(), 3 * 5, "one frame per state: 4 transitions + 1 per rollout");
+    let mut renderer = mbrl::envs::pendulum::render::PendulumRenderer::new();
+    assert_eq!(data.frames[0], renderer.frame(data.steps[0].state[0]));
+    assert_eq!(data.frames[4], renderer.frame(data.steps[3].next_state[0]), "the last frame is the last next state");
+
+    let out = collect(dir.path(), &["--env", "toy:inner", "--images", "--rollouts", "2", "--out", "t.mcap"]);
+    assert_one_line_error(&out, &["--images", "toy:inner"]);
+    let out = collect(dir.path(), &["--env", "pendulum", "--images", "--rollouts", "100000000", "--out", "b.mcap"]);
+    assert_one_line_error(&out, &["--images", "GiB"]);
+    assert!(!dir.path().join("t.mcap").exists() && !dir.path().join("b.mcap").exists());
+}

@@ -46,7 +46,11 @@ pub fn collect_random(settings: &CollectSettings, monitor: &dyn Monitor) -> Resu
         steps.extend(timesteps(&spec, &rollout, k as u32));
         monitor.progress("collect rollouts", k as u64 + 1, settings.rollouts as u64);
     }
-    Ok(Dataset { meta: meta(&spec, settings.seed, &settings.command_line, instances, DatasetLayout::Rollouts), steps })
+    Ok(Dataset {
+        meta: meta(&spec, settings.seed, &settings.command_line, instances, DatasetLayout::Rollouts),
+        steps,
+        frames: Vec::new(),
+    })
 }
 
 pub struct InstancePairSettings {
@@ -88,7 +92,11 @@ pub fn collect_instance_pairs(settings: &InstancePairSettings, monitor: &dyn Mon
         monitor.progress("collect instance pairs", k + 1, settings.instances as u64);
     }
     let layout = DatasetLayout::InstancePairs;
-    Ok(Dataset { meta: meta(&spec, settings.seed, &settings.command_line, instances, layout), steps })
+    Ok(Dataset {
+        meta: meta(&spec, settings.seed, &settings.command_line, instances, layout),
+        steps,
+        frames: Vec::new(),
+    })
 }
 
 pub struct ReplaySettings {
@@ -134,6 +142,7 @@ pub fn replay(settings: &ReplaySettings) -> Result<Dataset> {
     Ok(Dataset {
         meta: meta(&spec, settings.seed, &settings.command_line, vec![env.params()], DatasetLayout::Rollouts),
         steps,
+        frames: Vec::new(),
     })
 }
 
@@ -212,6 +221,7 @@ pub(super) fn meta(
         action_dim: spec.action_dim(),
         dt: spec.dt,
         layout,
+        frames: None,
     }
 }
 

@@ -203,7 +203,11 @@ impl Episodes {
     }
 
     fn into_dataset(self, spec: &EnvSpec, seed: u64, command_line: &str) -> Dataset {
-        Dataset { meta: meta(spec, seed, command_line, self.instances, DatasetLayout::Rollouts), steps: self.steps }
+        Dataset {
+            meta: meta(spec, seed, command_line, self.instances, DatasetLayout::Rollouts),
+            steps: self.steps,
+            frames: Vec::new(),
+        }
     }
 }
 

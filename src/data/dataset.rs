@@ -6,9 +6,10 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use super::mcap_io::{check_version, read_messages, write_messages, Layout};
+use super::frames::{frame_channel, read_frames, FrameInfo};
+use super::mcap_io::{check_version, read_messages_and_raw, write_messages_with, Layout};
 use super::rollout::{Rollout, Timestep};
-use super::schema::{TIMESTEP_SCHEMA, TIMESTEP_SCHEMA_NAME, TIMESTEP_TOPIC};
+use super::schema::{FRAME_TOPIC, TIMESTEP_SCHEMA, TIMESTEP_SCHEMA_NAME, TIMESTEP_TOPIC};
 use crate::error::{Error, Result};
 
 /// Version of the on-disk layout; readers reject any other.
@@ -65,17 +66,22 @@ pub struct DatasetMeta {
     pub dt: f64,
     #[serde(default)]
     pub layout: DatasetLayout,
+    /// Rendered frames of the states (`collect --images`), absent in most datasets.
+    #[serde(default)]
+    pub frames: Option<FrameInfo>,
 }
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Dataset {
     pub meta: DatasetMeta,
     pub steps: Vec<Timestep>,
+    /// RGB of every state when `meta.frames` is set: per rollout t = 0 … T, in step order (see data::frames).
+    pub frames: Vec<Vec<u8>>,
 }
 
 impl DatasetMeta {
     fn to_record(&self) -> BTreeMap<String, String> {
-        BTreeMap::from([
+        let mut record = BTreeMap::from([
             ("format_version".to_string(), self.format_version.to_string()),
             ("env".to_string(), self.env.clone()),
             ("seed".to_string(), self.seed.to_string()),
@@ -86,7 +92,11 @@ impl DatasetMeta {
             ("action_dim".to_string(), self.action_dim.to_string()),
             ("dt".to_string(), format!("{:?}", self.dt)),
             ("layout".to_string(), self.layout.as_str().to_string()),
-        ])
+        ]);
+        if let Some(frames) = &self.frames {
+            record.insert("frames".to_string(), to_json(frames));
+        }
+        record
     }
 
     fn from_record(path: &Path, record: &BTreeMap<String, String>) -> Result<Self> {
@@ -113,8 +123,33 @@ impl DatasetMeta {
                 Some(text) => DatasetLayout::parse(path, text)?,
                 None => DatasetLayout::Rollouts,
             },
+            frames: match record.get("frames") {
+                Some(text) => Some(parse_frame_info(path, text)?),
+                None => None,
+            },
         })
     }
+}
+
+/// Frames larger than this are not a rendering this tool makes; the bound keeps a forged header from sizing
+/// buffers.
+const MAX_FRAME_SIDE: u32 = 4096;
+
+fn parse_frame_info(path: &Path, text: &str) -> Result<FrameInfo> {
+    let info: FrameInfo = serde_json::from_str(text).map_err(|e| {
+        Error::bad_file(path, format!("metadata field 'frames': expected {{width, height, renderer}}: {e}"))
+    })?;
+    let side_ok = |s: u32| (1..=MAX_FRAME_SIDE).contains(&s);
+    if !side_ok(info.width) || !side_ok(info.height) {
+        return Err(Error::bad_file(
+            path,
+            format!(
+                "metadata field 'frames': {} × {} pixels; expected 1 … {MAX_FRAME_SIDE} per side",
+                info.width, info.height
+            ),
+        ));
+    }
+    Ok(info)
 }
 
 fn to_json<T: Serialize>(value: &T) -> String {
@@ -134,18 +169,29 @@ fn layout(meta: &DatasetMeta) -> Layout<'static> {
 
 /// Writes the dataset atomically: the file appears complete or not at all.
 pub fn write_dataset(path: &Path, dataset: &Dataset) -> Result<()> {
-    write_messages(path, &layout(&dataset.meta), dataset.meta.to_record(), &dataset.steps)
+    let layout = layout(&dataset.meta);
+    let frames = match &dataset.meta.frames {
+        Some(info) => Some(frame_channel(info, &dataset.steps, &dataset.frames, &layout)?),
+        None if dataset.frames.is_empty() => None,
+        None => return Err(Error::data("dataset has frames but its metadata does not describe them")),
+    };
+    write_messages_with(path, &layout, dataset.meta.to_record(), &dataset.steps, frames.as_ref())
 }
 
 pub fn read_dataset(path: &Path) -> Result<Dataset> {
-    let (record, messages) = read_messages::<Timestep>(path, METADATA_NAME, TIMESTEP_TOPIC)?;
+    let (record, messages, raw_frames) =
+        read_messages_and_raw::<Timestep>(path, METADATA_NAME, TIMESTEP_TOPIC, FRAME_TOPIC)?;
     let meta = DatasetMeta::from_record(path, &record)?;
     let mut steps = Vec::with_capacity(messages.len());
     for (sequence, step) in messages {
         validate_step(path, &meta, &step, sequence)?;
         steps.push(step);
     }
-    let data = Dataset { meta, steps };
+    let frames = match &meta.frames {
+        Some(info) => read_frames(path, info, &steps, raw_frames)?,
+        None => Vec::new(),
+    };
+    let data = Dataset { meta, steps, frames };
     if data.meta.layout == DatasetLayout::InstancePairs {
         check_pairs(&data.meta, &data.steps).map_err(|e| Error::bad_file(path, e))?;
     }
@@ -250,6 +296,7 @@ fn validate_step(path: &Path, meta: &DatasetMeta, step: &Timestep, sequence: u32
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::data::mcap_io::write_messages;
     use crate::data::Rollout;
 
     pub(crate) fn tiny_dataset() -> Dataset {
@@ -268,8 +315,10 @@ mod tests {
                 action_dim: 1,
                 dt: 0.05,
                 layout: DatasetLayout::Rollouts,
+                frames: None,
             },
             steps: r.timesteps(0).collect(),
+            frames: Vec::new(),
         }
     }
 
@@ -395,5 +444,54 @@ mod tests {
         write_dataset(&path, &data).unwrap();
         let err = read_dataset(&path).unwrap_err().to_string();
         assert!(err.contains("rollout 1 (instance 0) is missing"), "{err}");
+    }
+
+    /// The tiny dataset with a 4 × 2 frame per state (2 transitions → 3 frames).
+    fn with_frames() -> Dataset {
+        let mut data = tiny_dataset();
+        data.meta.frames = Some(FrameInfo { width: 4, height: 2, renderer: "test".into() });
+        data.frames = (0..3u8).map(|k| (0..24u8).map(|i| i.wrapping_mul(k + 1)).collect()).collect();
+        data
+    }
+
+    #[test]
+    fn frames_round_trip_beside_the_timesteps() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("frames.mcap");
+        let data = with_frames();
+        write_dataset(&path, &data).unwrap();
+        assert_eq!(read_dataset(&path).unwrap(), data);
+        let mut short = with_frames();
+        short.frames.pop();
+        let err = write_dataset(&dir.path().join("short.mcap"), &short).unwrap_err().to_string();
+        assert!(err.contains("2 frames for 3 states"), "{err}");
+        assert!(!dir.path().join("short.mcap").exists(), "nothing half-written");
+    }
+
+    #[test]
+    fn frames_that_do_not_match_the_metadata_are_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let data = with_frames();
+        let write_claiming = |name: &str, frames: &str| {
+            let path = dir.path().join(name);
+            let mut record = data.meta.to_record();
+            record.insert("frames".into(), frames.into());
+            let layout = layout(&data.meta);
+            let channel =
+                frame_channel(data.meta.frames.as_ref().unwrap(), &data.steps, &data.frames, &layout).unwrap();
+            write_messages_with(&path, &layout, record, &data.steps, Some(&channel)).unwrap();
+            read_dataset(&path).unwrap_err().to_string()
+        };
+        let err = write_claiming("big.mcap", r#"{"width": 100000, "height": 100000, "renderer": "x"}"#);
+        assert!(err.contains("'frames'") && err.contains("4096"), "{err}");
+        let err = write_claiming("other.mcap", r#"{"width": 2, "height": 4, "renderer": "x"}"#);
+        assert!(err.contains("/frames message 0") && err.contains("expected 2 × 4"), "{err}");
+        let err = write_claiming("garbled.mcap", "[1, 2]");
+        assert!(err.contains("'frames'"), "{err}");
+        // Frames declared but none stored.
+        let path = dir.path().join("none.mcap");
+        write_messages(&path, &layout(&data.meta), data.meta.to_record(), &data.steps).unwrap();
+        let err = read_dataset(&path).unwrap_err().to_string();
+        assert!(err.contains("0 frames for 3 states"), "{err}");
     }
 }

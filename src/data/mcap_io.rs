@@ -26,11 +26,35 @@ fn mcap_err(path: &Path, e: mcap::McapError) -> Error {
     Error::bad_file(path, format!("MCAP write failed: {e}"))
 }
 
+/// A second channel written beside the main one (a dataset's camera frames): pre-encoded messages, each with
+/// its log-clock time, merged into the file in time order.
+pub struct ExtraChannel<'a> {
+    pub topic: &'a str,
+    pub schema_name: &'a str,
+    pub schema: &'a str,
+    pub messages: Vec<(u64, Vec<u8>)>,
+}
+
 pub fn write_messages<T: Serialize>(
     path: &Path,
     layout: &Layout,
     metadata: BTreeMap<String, String>,
     messages: &[T],
+) -> Result<()> {
+    write_messages_with(path, layout, metadata, messages, None)
+}
+
+/// The log-clock time of main message `sequence`.
+pub fn message_clock(layout: &Layout, sequence: usize) -> u64 {
+    (sequence as u64 + 1) * layout.tick_ns.max(1)
+}
+
+pub fn write_messages_with<T: Serialize>(
+    path: &Path,
+    layout: &Layout,
+    metadata: BTreeMap<String, String>,
+    messages: &[T],
+    extra: Option<&ExtraChannel>,
 ) -> Result<()> {
     write_atomic_seekable(path, |file| {
         let options = mcap::WriteOptions::new()
@@ -46,8 +70,36 @@ pub fn write_messages<T: Serialize>(
             .map_err(|e| mcap_err(path, e))?;
         let channel =
             writer.add_channel(schema, layout.topic, "json", &BTreeMap::new()).map_err(|e| mcap_err(path, e))?;
+        let extra_channel = match extra {
+            Some(x) => {
+                let schema = writer
+                    .add_schema(x.schema_name, "jsonschema", x.schema.as_bytes())
+                    .map_err(|e| mcap_err(path, e))?;
+                Some(writer.add_channel(schema, x.topic, "json", &BTreeMap::new()).map_err(|e| mcap_err(path, e))?)
+            }
+            None => None,
+        };
+        let extra_messages: &[(u64, Vec<u8>)] = extra.map_or(&[], |x| &x.messages);
+        let mut next_extra = 0;
+        let mut write_extra_until = |writer: &mut mcap::Writer<_>, clock: u64| -> Result<()> {
+            while let (Some(id), Some((time, data))) = (extra_channel, extra_messages.get(next_extra)) {
+                if *time > clock {
+                    break;
+                }
+                let header = mcap::records::MessageHeader {
+                    channel_id: id,
+                    sequence: next_extra as u32,
+                    log_time: *time,
+                    publish_time: *time,
+                };
+                writer.write_to_known_channel(&header, data).map_err(|e| mcap_err(path, e))?;
+                next_extra += 1;
+            }
+            Ok(())
+        };
         for (sequence, message) in messages.iter().enumerate() {
-            let clock = (sequence as u64 + 1) * layout.tick_ns.max(1);
+            let clock = message_clock(layout, sequence);
+            write_extra_until(&mut writer, clock)?;
             let data = serde_json::to_vec(message).map_err(|e| Error::bad_file(path, e.to_string()))?;
             let header = mcap::records::MessageHeader {
                 channel_id: channel,
@@ -57,6 +109,7 @@ pub fn write_messages<T: Serialize>(
             };
             writer.write_to_known_channel(&header, &data).map_err(|e| mcap_err(path, e))?;
         }
+        write_extra_until(&mut writer, u64::MAX)?;
         writer.finish().map_err(|e| mcap_err(path, e))?;
         Ok(())
     })
@@ -71,6 +124,38 @@ pub fn read_messages<T: DeserializeOwned>(
     metadata_name: &str,
     topic: &str,
 ) -> Result<MetadataAndMessages<T>> {
+    let (metadata, mut topics) = read_raw(path, metadata_name, &[topic])?;
+    let messages = decode(path, topic, topics.remove(0))?;
+    Ok((metadata, messages))
+}
+
+/// Like [`read_messages`], plus the raw payloads of a second topic (in file order).
+pub fn read_messages_and_raw<T: DeserializeOwned>(
+    path: &Path,
+    metadata_name: &str,
+    topic: &str,
+    raw_topic: &str,
+) -> Result<(BTreeMap<String, String>, Vec<(u32, T)>, Vec<Vec<u8>>)> {
+    let (metadata, mut topics) = read_raw(path, metadata_name, &[topic, raw_topic])?;
+    let raw = topics.pop().unwrap_or_default().into_iter().map(|(_, data)| data).collect();
+    let messages = decode(path, topic, topics.pop().unwrap_or_default())?;
+    Ok((metadata, messages, raw))
+}
+
+fn decode<T: DeserializeOwned>(path: &Path, topic: &str, raw: Vec<(u32, Vec<u8>)>) -> Result<Vec<(u32, T)>> {
+    raw.into_iter()
+        .map(|(sequence, data)| {
+            serde_json::from_slice(&data)
+                .map(|value| (sequence, value))
+                .map_err(|e| Error::bad_file(path, format!("message {sequence} on {topic}: {e}")))
+        })
+        .collect()
+}
+
+type RawTopics = (BTreeMap<String, String>, Vec<Vec<(u32, Vec<u8>)>>);
+
+/// The named metadata record and the payloads of each of `topics`, with their sequence numbers.
+fn read_raw(path: &Path, metadata_name: &str, topics: &[&str]) -> Result<RawTopics> {
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
     let corrupt =
         |e: mcap::McapError| Error::bad_file(path, format!("not a readable MCAP file (truncated or corrupt?): {e}"));
@@ -89,17 +174,14 @@ pub fn read_messages<T: DeserializeOwned>(
         let found = if other_names.is_empty() { "none".to_string() } else { other_names.join(", ") };
         Error::bad_file(path, format!("expected a '{metadata_name}' metadata record, found {found}"))
     })?;
-    let mut messages = Vec::new();
+    let mut out = vec![Vec::new(); topics.len()];
     for message in mcap::MessageStream::new(&bytes).map_err(corrupt)? {
         let message = message.map_err(corrupt)?;
-        if message.channel.topic != topic {
-            continue;
+        if let Some(k) = topics.iter().position(|t| *t == message.channel.topic) {
+            out[k].push((message.sequence, message.data.into_owned()));
         }
-        let value: T = serde_json::from_slice(&message.data)
-            .map_err(|e| Error::bad_file(path, format!("message {} on {topic}: {e}", message.sequence)))?;
-        messages.push((message.sequence, value));
     }
-    Ok((metadata, messages))
+    Ok((metadata, out))
 }
 
 /// Reads the `format_version` field and rejects versions this build does not know.

@@ -21,3 +21,28 @@ pub const TIMESTEP_SCHEMA: &str = r#"{
     "next_obs": {"type": "array", "items": {"type": "number"}, "description": "observation after the step"}
   }
 }"#;
+
+/// Camera frames of a dataset's states, as Foxglove's CompressedImage (so its Image panel shows them) with the
+/// rollout and time step they belong to.
+pub const FRAME_SCHEMA_NAME: &str = "foxglove.CompressedImage";
+pub const FRAME_TOPIC: &str = "/frames";
+
+pub const FRAME_SCHEMA: &str = r#"{
+  "$schema": "https://json-schema.org/draft/2020-12/schema",
+  "title": "foxglove.CompressedImage",
+  "description": "A rendered frame of state s_t of a rollout (t = 0 … T: one more frame than transitions), PNG-encoded.",
+  "type": "object",
+  "required": ["timestamp", "frame_id", "data", "format", "rollout", "t"],
+  "properties": {
+    "timestamp": {
+      "type": "object",
+      "title": "time",
+      "properties": {"sec": {"type": "integer", "minimum": 0}, "nsec": {"type": "integer", "minimum": 0, "maximum": 999999999}}
+    },
+    "frame_id": {"type": "string"},
+    "data": {"type": "string", "contentEncoding": "base64", "description": "PNG bytes"},
+    "format": {"type": "string", "description": "always png"},
+    "rollout": {"type": "integer", "minimum": 0},
+    "t": {"type": "integer", "minimum": 0, "description": "the state's time step; t = T is the rollout's last next_state"}
+  }
+}"#;

@@ -163,8 +163,10 @@ pub fn episodes_dataset(
             action_dim: spec.action_dim(),
             dt: spec.dt,
             layout: DatasetLayout::Rollouts,
+            frames: None,
         },
         steps: episodes.iter().flat_map(|e| e.rollout.timesteps(e.episode as u32)).collect(),
+        frames: Vec::new(),
     }
 }
 

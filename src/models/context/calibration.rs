@@ -294,8 +294,10 @@ pub fn calibration_dataset(
             action_dim: spec.action_dim(),
             dt: spec.dt,
             layout: crate::data::DatasetLayout::Rollouts,
+            frames: None,
         },
         steps: calibration.rollout.timesteps(0).collect(),
+        frames: Vec::new(),
     })
 }
 

@@ -1,0 +1,50 @@
+//! `collect --images`: rendered frames of every state of a pendulum dataset (DLGPD's observations).
+
+use super::frames::FrameInfo;
+use super::Dataset;
+use crate::envs::pendulum::render::{PendulumRenderer, FRAME_BYTES, FRAME_SIZE};
+use crate::envs::EnvName;
+use crate::error::{Error, Result};
+use crate::run::Monitor;
+
+pub const PENDULUM_RENDERER: &str = "gym-pendulum";
+/// Frames held in memory before the file is written; beyond this the flags ask for too much.
+const MAX_FRAME_BYTES: f64 = 8.0 * (1u64 << 30) as f64;
+
+/// Refuses before any work when the frames of `states` states would not fit the budget.
+pub fn check_frames_size(env: &EnvName, states: f64) -> Result<()> {
+    if !matches!(env, EnvName::Pendulum(_)) {
+        return Err(Error::config(format!(
+            "--images renders the pendulum (pendulum[:variant]); '{}' has no renderer",
+            env.canonical()
+        )));
+    }
+    let bytes = states * FRAME_BYTES as f64;
+    if bytes > MAX_FRAME_BYTES {
+        return Err(Error::Budget(format!(
+            "--images: {states} frames would take {:.1} GiB in memory (limit {:.0} GiB); collect fewer rollouts or steps",
+            bytes / (1u64 << 30) as f64,
+            MAX_FRAME_BYTES / (1u64 << 30) as f64
+        )));
+    }
+    Ok(())
+}
+
+/// Renders θ (the first state dimension) of every state, t = 0 … T of each rollout, into `data.frames`.
+pub fn add_pendulum_frames(data: &mut Dataset, monitor: &dyn Monitor) -> Result<()> {
+    let rollouts = crate::data::Rollout::group(&data.steps)
+        .map_err(|i| Error::data(format!("message {i} does not continue its rollout")))?;
+    let mut renderer = PendulumRenderer::new();
+    let total = rollouts.len() as u64;
+    let mut frames = Vec::with_capacity(data.steps.len() + rollouts.len());
+    for (k, (_, rollout)) in rollouts.iter().enumerate() {
+        if monitor.is_cancelled() {
+            return Err(Error::Cancelled);
+        }
+        frames.extend(rollout.states.iter().map(|state| renderer.frame(state[0])));
+        monitor.progress("render frames", k as u64 + 1, total);
+    }
+    data.frames = frames;
+    data.meta.frames = Some(FrameInfo { width: FRAME_SIZE, height: FRAME_SIZE, renderer: PENDULUM_RENDERER.into() });
+    Ok(())
+}
