@@ -1,5 +1,6 @@
 pub mod ball;
 pub mod context;
+pub mod dlgpd;
 pub mod gp;
 pub mod pets;
 pub mod seads;

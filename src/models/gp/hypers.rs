@@ -106,10 +106,25 @@ impl GpHypers {
         targets: &[f64],
         prior_mean: &[f64],
     ) -> Result<(f64, ObjectiveGradients, ConditionedGp)> {
-        let gp = self.condition(inputs, targets, prior_mean)?;
+        self.objective_scaled(inputs, targets, prior_mean, 1.0)
+    }
+
+    /// [`GpHypers::objective`] with the kernel's outputscale multiplied by a constant `scale` (> 0), as when a
+    /// GP learned on standardized targets is evaluated on raw ones: the prior still applies to the unscaled
+    /// outputscale, and `scale` gets no gradient.
+    pub fn objective_scaled(
+        &self,
+        inputs: &[f64],
+        targets: &[f64],
+        prior_mean: &[f64],
+        scale: f64,
+    ) -> Result<(f64, ObjectiveGradients, ConditionedGp)> {
+        let mut kernel = self.kernel();
+        let outputscale = kernel.outputscale;
+        kernel.outputscale *= scale;
+        let gp = ConditionedGp::condition(inputs, targets, prior_mean, kernel, self.noise())?;
         let n = gp.len() as f64;
         let g = gp.gradients();
-        let outputscale = gp.kernel().outputscale;
         let (log_prior, d_log_prior) = match &self.outputscale_prior {
             Some(p) => (p.log_density(outputscale), p.d_log_density(outputscale)),
             None => (0.0, 0.0),
@@ -122,7 +137,8 @@ impl GpHypers {
                 .zip(&self.raw_lengthscales)
                 .map(|(d, &r)| d * self.lengthscale_constraint.slope(r) / n)
                 .collect(),
-            raw_outputscale: (g.outputscale - d_log_prior) * self.outputscale_constraint.slope(self.raw_outputscale)
+            raw_outputscale: (g.outputscale * scale - d_log_prior)
+                * self.outputscale_constraint.slope(self.raw_outputscale)
                 / n,
             raw_noise: g.noise * self.noise_constraint.slope(self.raw_noise) / n,
             inputs: g.inputs.iter().map(|d| d / n).collect(),
