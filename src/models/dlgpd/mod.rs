@@ -2,3 +2,4 @@
 //! processes, controlled with CEM and adapted to changed dynamics by swapping the GPs' evidence.
 
 pub mod latent_gp;
+pub mod vae;
