@@ -2,4 +2,5 @@
 //! processes, controlled with CEM and adapted to changed dynamics by swapping the GPs' evidence.
 
 pub mod latent_gp;
+pub mod loss;
 pub mod vae;
