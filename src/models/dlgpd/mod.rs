@@ -1,6 +1,7 @@
 //! DLGPD (thesis chapter 3): a VAE on pendulum images whose latent dynamics and reward are Gaussian
 //! processes, controlled with CEM and adapted to changed dynamics by swapping the GPs' evidence.
 
+pub mod data;
 pub mod latent_gp;
 pub mod loss;
 pub mod vae;
