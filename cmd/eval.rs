@@ -13,7 +13,7 @@ use mbrl::eval::dataset_report;
 use mbrl::eval::quick::run_quick;
 use mbrl::eval::seads::{compare_runs, seads_report, variant_label, ComparedRun, SeadsEvalSettings};
 use mbrl::eval::swingup::{self, SwingupSettings};
-use mbrl::models::ball::checkpoint::load_ball_model;
+use mbrl::models::ball::checkpoint::{load_ball_model, report_name};
 use mbrl::run::dir::Provenance;
 
 use crate::cem_args::CemArgs;
@@ -241,7 +241,7 @@ pub fn run(global: &GlobalArgs, args: EvalArgs) -> anyhow::Result<()> {
         }
         Protocol::Ball(a) => {
             let models =
-                a.model.iter().map(|m| Ok((m.clone(), load_ball_model(m)?))).collect::<anyhow::Result<Vec<_>>>()?;
+                a.model.iter().map(|m| Ok((report_name(m), load_ball_model(m)?))).collect::<anyhow::Result<Vec<_>>>()?;
             if a.train_shots == 0 || a.test_shots == 0 || a.unseen_shots == 0 {
                 bail!("--train-shots, --test-shots and --unseen-shots must be at least 1");
             }

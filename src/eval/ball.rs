@@ -336,7 +336,9 @@ fn report_markdown(settings: &BallEvalSettings, methods: &[Method], rows: &[Erro
          Train: {} default-pose shots + {} rotated copies each (baseline fitting). Test: {} default-pose shots and {} per unseen pose.\n\
          Protocol: filter until the horizon before the end (at least ten measurements), predict the rest; error = largest distance over the\n\
          last five prediction–measurement pairs. The ridge baseline maps the last 8 positions (relative to the newest) to displacements\n\
-         at every future frame; it is transparent, fast and strong on ballistic flight, and has no model of the bounce.\n\n\
+         at every future frame; it is transparent, fast and strong on ballistic flight, and has no model of the bounce.\n\
+         A model named `oracle` runs the thesis' Table C.1 parameters, which are the constants the simulator generates these shots\n\
+         with: it bounds what a perfectly learned EKF could reach here and is not a competitor.\n\n\
          | method | group | horizon [s] | n | 10 % [cm] | median [cm] | 90 % [cm] |\n|---|---|---|---|---|---|---|\n",
         settings.train_shots, settings.augment_rotations, settings.test_shots_default, settings.test_shots_unseen
     );

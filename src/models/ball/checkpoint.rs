@@ -35,6 +35,18 @@ impl LoadedBallModel {
 }
 
 /// Parses `--model`: a built-in name or a directory written by `mbrl train --method ball-ekf`.
+/// How reports name a model given as `spec`: the built-in `thesis` parameters (Table C.1) are the very
+/// constants the simulator generates its shots with, so on simulated shots that model is an oracle, not a
+/// competitor, and is named so.
+pub fn report_name(spec: &str) -> String {
+    match spec {
+        "thesis" => ORACLE_NAME.to_string(),
+        other => other.to_string(),
+    }
+}
+
+pub const ORACLE_NAME: &str = "oracle (simulator's constants)";
+
 pub fn load_ball_model(spec: &str) -> Result<LoadedBallModel> {
     let (params, spin_net) = match spec {
         "thesis" => (BallModelParams::thesis_learned(), None),
