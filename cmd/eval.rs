@@ -240,8 +240,11 @@ pub fn run(global: &GlobalArgs, args: EvalArgs) -> anyhow::Result<()> {
             println!("report: {}", a.out.join("report.md").display());
         }
         Protocol::Ball(a) => {
-            let models =
-                a.model.iter().map(|m| Ok((report_name(m), load_ball_model(m)?))).collect::<anyhow::Result<Vec<_>>>()?;
+            let models = a
+                .model
+                .iter()
+                .map(|m| Ok((report_name(m), load_ball_model(m)?)))
+                .collect::<anyhow::Result<Vec<_>>>()?;
             if a.train_shots == 0 || a.test_shots == 0 || a.unseen_shots == 0 {
                 bail!("--train-shots, --test-shots and --unseen-shots must be at least 1");
             }
