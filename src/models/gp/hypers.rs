@@ -7,6 +7,7 @@ use super::constraint::{GammaPrior, GreaterThan};
 use super::exact::ConditionedGp;
 use super::kernel::SeArd;
 use crate::error::{Error, Result};
+use crate::train::tensors::{StoredTensor, TensorData};
 
 /// Starting values and bounds (DLGPD, METHODS.md: lengthscales softplus(0), outputscale Var(y) with a lower
 /// bound 1e-2 and a Gamma(1, 5) prior, noise 0.2·Var(y) bounded below by 1e-3·Var(y)).
@@ -159,5 +160,67 @@ impl GpHypers {
         let d_signal = d_s * 0.5 / (signal * ln10) * self.outputscale_constraint.slope(self.raw_outputscale);
         let d_noise = -d_s * 0.5 / (noise * ln10) * self.noise_constraint.slope(self.raw_noise);
         (s.powi(8), d_signal, d_noise)
+    }
+}
+
+const RAW_NOISE: &str = "likelihood.noise_covar.raw_noise";
+const NOISE_LOWER: &str = "likelihood.noise_covar.raw_noise_constraint.lower_bound";
+const RAW_OUTPUTSCALE: &str = "covar_module.raw_outputscale";
+const OUTPUTSCALE_LOWER: &str = "covar_module.raw_outputscale_constraint.lower_bound";
+const RAW_LENGTHSCALE: &str = "covar_module.base_kernel.raw_lengthscale";
+
+impl GpHypers {
+    /// The entries GPyTorch's `state_dict` holds for this GP (an ExactGP with ScaleKernel(RBF, ARD) and a
+    /// Gaussian likelihood) under `prefix.`, the constraints' bounds included: they are set from the first
+    /// batch, so a loaded model needs them.
+    pub fn stored(&self, prefix: &str) -> Vec<StoredTensor> {
+        let name = |n: &str| format!("{prefix}.{n}");
+        vec![
+            StoredTensor::f64(name(RAW_NOISE), vec![1], vec![self.raw_noise]),
+            StoredTensor::f64(name(NOISE_LOWER), vec![], vec![self.noise_constraint.lower]),
+            StoredTensor::f64(name(RAW_OUTPUTSCALE), vec![], vec![self.raw_outputscale]),
+            StoredTensor::f64(name(OUTPUTSCALE_LOWER), vec![], vec![self.outputscale_constraint.lower]),
+            StoredTensor::f64(
+                name(RAW_LENGTHSCALE),
+                vec![1, self.raw_lengthscales.len()],
+                self.raw_lengthscales.clone(),
+            ),
+        ]
+    }
+
+    /// The GP `stored` wrote under `prefix`, over `dims` inputs, with the given outputscale prior.
+    pub fn from_stored(
+        prefix: &str,
+        tensors: &[StoredTensor],
+        dims: usize,
+        outputscale_prior: Option<GammaPrior>,
+    ) -> Result<GpHypers> {
+        let get = |n: &str, len: usize| -> Result<Vec<f64>> {
+            let full = format!("{prefix}.{n}");
+            let t = tensors
+                .iter()
+                .find(|t| t.name == full)
+                .ok_or_else(|| Error::data(format!("GP parameters lack '{full}'")))?;
+            match &t.data {
+                TensorData::F64(v) if v.len() == len && v.iter().all(|x| x.is_finite()) => Ok(v.clone()),
+                _ => Err(Error::data(format!("GP parameter '{full}': expected {len} finite f64 values"))),
+            }
+        };
+        let bound = |n: &str| -> Result<GreaterThan> {
+            let lower = get(n, 1)?[0];
+            if lower < 0.0 {
+                return Err(Error::data(format!("GP parameter '{prefix}.{n}' is {lower}; expected a bound ≥ 0")));
+            }
+            Ok(GreaterThan { lower })
+        };
+        Ok(GpHypers {
+            raw_lengthscales: get(RAW_LENGTHSCALE, dims)?,
+            raw_outputscale: get(RAW_OUTPUTSCALE, 1)?[0],
+            raw_noise: get(RAW_NOISE, 1)?[0],
+            lengthscale_constraint: GreaterThan { lower: 0.0 },
+            outputscale_constraint: bound(OUTPUTSCALE_LOWER)?,
+            noise_constraint: bound(NOISE_LOWER)?,
+            outputscale_prior,
+        })
     }
 }

@@ -196,3 +196,21 @@ fn the_objective_differentiates_through_constraints_and_prior() {
     assert!(hypers.noise() >= 0.9e-3);
     assert!(GpHypers::new(&HyperInit::dlgpd(4, 0.0)).is_err(), "zero target variance leaves no valid start");
 }
+
+#[test]
+fn hyperparameters_round_trip_through_a_checkpoint_under_gpytorch_names() {
+    let mut hypers = GpHypers::new(&HyperInit::dlgpd(4, 0.7)).unwrap();
+    hypers.raw_lengthscales = vec![0.1, -0.2, 0.3, 1.4];
+    let stored = hypers.stored("transition.gp_0");
+    assert!(stored.iter().any(|t| t.name == "transition.gp_0.covar_module.base_kernel.raw_lengthscale"));
+    let bytes = crate::train::tensors::to_bytes(&stored).unwrap();
+    let parsed = crate::train::tensors::parse(std::path::Path::new("m.safetensors"), &bytes).unwrap();
+    let back = GpHypers::from_stored("transition.gp_0", &parsed, 4, hypers.outputscale_prior).unwrap();
+    assert_eq!(back, hypers);
+    let e = GpHypers::from_stored("transition.gp_0", &parsed, 3, None).unwrap_err().to_string();
+    assert!(e.contains("raw_lengthscale") && e.contains("expected 3"), "{e}");
+    assert!(GpHypers::from_stored("reward", &parsed, 4, None).unwrap_err().to_string().contains("lack"));
+    let mut bad = stored.clone();
+    bad[1] = crate::train::tensors::StoredTensor::f64(bad[1].name.clone(), vec![], vec![-1.0]);
+    assert!(GpHypers::from_stored("transition.gp_0", &bad, 4, None).is_err());
+}
