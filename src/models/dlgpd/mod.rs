@@ -4,4 +4,5 @@
 pub mod data;
 pub mod latent_gp;
 pub mod loss;
+pub mod model;
 pub mod vae;

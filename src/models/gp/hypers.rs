@@ -23,13 +23,16 @@ pub struct HyperInit {
 }
 
 impl HyperInit {
-    /// DLGPD's settings for targets of variance `target_variance`.
+    /// DLGPD's settings for targets of variance `target_variance`. An outputscale below its bound (a first
+    /// batch whose targets barely vary, as an untrained encoder's can) starts at twice the bound instead,
+    /// where GPyTorch would refuse the value.
     pub fn dlgpd(dims: usize, target_variance: f64) -> HyperInit {
+        const OUTPUTSCALE_LOWER: f64 = 1e-2;
         HyperInit {
             dims,
             lengthscale: std::f64::consts::LN_2,
-            outputscale: target_variance,
-            outputscale_lower: 1e-2,
+            outputscale: target_variance.max(2.0 * OUTPUTSCALE_LOWER),
+            outputscale_lower: OUTPUTSCALE_LOWER,
             outputscale_prior: Some(GammaPrior { concentration: 1.0, rate: 5.0 }),
             noise: 0.2 * target_variance,
             noise_lower: 1e-3 * target_variance,
