@@ -2,6 +2,7 @@
 //! processes, controlled with CEM and adapted to changed dynamics by swapping the GPs' evidence.
 
 pub mod data;
+pub mod dynamics;
 pub mod latent_gp;
 pub mod loss;
 pub mod model;
