@@ -1,15 +1,14 @@
-//! DLGPD's training step, by parts, at the paper's batch of 1024 transitions: the GP terms (three transition
-//! GPs and the reward GP conditioned on the batch, exact f64 Cholesky, with every gradient) and the VAE's
-//! forward and backward pass (two encodings of 6 × 64 × 64 frames, one decoding). PyTorch reference for the
+//! DLGPD's training step at the paper's batch of 1024 transitions: the GP terms alone (three transition GPs
+//! and the reward GP conditioned on the batch, exact f64 Cholesky, with every gradient), and the whole step's
+//! loss and gradients (two encodings of 6 × 64 × 64 frames, one decoding, the GP terms injected, backward),
+//! without the optimizer update. PyTorch reference for the
 //! whole step on this kind of machine: 9.2 s at 2 threads (../shared/ARCHITECTURE.md).
 
-use burn::tensor::Tensor;
 use criterion::{criterion_group, criterion_main, Criterion};
 use mbrl::models::dlgpd::latent_gp::gp_terms;
-use mbrl::models::dlgpd::loss::{entropy_term, reconstruction_bce};
-use mbrl::models::dlgpd::vae::{ConvDecoder, ConvEncoder};
+use mbrl::models::dlgpd::model::{loss_and_gradients, sample_noise, Batch, Vae};
 use mbrl::models::gp::{GpHypers, HyperInit};
-use mbrl::nn::tensor::{tensor, training_device};
+use mbrl::nn::tensor::training_device;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -29,20 +28,14 @@ fn gp(c: &mut Criterion) {
         b.iter(|| gp_terms(&transition, &reward, &latents, &actions, &next, &rewards).unwrap())
     });
     let device = training_device();
-    let encoder = ConvEncoder::init(3, &device, &mut rng);
-    let decoder = ConvDecoder::init(3, &device, &mut rng);
+    let vae = Vae::init(3, &device, &mut rng);
     let pixels = BATCH * 6 * 64 * 64;
     let frames: Vec<f32> = (0..pixels).map(|i| ((i % 251) as f32) / 251.0).collect();
-    group.bench_function("vae_forward_backward", |b| {
-        b.iter(|| {
-            let obs: Tensor<4> = tensor(frames.clone(), [BATCH, 6, 64, 64], &device);
-            let next: Tensor<4> = tensor(frames.clone(), [BATCH, 6, 64, 64], &device);
-            let (mean, _) = encoder.forward(obs);
-            let (next_mean, next_std) = encoder.forward(next.clone());
-            let logits = decoder.forward(next_mean.clone() + next_std.clone());
-            let loss = reconstruction_bce(logits, next) + entropy_term(next_std) + mean.sum() * 0.0;
-            loss.backward()
-        })
+    let batch =
+        Batch { rows: BATCH, side: 64, obs: frames.clone(), next_obs: frames, actions, rewards: rewards.clone() };
+    let noise = sample_noise(BATCH, 3, &mut rng);
+    group.bench_function("whole_step_gradients_without_optimizer", |b| {
+        b.iter(|| loss_and_gradients(&vae, &transition, &reward, &batch, (&noise.0, &noise.1), &device).unwrap())
     });
     group.finish();
 }

@@ -53,6 +53,24 @@ fn bounds(values: impl Iterator<Item = f64>) -> (f64, f64) {
 
 type XyChart<'a, 'b> = ChartContext<'a, BitMapBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
+/// A white canvas with a title over the given ranges, its axes not yet drawn.
+fn titled_chart<'a, 'b>(
+    root: &'a DrawingArea<BitMapBackend<'b>, Shift>,
+    path: &Path,
+    title: &str,
+    x: std::ops::Range<f64>,
+    y: std::ops::Range<f64>,
+) -> Result<XyChart<'a, 'b>> {
+    root.fill(&WHITE).map_err(|e| plot_err(path, e))?;
+    ChartBuilder::on(root)
+        .caption(title, ("sans-serif", 24))
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d(x, y)
+        .map_err(|e| plot_err(path, e))
+}
+
 /// A white canvas with a title and labelled axes over the given ranges: the frame every x–y plot shares.
 fn xy_chart<'a, 'b>(
     root: &'a DrawingArea<BitMapBackend<'b>, Shift>,
@@ -62,14 +80,7 @@ fn xy_chart<'a, 'b>(
     x: std::ops::Range<f64>,
     y: std::ops::Range<f64>,
 ) -> Result<XyChart<'a, 'b>> {
-    root.fill(&WHITE).map_err(|e| plot_err(path, e))?;
-    let mut chart = ChartBuilder::on(root)
-        .caption(title, ("sans-serif", 24))
-        .margin(12)
-        .x_label_area_size(40)
-        .y_label_area_size(60)
-        .build_cartesian_2d(x, y)
-        .map_err(|e| plot_err(path, e))?;
+    let mut chart = titled_chart(root, path, title, x, y)?;
     chart.configure_mesh().x_desc(x_label).y_desc(y_label).draw().map_err(|e| plot_err(path, e))?;
     Ok(chart)
 }
@@ -192,14 +203,7 @@ pub fn box_plot(path: &Path, title: &str, x_label: &str, y_label: &str, groups: 
     let names: Vec<String> = groups.iter().map(|(name, _)| name.clone()).collect();
     render_atomic(path, |tmp| {
         let root = BitMapBackend::new(tmp, SIZE).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| plot_err(path, e))?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 24))
-            .margin(12)
-            .x_label_area_size(40)
-            .y_label_area_size(60)
-            .build_cartesian_2d(-0.5..n as f64 - 0.5, 0.0..y1.max(1.0))
-            .map_err(|e| plot_err(path, e))?;
+        let mut chart = titled_chart(&root, path, title, -0.5..n as f64 - 0.5, 0.0..y1.max(1.0))?;
         chart
             .configure_mesh()
             .x_labels(n)

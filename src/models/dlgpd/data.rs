@@ -100,24 +100,24 @@ impl FrameTransitions {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::data::collect::{collect_random, CollectSettings};
     use crate::data::collect_frames::add_pendulum_frames;
     use crate::envs::parse_env;
     use crate::run::NullMonitor;
 
-    fn dataset() -> Dataset {
-        let settings = CollectSettings {
-            env: parse_env("pendulum").unwrap(),
-            rollouts: 2,
-            steps: 5,
-            seed: 1,
-            command_line: "test".into(),
-        };
+    /// Random pendulum rollouts with their frames rendered.
+    pub(crate) fn rendered_pendulum(rollouts: usize, steps: usize, seed: u64) -> Dataset {
+        let env = parse_env("pendulum").unwrap();
+        let settings = CollectSettings { env, rollouts, steps, seed, command_line: "test".into() };
         let mut data = collect_random(&settings, &NullMonitor).unwrap();
         add_pendulum_frames(&mut data, &NullMonitor).unwrap();
         data
+    }
+
+    fn dataset() -> Dataset {
+        rendered_pendulum(2, 5, 1)
     }
 
     #[test]

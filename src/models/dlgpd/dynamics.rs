@@ -5,7 +5,7 @@
 //! predictions are unscaled, and the noise σ_d² is added once more in raw units to the predictive variance.
 //! The reward GP works on raw latents ⊕ actions with the smallest evidence reward as its prior mean.
 
-use super::latent_gp::LatentScale;
+use super::latent_gp::{latent_action_rows, LatentScale};
 use crate::error::{Error, Result};
 use crate::models::gp::{ConditionedGp, GpHypers};
 
@@ -61,7 +61,7 @@ impl LatentDynamics {
                 transition[d].condition(&inputs, &targets, &prior_mean)
             })
             .collect::<Result<Vec<_>>>()?;
-        let raw_inputs = raw_rows(evidence.latents, evidence.actions, dims, action_dim);
+        let raw_inputs = latent_action_rows(evidence.latents, evidence.actions, dims);
         let reward_floor = evidence.rewards.iter().copied().fold(f64::INFINITY, f64::min);
         let reward = reward.condition(&raw_inputs, evidence.rewards, &vec![reward_floor; rows])?;
         Ok(LatentDynamics { scale, transition, reward, reward_floor, action_dim })
@@ -100,19 +100,9 @@ impl LatentDynamics {
     pub fn reward_mean(&self, latents: &[f64], actions: &[f64]) -> Result<Vec<f64>> {
         let dims = self.latent_dim();
         let rows = latents.len() / dims;
-        let inputs = raw_rows(latents, actions, dims, self.action_dim);
+        let inputs = latent_action_rows(latents, actions, dims);
         Ok(self.reward.predict(&inputs, &vec![self.reward_floor; rows], false)?.mean)
     }
-}
-
-fn raw_rows(latents: &[f64], actions: &[f64], dims: usize, action_dim: usize) -> Vec<f64> {
-    let rows = latents.len() / dims;
-    let mut out = Vec::with_capacity(rows * (dims + action_dim));
-    for b in 0..rows {
-        out.extend_from_slice(&latents[b * dims..(b + 1) * dims]);
-        out.extend_from_slice(&actions[b * action_dim..(b + 1) * action_dim]);
-    }
-    out
 }
 
 #[cfg(test)]

@@ -47,14 +47,9 @@ impl LatentScale {
     /// [(s − m)/σ̂, a] per row.
     pub fn inputs(&self, latents: &[f64], actions: &[f64]) -> Vec<f64> {
         let dims = self.mean.len();
-        let rows = latents.len() / dims;
-        let action_dim = actions.len() / rows.max(1);
-        let mut out = Vec::with_capacity(rows * (dims + action_dim));
-        for b in 0..rows {
-            out.extend((0..dims).map(|c| (latents[b * dims + c] - self.mean[c]) / self.std[c]));
-            out.extend_from_slice(&actions[b * action_dim..(b + 1) * action_dim]);
-        }
-        out
+        let scaled: Vec<f64> =
+            latents.iter().enumerate().map(|(i, s)| (s - self.mean[i % dims]) / self.std[i % dims]).collect();
+        latent_action_rows(&scaled, actions, dims)
     }
 
     /// Pulls gradients on the standardized latents `d_scaled` (rows × dims) back to the raw latents, through
@@ -77,6 +72,18 @@ impl LatentScale {
         }
         out
     }
+}
+
+/// Rows of latent ⊕ action, the reward GP's inputs (raw, unstandardized).
+pub fn latent_action_rows(latents: &[f64], actions: &[f64], dims: usize) -> Vec<f64> {
+    let rows = latents.len() / dims.max(1);
+    let action_dim = actions.len() / rows.max(1);
+    let mut out = Vec::with_capacity(rows * (dims + action_dim));
+    for b in 0..rows {
+        out.extend_from_slice(&latents[b * dims..(b + 1) * dims]);
+        out.extend_from_slice(&actions[b * action_dim..(b + 1) * action_dim]);
+    }
+    out
 }
 
 /// The GP terms' value, its parts, and the gradients for the latents and every GP's raw hyperparameters.
@@ -167,12 +174,7 @@ fn terms_with_unscale(
     }
     let d_latents = scale.backward(latents, &d_inputs);
 
-    let reward_inputs: Vec<f64> = (0..rows)
-        .flat_map(|b| {
-            let a = actions.len() / rows;
-            latents[b * dims..(b + 1) * dims].iter().chain(&actions[b * a..(b + 1) * a]).copied().collect::<Vec<_>>()
-        })
-        .collect();
+    let reward_inputs = latent_action_rows(latents, actions, dims);
     let floor = rewards.iter().copied().fold(f64::INFINITY, f64::min);
     let (reward_value, mut g, gp) = reward.objective(&reward_inputs, rewards, &vec![floor; rows])?;
     jitter = jitter.max(gp.jitter());

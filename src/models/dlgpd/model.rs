@@ -148,25 +148,14 @@ mod tests {
     use rand_chacha::ChaCha8Rng;
 
     use super::*;
-    use crate::data::collect::{collect_random, CollectSettings};
-    use crate::data::collect_frames::add_pendulum_frames;
-    use crate::envs::parse_env;
+    use crate::models::dlgpd::data::tests::rendered_pendulum;
     use crate::models::dlgpd::data::FrameTransitions;
     use crate::nn::tensor::training_device;
     use crate::nn::{Adam, AdamConfig};
-    use crate::run::NullMonitor;
 
     #[test]
     fn a_few_adam_steps_lower_the_loss_on_one_batch() {
-        let settings = CollectSettings {
-            env: parse_env("pendulum").unwrap(),
-            rollouts: 4,
-            steps: 5,
-            seed: 2,
-            command_line: "test".into(),
-        };
-        let mut data = collect_random(&settings, &NullMonitor).unwrap();
-        add_pendulum_frames(&mut data, &NullMonitor).unwrap();
+        let data = rendered_pendulum(4, 5, 2);
         let frames = FrameTransitions::from_dataset(&data, 0).unwrap();
         let rows: Vec<usize> = (0..frames.len()).collect();
         let (obs, next_obs) = frames.observations(&rows);
