@@ -98,6 +98,9 @@ pub(crate) struct PhaseProgress {
     total: u64,
     /// The phase's first update, or the update at which its counter last went backwards.
     started: Instant,
+    /// The counter at `started`: a resumed run's phase starts part-way, and only what this process did
+    /// since then says how fast it goes.
+    done_at_start: u64,
     updated: Instant,
     /// When the console last printed this phase (its throttle); unused by the live view.
     reported: Option<Instant>,
@@ -116,7 +119,7 @@ impl PhaseProgress {
     /// `phase: done/total (pct) rate/s, ETA`, with the rate measured from this phase's own start.
     pub(crate) fn summary(&self) -> String {
         let elapsed = self.updated.duration_since(self.started).as_secs_f64();
-        format_progress(&self.name, self.done, self.total, elapsed)
+        format_progress(&self.name, self.done, self.total, self.done - self.done_at_start, elapsed)
     }
 }
 
@@ -154,7 +157,16 @@ impl PhaseTracker {
                 self.phases.remove(stalest);
             }
             let name = name.to_string();
-            self.phases.push(PhaseProgress { name, done, total, started: now, updated: now, reported: None, sequence });
+            self.phases.push(PhaseProgress {
+                name,
+                done,
+                total,
+                started: now,
+                done_at_start: done,
+                updated: now,
+                reported: None,
+                sequence,
+            });
             let change = PhaseChange { started: true, completed: is_complete(done, total) };
             return (self.phases.last_mut().expect("just pushed"), change);
         };
@@ -163,6 +175,7 @@ impl PhaseTracker {
         let started = done < phase.done;
         if started {
             phase.started = now;
+            phase.done_at_start = done;
         }
         let completed = is_complete(done, total) && (started || !is_complete(phase.done, phase.total));
         phase.done = done;
@@ -190,14 +203,15 @@ fn is_complete(done: u64, total: u64) -> bool {
     total > 0 && done >= total
 }
 
-/// `phase: done/total (pct) rate/s, ETA` as one line; shared by the console and the TUI. With (next to)
-/// no time elapsed there is no meaningful rate, so it is left out rather than shown as `0.0/s`.
-pub fn format_progress(phase: &str, done: u64, total: u64, elapsed_s: f64) -> String {
+/// `phase: done/total (pct) rate/s, ETA` as one line; shared by the console and the TUI. The rate is
+/// `progressed` (the units done in the `elapsed_s` measured) per second. With (next to) no time elapsed
+/// there is no meaningful rate, so it is left out rather than shown as `0.0/s`.
+pub fn format_progress(phase: &str, done: u64, total: u64, progressed: u64, elapsed_s: f64) -> String {
     let pct = if total > 0 { 100.0 * done as f64 / total as f64 } else { 0.0 };
     if elapsed_s.is_nan() || elapsed_s < MIN_RATE_ELAPSED_S {
         return format!("{phase}: {done}/{total} ({pct:.0}%)");
     }
-    let rate = done as f64 / elapsed_s;
+    let rate = progressed as f64 / elapsed_s;
     let eta = if rate > 0.0 && total > done {
         format!(", ETA {}", format_duration((total - done) as f64 / rate))
     } else {
@@ -351,17 +365,26 @@ mod tests {
 
     #[test]
     fn progress_line_reports_rate_and_eta() {
-        let line = format_progress("mpc", 50, 150, 10.0);
+        let line = format_progress("mpc", 50, 150, 50, 10.0);
         assert_eq!(line, "mpc: 50/150 (33%) 5.0/s, ETA 20s");
     }
 
     #[test]
+    fn a_phase_that_starts_part_way_is_timed_from_where_it_started() {
+        let mut tracker = PhaseTracker::default();
+        let t0 = Instant::now();
+        tracker.update("env steps", 4_000, 10_000, t0);
+        let (phase, _) = tracker.update("env steps", 4_100, 10_000, t0 + std::time::Duration::from_secs(10));
+        assert_eq!(phase.summary(), "env steps: 4100/10000 (41%) 10.0/s, ETA 9m50s");
+    }
+
+    #[test]
     fn no_rate_without_elapsed_time() {
-        assert_eq!(format_progress("episodes", 0, 3, 0.0), "episodes: 0/3 (0%)");
-        assert_eq!(format_progress("episodes", 3, 3, 0.0002), "episodes: 3/3 (100%)");
-        assert_eq!(format_progress("episodes", 1, 3, f64::NAN), "episodes: 1/3 (33%)");
-        assert_eq!(format_progress("episodes", 0, 3, 5.0), "episodes: 0/3 (0%) 0.0/s");
-        assert_eq!(format_progress("episodes", 3, 3, 0.002), "episodes: 3/3 (100%) 1500.0/s");
+        assert_eq!(format_progress("episodes", 0, 3, 0, 0.0), "episodes: 0/3 (0%)");
+        assert_eq!(format_progress("episodes", 3, 3, 3, 0.0002), "episodes: 3/3 (100%)");
+        assert_eq!(format_progress("episodes", 1, 3, 1, f64::NAN), "episodes: 1/3 (33%)");
+        assert_eq!(format_progress("episodes", 0, 3, 0, 5.0), "episodes: 0/3 (0%) 0.0/s");
+        assert_eq!(format_progress("episodes", 3, 3, 3, 0.002), "episodes: 3/3 (100%) 1500.0/s");
     }
 
     #[test]
@@ -381,8 +404,8 @@ mod tests {
             shown,
             vec![
                 "episodes: 3/3 (100%) 0.1/s",
-                "episode 2 MPC: 10/10 (100%) 1.1/s",
-                "episode 3 MPC: 10/10 (100%) 1.1/s",
+                "episode 2 MPC: 10/10 (100%) 1.0/s",
+                "episode 3 MPC: 10/10 (100%) 1.0/s",
             ]
         );
     }
@@ -403,7 +426,7 @@ mod tests {
         let (outer, _) = phases.update("outer", 3, 4, at(30));
         assert_eq!(outer.summary(), "outer: 3/4 (75%) 0.1/s, ETA 10s");
         let (inner, _) = phases.update("inner", 4, 10, at(22));
-        assert_eq!(inner.summary(), "inner: 4/10 (40%) 2.0/s, ETA 3s");
+        assert_eq!(inner.summary(), "inner: 4/10 (40%) 1.0/s, ETA 6s");
     }
 
     #[test]
@@ -461,14 +484,14 @@ mod tests {
             vec![
                 "episodes: 0/2 (0%)",
                 "episode 1 MPC: 1/150 (1%)",
-                "episode 1 MPC: 51/150 (34%) 51.0/s, ETA 2s",
-                "episode 1 MPC: 101/150 (67%) 50.5/s, ETA 1s",
-                "episode 1 MPC: 150/150 (100%) 50.3/s",
+                "episode 1 MPC: 51/150 (34%) 50.0/s, ETA 2s",
+                "episode 1 MPC: 101/150 (67%) 50.0/s, ETA 1s",
+                "episode 1 MPC: 150/150 (100%) 50.0/s",
                 "episodes: 1/2 (50%) 0.3/s, ETA 3s",
                 "episode 2 MPC: 1/150 (1%)",
-                "episode 2 MPC: 51/150 (34%) 51.0/s, ETA 2s",
-                "episode 2 MPC: 101/150 (67%) 50.5/s, ETA 1s",
-                "episode 2 MPC: 150/150 (100%) 50.3/s",
+                "episode 2 MPC: 51/150 (34%) 50.0/s, ETA 2s",
+                "episode 2 MPC: 101/150 (67%) 50.0/s, ETA 1s",
+                "episode 2 MPC: 150/150 (100%) 50.0/s",
                 "episodes: 2/2 (100%) 0.3/s",
             ]
         );

@@ -297,7 +297,7 @@ mod tests {
         app.ingest_at(&Event::progress("eval", 20, 20), t0 + Duration::from_secs(30));
         app.ingest_at(&Event::progress("eval", 4, 20), t0 + Duration::from_secs(40));
         app.ingest_at(&Event::progress("eval", 8, 20), t0 + Duration::from_secs(42));
-        assert_eq!(summaries(&app), vec!["train: 50/150 (33%) 5.0/s, ETA 20s", "eval: 8/20 (40%) 4.0/s, ETA 3s"]);
+        assert_eq!(summaries(&app), vec!["train: 50/150 (33%) 5.0/s, ETA 20s", "eval: 8/20 (40%) 2.0/s, ETA 6s"]);
     }
 
     #[test]
@@ -319,8 +319,8 @@ mod tests {
             summaries(&app),
             vec![
                 "episodes: 3/3 (100%) 0.3/s",
-                "episode 2 MPC: 150/150 (100%) 50.3/s",
-                "episode 3 MPC: 150/150 (100%) 50.3/s"
+                "episode 2 MPC: 150/150 (100%) 50.0/s",
+                "episode 3 MPC: 150/150 (100%) 50.0/s"
             ]
         );
     }
