@@ -5,8 +5,10 @@
 //! whole step on this kind of machine: 9.2 s at 2 threads (../shared/ARCHITECTURE.md).
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use mbrl::models::dlgpd::data::ObservationKind;
 use mbrl::models::dlgpd::latent_gp::gp_terms;
-use mbrl::models::dlgpd::model::{loss_and_gradients, sample_noise, Batch, Vae};
+use mbrl::models::dlgpd::model::{loss_and_gradients, sample_noise, Batch, Gradients};
+use mbrl::models::dlgpd::vae::VaeNet;
 use mbrl::models::gp::{GpHypers, HyperInit};
 use mbrl::nn::tensor::training_device;
 use rand::{Rng, SeedableRng};
@@ -28,14 +30,16 @@ fn gp(c: &mut Criterion) {
         b.iter(|| gp_terms(&transition, &reward, &latents, &actions, &next, &rewards).unwrap())
     });
     let device = training_device();
-    let vae = Vae::init(3, &device, &mut rng);
+    let vae = VaeNet::init(ObservationKind::Images { side: 64 }, 3, 0, &device, &mut rng).unwrap();
     let pixels = BATCH * 6 * 64 * 64;
     let frames: Vec<f32> = (0..pixels).map(|i| ((i % 251) as f32) / 251.0).collect();
-    let batch =
-        Batch { rows: BATCH, side: 64, obs: frames.clone(), next_obs: frames, actions, rewards: rewards.clone() };
+    let batch = Batch { rows: BATCH, obs: frames.clone(), next_obs: frames, actions, rewards: rewards.clone() };
     let noise = sample_noise(BATCH, 3, &mut rng);
     group.bench_function("whole_step_gradients_without_optimizer", |b| {
-        b.iter(|| loss_and_gradients(&vae, &transition, &reward, &batch, (&noise.0, &noise.1), &device).unwrap())
+        b.iter(|| {
+            loss_and_gradients(&vae, &transition, &reward, &batch, (&noise.0, &noise.1), Gradients::Wanted, &device)
+                .unwrap()
+        })
     });
     group.finish();
 }

@@ -9,6 +9,8 @@ use mbrl::models::ball::learn::job::{self as ball_job, BallTrainReport, BallTrai
 use mbrl::models::ball::learn::TrainSettings;
 use mbrl::models::ball::BallModelParams;
 use mbrl::models::context::{self, ContextConfig};
+use mbrl::models::dlgpd::config::{DlgpdConfig, Preset as DlgpdPreset};
+use mbrl::models::dlgpd::job as dlgpd;
 use mbrl::models::pets::{self, PetsConfig, Preset, RewardSource};
 use mbrl::models::seads::{self, EmbodiedGame, SeadsConfig};
 use mbrl::run::dir::{Provenance, METRICS_FILE};
@@ -33,6 +35,10 @@ pub enum Method {
     /// embodied board game (--env lightsout:cursor|tileswap:cursor|lightsout:reacher|tileswap:reacher); needs no
     /// --data, it collects its own episodes.
     Seads,
+    /// DLGPD (thesis ch. 3): a VAE on pendulum frames (`collect --images`) with Gaussian-process latent
+    /// dynamics and reward; plan with `mbrl plan --model DIR --evidence E.mcap`. The small preset learns from
+    /// the pole angle instead of frames.
+    Dlgpd,
 }
 
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
@@ -41,7 +47,7 @@ pub enum PresetChoice {
     Small,
     /// 4 × 200 SiLU units, 5000 steps: mbrl-lib's PETS pendulum network.
     Medium,
-    /// Context model only: Table B.1 (toy 50k steps, pendulum and MountainCar 100k at batch 512).
+    /// The paper's scale (context: Table B.1; seads: 500k/10M env steps; dlgpd: batch 1024, 28 000 steps).
     Paper,
 }
 
@@ -67,6 +73,10 @@ Examples:
   mbrl train --method context --data datasets/toy-inner.mcap --preset small --out models/context-toy-inner
   mbrl train --method seads --env tileswap:cursor --preset small --out models/seads-tileswap-cursor
   mbrl train --method seads --env lightsout:cursor --preset medium --no-novelty --out models/seads-lo-nonov
+  mbrl collect --env pendulum --rollouts 500 --steps 29 --out datasets/pendulum-dlgpd.mcap
+  mbrl train --method dlgpd --data datasets/pendulum-dlgpd.mcap --preset small --out models/dlgpd-small
+  mbrl collect --env pendulum --images --rollouts 500 --steps 29 --out datasets/pendulum-frames.mcap
+  mbrl train --method dlgpd --data datasets/pendulum-frames.mcap --preset medium --out models/dlgpd-medium
 
 A config file (TOML) sets any key of the method's config.json `config` table; unknown keys are errors.
 Flags given explicitly override the file. `--resume DIR` continues a stopped run from its last checkpoint
@@ -91,19 +101,20 @@ pub struct TrainArgs {
     /// Hyperparameters from a TOML file (pets, context), over the preset's.
     #[arg(long)]
     config: Option<PathBuf>,
-    /// Network size and training length (pets: small, medium; context: small, medium, paper).
+    /// Network size and training length (pets: small, medium; context, seads, dlgpd: small, medium, paper).
     #[arg(long, value_enum)]
     preset: Option<PresetChoice>,
     /// Ensemble members (pets; default 5).
     #[arg(long)]
     ensemble: Option<usize>,
-    /// Optimizer steps (pets: preset's; ball-ekf: 1000).
+    /// Optimizer steps (pets, context, dlgpd: the preset's; ball-ekf: 1000).
     #[arg(long)]
     steps: Option<u64>,
-    /// Batch size: transitions per member (pets, 256) or chunks (ball-ekf, thesis 64).
+    /// Batch size: transitions per member (pets, 256), chunks (ball-ekf, thesis 64), transitions (dlgpd: the
+    /// preset's; the paper 1024).
     #[arg(long)]
     batch: Option<usize>,
-    /// Adam learning rate (pets: 1e-3; ball-ekf: thesis 5e-3).
+    /// Adam learning rate (pets, dlgpd: 1e-3; ball-ekf: thesis 5e-3).
     #[arg(long, value_parser = crate::common::finite_f64)]
     lr: Option<f64>,
     /// Where the model's reward comes from (pets; default: known where the env has a closed form).
@@ -144,6 +155,7 @@ pub fn run(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
         Method::BallEkf => train_ball(global, args),
         Method::Context => train_context(global, args),
         Method::Seads => train_seads(global, args),
+        Method::Dlgpd => train_dlgpd(global, args),
     }
 }
 
@@ -166,13 +178,18 @@ fn resume(global: &GlobalArgs, dir: &Path) -> anyhow::Result<()> {
             let report = run_job(global, "train seads (resumed)", |monitor| seads::resume(dir, monitor))?;
             print_seads_report(&report, dir)
         }
+        dlgpd::METHOD => {
+            let report = run_job(global, "train dlgpd (resumed)", |monitor| dlgpd::resume(dir, monitor))?;
+            print_dlgpd_report(&report, dir)
+        }
         other => bail!(
-            "{}: '{other}' runs cannot be resumed; resumable methods: {}, {}, {}, {}",
+            "{}: '{other}' runs cannot be resumed; resumable methods: {}, {}, {}, {}, {}",
             dir.display(),
             pets::METHOD,
             ball_job::METHOD,
             context::METHOD,
-            seads::METHOD
+            seads::METHOD,
+            dlgpd::METHOD
         ),
     }
 }
@@ -503,6 +520,92 @@ fn print_seads_report(report: &seads::TrainReport, out: &Path) -> anyhow::Result
         last.model_loss,
         last.mean_final_reward.map(|r| format!("; mean intrinsic reward {r:.3}")).unwrap_or_default()
     );
+    println!("checkpoint: {}", out.display());
+    Ok(())
+}
+
+fn dlgpd_config(args: &TrainArgs) -> anyhow::Result<DlgpdConfig> {
+    for (flag, given) in [
+        ("--ensemble", args.ensemble.is_some()),
+        ("--reward", args.reward.is_some()),
+        ("--launcher-prior", args.launcher_prior),
+        ("--skills", args.skills.is_some()),
+        ("--env-steps", args.env_steps.is_some()),
+        ("--no-relabel", args.no_relabel),
+        ("--no-second-best", args.no_second_best),
+        ("--no-novelty", args.no_novelty),
+    ] {
+        if given {
+            bail!(
+                "{flag} does not apply to dlgpd; it takes --data, --env, --out, --preset, --config, --steps, --batch, --lr"
+            );
+        }
+    }
+    let preset = match args.preset.unwrap_or(PresetChoice::Small) {
+        PresetChoice::Small => DlgpdPreset::Small,
+        PresetChoice::Medium => DlgpdPreset::Medium,
+        PresetChoice::Paper => DlgpdPreset::Paper,
+    };
+    let mut config = DlgpdConfig::preset(preset);
+    if let Some(path) = &args.config {
+        config = apply_toml_file(&config, path)?;
+    }
+    if let Some(n) = args.steps {
+        config.steps = n;
+    }
+    if let Some(n) = args.batch {
+        config.batch_size = n;
+    }
+    if let Some(lr) = args.lr {
+        config.learning_rate = lr;
+    }
+    config.validate()?;
+    Ok(config)
+}
+
+fn train_dlgpd(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
+    let config = dlgpd_config(&args)?;
+    if args.data.is_empty() {
+        bail!("dlgpd needs --data: pendulum rollouts (`mbrl collect --env pendulum [--images]`)");
+    }
+    let out = args.out.clone().unwrap_or_else(|| PathBuf::from("models/dlgpd-pendulum"));
+    let request = dlgpd::TrainRequest {
+        out: out.clone(),
+        data: args.data.clone(),
+        env: args.env.clone(),
+        config,
+        seed: global.seed,
+        provenance: Provenance::new(command_line(), global.seed, global.thread_count()),
+    };
+    let report = run_job(global, "train dlgpd", |monitor| dlgpd::train(&request, false, monitor))?;
+    print_dlgpd_report(&report, &out)
+}
+
+fn print_dlgpd_report(report: &dlgpd::TrainReport, out: &Path) -> anyhow::Result<()> {
+    write_loss_report(out, "DLGPD training loss (eq. 3.16 with the SNR penalty, per batch)", "loss")?;
+    let run = &report.run;
+    let c = &run.config;
+    let observed = match run.observation {
+        mbrl::models::dlgpd::data::ObservationKind::Images { side } => format!("{side}×{side} frames (conv VAE)"),
+        mbrl::models::dlgpd::data::ObservationKind::Angles => "pole angles (MLP VAE, small preset)".to_string(),
+    };
+    println!(
+        "trained DLGPD ({} parameters, latent {}) on {} transitions of {} from {observed} ({} rollouts; {} held out), batch {}",
+        report.parameters,
+        c.latent_dim,
+        run.transitions.train,
+        run.env,
+        run.transitions.train_rollouts,
+        run.transitions.valid_rollouts,
+        c.batch_size
+    );
+    let o = &report.outcome;
+    if let Some(loss) = o.last_train_loss {
+        println!("final training loss {loss:.3} after {} steps", o.steps);
+    }
+    if let (Some(step), Some(v)) = (o.best_step, o.best_valid_loss) {
+        println!("best validation loss {v:.3} at step {step} (saved as model.safetensors)");
+    }
     println!("checkpoint: {}", out.display());
     Ok(())
 }

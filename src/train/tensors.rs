@@ -50,6 +50,13 @@ impl StoredTensor {
 
 /// Serializes tensors (names must be unique) to safetensors bytes.
 pub fn to_bytes(tensors: &[StoredTensor]) -> Result<Vec<u8>> {
+    let mut names = std::collections::HashSet::new();
+    if let Some(t) = tensors.iter().find(|t| !names.insert(t.name.as_str())) {
+        return Err(Error::config(format!(
+            "two tensors are named '{}'; a safetensors file needs distinct names",
+            t.name
+        )));
+    }
     let raw: Vec<(String, Dtype, Vec<usize>, Vec<u8>)> = tensors
         .iter()
         .map(|t| {
@@ -152,6 +159,13 @@ mod tests {
         assert_eq!(back.len(), 2);
         assert_eq!(back[0].name, "a");
         assert_eq!(back[1], tensors[0]);
+    }
+
+    #[test]
+    fn two_tensors_of_one_name_are_an_error_not_a_panic() {
+        let step = || StoredTensor::f64("adam.step", vec![1], vec![3.0]);
+        let e = to_bytes(&[step(), step()]).unwrap_err().to_string();
+        assert!(e.contains("adam.step"), "{e}");
     }
 
     #[test]

@@ -1,9 +1,12 @@
 //! DLGPD (thesis chapter 3): a VAE on pendulum images whose latent dynamics and reward are Gaussian
 //! processes, controlled with CEM and adapted to changed dynamics by swapping the GPs' evidence.
 
+pub mod config;
 pub mod data;
 pub mod dynamics;
+pub mod job;
 pub mod latent_gp;
 pub mod loss;
 pub mod model;
+pub mod train;
 pub mod vae;

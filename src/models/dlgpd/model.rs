@@ -2,36 +2,21 @@
 //! next observation, add the GP terms (f64, outside the graph) through gradient injection, and backpropagate
 //! into the VAE; the GP hyperparameters get their gradients from the GP terms directly.
 
-use burn::module::Module;
 use burn::tensor::{Device, Tensor};
 use rand::Rng;
 use rand_distr::StandardNormal;
 
 use super::latent_gp::{gp_terms, GpTerms, LatentScale};
-use super::loss::{entropy_term, injected, reconstruction_bce};
-use super::vae::{ConvDecoder, ConvEncoder, FRAME_CHANNELS};
+use super::loss::{entropy_term, injected};
+use super::vae::VaeNet;
 use crate::error::{Error, Result};
 use crate::models::gp::{GpHypers, HyperInit, ObjectiveGradients};
 use crate::nn::tensor::{scalar, tensor, values};
-use crate::nn::ParamSet;
 
-#[derive(Module, Debug)]
-pub struct Vae {
-    pub encoder: ConvEncoder,
-    pub decoder: ConvDecoder,
-}
-
-impl Vae {
-    pub fn init<R: Rng + ?Sized>(latent: usize, device: &Device, rng: &mut R) -> Vae {
-        Vae { encoder: ConvEncoder::init(latent, device, rng), decoder: ConvDecoder::init(latent, device, rng) }
-    }
-}
-
-/// A batch of transitions: observations and next observations [rows, 6, side, side], actions [rows, A],
-/// rewards [rows].
+/// A batch of transitions: observations and next observations as rows of the VAE's input (for images
+/// [rows, 6, side, side] flattened), actions [rows, A], rewards [rows].
 pub struct Batch {
     pub rows: usize,
-    pub side: usize,
     pub obs: Vec<f32>,
     pub next_obs: Vec<f32>,
     pub actions: Vec<f64>,
@@ -44,7 +29,7 @@ pub struct StepLoss {
     pub reconstruction: f64,
     pub entropy: f64,
     pub gp: GpTerms,
-    /// In the order of `ParamSet::from_module(vae)`.
+    /// In the order of `VaeNet::params`; empty when gradients were not asked for.
     pub vae_gradients: Vec<Vec<f32>>,
 }
 
@@ -82,26 +67,35 @@ pub fn sample_noise<R: Rng + ?Sized>(rows: usize, latent: usize, rng: &mut R) ->
     (current, draw())
 }
 
-/// Loss and gradients of one batch. `noise` = the standard-normal draws of the current and next latents.
+/// Whether a loss evaluation also backpropagates (training) or not (validation).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Gradients {
+    Wanted,
+    NotWanted,
+}
+
+/// Loss (and, when wanted, gradients) of one batch. `noise` = the standard-normal draws of the current and
+/// next latents.
 pub fn loss_and_gradients(
-    vae: &Vae,
+    vae: &VaeNet,
     transition: &[GpHypers],
     reward: &GpHypers,
     batch: &Batch,
     noise: (&[f32], &[f32]),
+    gradients: Gradients,
     device: &Device,
 ) -> Result<StepLoss> {
     let latent = transition.len();
-    let shape = [batch.rows, FRAME_CHANNELS, batch.side, batch.side];
-    let obs: Tensor<4> = tensor(batch.obs.clone(), shape, device);
-    let next: Tensor<4> = tensor(batch.next_obs.clone(), shape, device);
-    let (mean, std) = vae.encoder.forward(obs);
-    let (next_mean, next_std) = vae.encoder.forward(next.clone());
+    let width = batch.obs.len() / batch.rows.max(1);
+    let obs: Tensor<2> = tensor(batch.obs.clone(), [batch.rows, width], device);
+    let next: Tensor<2> = tensor(batch.next_obs.clone(), [batch.rows, width], device);
+    let (mean, std) = vae.encode(obs);
+    let (next_mean, next_std) = vae.encode(next.clone());
     let eps = tensor(noise.0.to_vec(), [batch.rows, latent], device);
     let next_eps = tensor(noise.1.to_vec(), [batch.rows, latent], device);
     let sample = mean + std * eps;
     let next_sample = next_mean + next_std.clone() * next_eps;
-    let reconstruction = reconstruction_bce(vae.decoder.forward(next_sample.clone()), next);
+    let reconstruction = vae.reconstruction(next_sample.clone(), next);
     let entropy = entropy_term(next_std);
     let as_f64 = |t: &Tensor<2>| values(t).into_iter().map(f64::from).collect::<Vec<f64>>();
     let (s, s_next) = (as_f64(&sample), as_f64(&next_sample));
@@ -116,8 +110,10 @@ pub fn loss_and_gradients(
             gp.value
         )));
     }
-    let grads = loss.backward();
-    let vae_gradients = ParamSet::<f32>::gradients(vae, &grads);
+    let vae_gradients = match gradients {
+        Gradients::Wanted => vae.gradients(&loss.backward()),
+        Gradients::NotWanted => Vec::new(),
+    };
     Ok(StepLoss { total, reconstruction: reconstruction_value, entropy: entropy_value, gp, vae_gradients })
 }
 
@@ -149,28 +145,23 @@ mod tests {
 
     use super::*;
     use crate::models::dlgpd::data::tests::rendered_pendulum;
-    use crate::models::dlgpd::data::FrameTransitions;
+    use crate::models::dlgpd::data::{ObservationKind, Windows};
     use crate::nn::tensor::training_device;
     use crate::nn::{Adam, AdamConfig};
 
     #[test]
     fn a_few_adam_steps_lower_the_loss_on_one_batch() {
         let data = rendered_pendulum(4, 5, 2);
-        let frames = FrameTransitions::from_dataset(&data, 0).unwrap();
+        let kind = ObservationKind::Images { side: 64 };
+        let frames = Windows::from_dataset(&data, kind, 0).unwrap();
         let rows: Vec<usize> = (0..frames.len()).collect();
         let (obs, next_obs) = frames.observations(&rows);
-        let batch = Batch {
-            rows: rows.len(),
-            side: frames.side,
-            obs,
-            next_obs,
-            actions: frames.actions.iter().map(|&a| a as f64).collect(),
-            rewards: frames.rewards.iter().map(|&r| r as f64).collect(),
-        };
+        let (actions, rewards) = frames.actions_and_rewards(&rows);
+        let batch = Batch { rows: rows.len(), obs, next_obs, actions, rewards };
         let device = training_device();
         let mut rng = ChaCha8Rng::seed_from_u64(5);
-        let mut vae = Vae::init(3, &device, &mut rng);
-        let mut params = ParamSet::<f32>::from_module(&vae, |n| n.to_string());
+        let mut vae = VaeNet::init(kind, 3, 0, &device, &mut rng).unwrap();
+        let mut params = vae.params();
         let sizes: Vec<usize> = params.tensors.iter().map(|t| t.values.len()).collect();
         let adam_config = |lr| AdamConfig {
             learning_rate: lr,
@@ -184,8 +175,9 @@ mod tests {
         // Fixed noise, so the loss changes only through the parameters.
         let noise = sample_noise(batch.rows, 3, &mut rng);
         let first = {
-            let (mean, _) = vae.encoder.forward(tensor(batch.obs.clone(), [batch.rows, 6, 64, 64], &device));
-            let (next_mean, _) = vae.encoder.forward(tensor(batch.next_obs.clone(), [batch.rows, 6, 64, 64], &device));
+            let width = kind.input_len();
+            let (mean, _) = vae.encode(tensor(batch.obs.clone(), [batch.rows, width], &device));
+            let (next_mean, _) = vae.encode(tensor(batch.next_obs.clone(), [batch.rows, width], &device));
             let f = |t: Tensor<2>| values(&t).into_iter().map(f64::from).collect::<Vec<f64>>();
             init_hypers(&f(mean), &f(next_mean), &batch.rewards, 1).unwrap()
         };
@@ -194,11 +186,20 @@ mod tests {
             (0..4).map(|_| Adam::<f64>::new(adam_config(1e-2), &[raw_vector(&reward).len()])).collect();
         let mut losses = Vec::new();
         for _ in 0..8 {
-            let step = loss_and_gradients(&vae, &transition, &reward, &batch, (&noise.0, &noise.1), &device).unwrap();
+            let step = loss_and_gradients(
+                &vae,
+                &transition,
+                &reward,
+                &batch,
+                (&noise.0, &noise.1),
+                Gradients::Wanted,
+                &device,
+            )
+            .unwrap();
             losses.push(step.total);
             let mut grads = step.vae_gradients;
             vae_adam.update(&mut params.values_mut(), &mut grads).unwrap();
-            vae = params.load_into(vae, &device).unwrap();
+            vae = vae.with_params(&params, &device).unwrap();
             for (k, g) in step.gp.d_hypers.iter().enumerate() {
                 let h = if k < 3 { &mut transition[k] } else { &mut reward };
                 let mut v = raw_vector(h);

@@ -1,0 +1,406 @@
+//! DLGPD on the shared training loop: each step draws a batch of transitions, which is also the GPs'
+//! training set, and takes one step of each of the authors' three Adams (VAE, transition GPs, reward GP;
+//! Adam is elementwise, so one Adam over the GP vectors is the same). The GPs start from the first batch's
+//! latents. A checkpoint's weights carry the latent standardization that planning freezes: the statistics of
+//! the encoder's samples on (at most) 1024 training transitions, as the authors' planning code takes them.
+
+use burn::tensor::Device;
+use rand::seq::index::sample;
+use rand::Rng;
+use rand_distr::StandardNormal;
+
+use super::config::DlgpdConfig;
+use super::data::Windows;
+use super::latent_gp::LatentScale;
+use super::model::{
+    init_hypers, loss_and_gradients, raw_gradient, raw_vector, sample_noise, set_raw_vector, Batch, Gradients, StepLoss,
+};
+use super::vae::VaeNet;
+use crate::error::{Error, Result};
+use crate::models::gp::{GpHypers, HyperInit};
+use crate::nn::params::NamedTensor;
+use crate::nn::tensor::{tensor, training_device, values};
+use crate::nn::{Adam, AdamConfig, ParamSet};
+use crate::train::tensors::TensorData;
+use crate::train::{state, StoredTensor, TrainingMethod};
+use crate::util::seeding::rng_for;
+
+const INIT_STREAM: u64 = 1;
+const BATCH_STREAM: u64 = 2;
+const VALID_STREAM: u64 = 3;
+const SCALE_STREAM: u64 = 4;
+/// Training transitions the frozen standardization is measured on (the authors' one batch of 1024).
+pub const SCALE_ROWS: usize = 1024;
+/// Rows encoded at once outside training, bounding the memory of a conv forward pass.
+const ENCODE_CHUNK: usize = 256;
+
+pub const SCALE_MEAN: &str = "latent_scale.mean";
+pub const SCALE_STD: &str = "latent_scale.std";
+pub const REWARD_GP: &str = "reward_gp";
+const GP_STATE_PREFIX: &str = "gp";
+/// The GP optimizer's saved state is kept apart from the VAE's (both have an `adam.step`).
+const GP_OPTIMIZER_PREFIX: &str = "gp_optimizer.";
+
+pub fn transition_gp_name(d: usize) -> String {
+    format!("transition_gp.{d}")
+}
+
+/// The GPs' hyperparameters with their optimizer.
+struct Gps {
+    transition: Vec<GpHypers>,
+    reward: GpHypers,
+    adam: Adam<f64>,
+}
+
+impl Gps {
+    fn names(&self) -> Vec<String> {
+        (0..self.transition.len()).map(transition_gp_name).chain([REWARD_GP.to_string()]).collect()
+    }
+
+    fn all(&self) -> impl Iterator<Item = &GpHypers> {
+        self.transition.iter().chain(std::iter::once(&self.reward))
+    }
+
+    /// The raw vectors as a parameter set, for the optimizer's saved state.
+    fn raw_params(&self) -> ParamSet<f64> {
+        let tensors = self
+            .names()
+            .into_iter()
+            .zip(self.all())
+            .map(|(name, h)| {
+                let values = raw_vector(h);
+                NamedTensor { name: format!("{GP_STATE_PREFIX}.{name}"), shape: vec![values.len()], values }
+            })
+            .collect();
+        ParamSet { tensors }
+    }
+
+    fn stored(&self, prefix: &str) -> Vec<StoredTensor> {
+        self.names().iter().zip(self.all()).flat_map(|(name, h)| h.stored(&format!("{prefix}{name}"))).collect()
+    }
+}
+
+fn gp_adam(config: &DlgpdConfig, sizes: &[usize]) -> Adam<f64> {
+    Adam::new(adam_config(config.learning_rate), sizes)
+}
+
+fn adam_config(learning_rate: f64) -> AdamConfig {
+    AdamConfig { learning_rate, beta1: 0.9, beta2: 0.999, epsilon: 1e-8, weight_decay: 0.0, clip_grad_norm: None }
+}
+
+/// The GPs stored under `prefix` (`transition_gp.0` …, `reward_gp`), over latent ⊕ action inputs.
+pub fn gps_from_stored(
+    tensors: &[StoredTensor],
+    prefix: &str,
+    latent_dim: usize,
+    action_dim: usize,
+) -> Result<(Vec<GpHypers>, GpHypers)> {
+    let inputs = latent_dim + action_dim;
+    let prior = HyperInit::dlgpd(inputs, 1.0).outputscale_prior;
+    let transition = (0..latent_dim)
+        .map(|d| GpHypers::from_stored(&format!("{prefix}{}", transition_gp_name(d)), tensors, inputs, prior))
+        .collect::<Result<Vec<_>>>()?;
+    let reward = GpHypers::from_stored(&format!("{prefix}{REWARD_GP}"), tensors, inputs, prior)?;
+    Ok((transition, reward))
+}
+
+/// Encoder means and stds of observation rows, in chunks.
+pub fn encode_rows(vae: &VaeNet, obs: &[f32], width: usize, device: &Device) -> (Vec<f32>, Vec<f32>) {
+    let (mut means, mut stds) = (Vec::new(), Vec::new());
+    for chunk in obs.chunks(ENCODE_CHUNK * width) {
+        let rows = chunk.len() / width;
+        let (m, s) = vae.encode(tensor(chunk.to_vec(), [rows, width], device));
+        means.extend(values(&m));
+        stds.extend(values(&s));
+    }
+    (means, stds)
+}
+
+pub struct DlgpdTrainer {
+    config: DlgpdConfig,
+    seed: u64,
+    device: Device,
+    vae: Option<VaeNet>,
+    params: ParamSet<f32>,
+    vae_adam: Adam<f32>,
+    gps: Option<Gps>,
+    windows: Windows,
+    train_rows: Vec<usize>,
+    valid_rows: Vec<usize>,
+    last: Option<StepLoss>,
+}
+
+impl DlgpdTrainer {
+    pub fn new(
+        config: DlgpdConfig,
+        seed: u64,
+        windows: Windows,
+        train_rows: Vec<usize>,
+        valid_rows: Vec<usize>,
+    ) -> Result<Self> {
+        config.validate()?;
+        if train_rows.len() < 2 {
+            return Err(Error::data(format!(
+                "{} training transitions; DLGPD's GPs need a batch of at least 2",
+                train_rows.len()
+            )));
+        }
+        let device = training_device();
+        let mut rng = rng_for(seed, &[INIT_STREAM]);
+        let vae = VaeNet::init(windows.kind, config.latent_dim, config.hidden_units, &device, &mut rng)?;
+        let params = vae.params();
+        let sizes: Vec<usize> = params.tensors.iter().map(|t| t.values.len()).collect();
+        let vae_adam = Adam::new(adam_config(config.learning_rate), &sizes);
+        Ok(DlgpdTrainer {
+            config,
+            seed,
+            device,
+            vae: Some(vae),
+            params,
+            vae_adam,
+            gps: None,
+            windows,
+            train_rows,
+            valid_rows,
+            last: None,
+        })
+    }
+
+    pub fn parameter_count(&self) -> usize {
+        self.params.count()
+    }
+
+    fn vae(&self) -> &VaeNet {
+        self.vae.as_ref().expect("the VAE is only taken out while loading new weights")
+    }
+
+    fn batch(&self, rows: &[usize]) -> Batch {
+        let (obs, next_obs) = self.windows.observations(rows);
+        let (actions, rewards) = self.windows.actions_and_rewards(rows);
+        Batch { rows: rows.len(), obs, next_obs, actions, rewards }
+    }
+
+    /// Reparameterized samples of the encoder at `obs` with standard-normal `noise`.
+    fn samples(&self, obs: &[f32], noise: &[f32]) -> Vec<f64> {
+        let (mean, std) = encode_rows(self.vae(), obs, self.windows.kind.input_len(), &self.device);
+        mean.iter().zip(&std).zip(noise).map(|((m, s), e)| (m + s * e) as f64).collect()
+    }
+
+    /// The GPs' starting point from the first batch, as the authors' first `set_train_data` does.
+    fn init_gps(&self, batch: &Batch, noise: (&[f32], &[f32])) -> Result<Gps> {
+        let latents = self.samples(&batch.obs, noise.0);
+        let next = self.samples(&batch.next_obs, noise.1);
+        let (transition, reward) = init_hypers(&latents, &next, &batch.rewards, self.windows.action_dim)?;
+        let sizes: Vec<usize> = transition.iter().chain([&reward]).map(|h| raw_vector(h).len()).collect();
+        Ok(Gps { transition, reward, adam: gp_adam(&self.config, &sizes) })
+    }
+
+    /// The standardization planning freezes: mean and std (+0.01) of encoder samples on training transitions.
+    pub fn frozen_scale(&self) -> Result<LatentScale> {
+        let mut rng = rng_for(self.seed, &[SCALE_STREAM]);
+        let count = self.train_rows.len().min(SCALE_ROWS);
+        let rows: Vec<usize> =
+            sample(&mut rng, self.train_rows.len(), count).into_iter().map(|i| self.train_rows[i]).collect();
+        let (obs, _) = self.windows.observations(&rows);
+        let noise: Vec<f32> =
+            (0..count * self.config.latent_dim).map(|_| rng.sample::<f32, _>(StandardNormal)).collect();
+        LatentScale::of(&self.samples(&obs, &noise), self.config.latent_dim)
+    }
+}
+
+impl TrainingMethod for DlgpdTrainer {
+    fn step(&mut self, step: u64) -> Result<f64> {
+        let mut rng = rng_for(self.seed, &[BATCH_STREAM, step]);
+        let n = self.train_rows.len();
+        let rows: Vec<usize> =
+            sample(&mut rng, n, self.config.batch_size.min(n)).into_iter().map(|i| self.train_rows[i]).collect();
+        let batch = self.batch(&rows);
+        let noise = sample_noise(batch.rows, self.config.latent_dim, &mut rng);
+        if self.gps.is_none() {
+            self.gps = Some(self.init_gps(&batch, (&noise.0, &noise.1))?);
+        }
+        let gps = self.gps.as_mut().expect("initialized above");
+        let vae = self.vae.as_ref().expect("present between steps");
+        let mut loss = loss_and_gradients(
+            vae,
+            &gps.transition,
+            &gps.reward,
+            &batch,
+            (&noise.0, &noise.1),
+            Gradients::Wanted,
+            &self.device,
+        )?;
+        let mut vae_grads = std::mem::take(&mut loss.vae_gradients);
+        self.vae_adam.update(&mut self.params.values_mut(), &mut vae_grads)?;
+        let vae = self.vae.take().expect("present between steps");
+        self.vae = Some(vae.with_params(&self.params, &self.device)?);
+        let mut raw: Vec<Vec<f64>> = gps.all().map(raw_vector).collect();
+        let mut grads: Vec<Vec<f64>> = loss.gp.d_hypers.iter().map(raw_gradient).collect();
+        gps.adam.update(&mut raw.iter_mut().collect::<Vec<_>>(), &mut grads)?;
+        let latent = gps.transition.len();
+        for (k, v) in raw.iter().enumerate() {
+            let h = if k < latent { &mut gps.transition[k] } else { &mut gps.reward };
+            set_raw_vector(h, v);
+        }
+        let total = loss.total;
+        self.last = Some(loss);
+        Ok(total)
+    }
+
+    fn validate(&mut self) -> Result<Option<f64>> {
+        let count = self.valid_rows.len().min(self.config.batch_size);
+        let Some(gps) = self.gps.as_ref().filter(|_| count >= 2) else {
+            return Ok(None);
+        };
+        let batch = self.batch(&self.valid_rows[..count]);
+        let noise = sample_noise(count, self.config.latent_dim, &mut rng_for(self.seed, &[VALID_STREAM]));
+        let loss = loss_and_gradients(
+            self.vae(),
+            &gps.transition,
+            &gps.reward,
+            &batch,
+            (&noise.0, &noise.1),
+            Gradients::NotWanted,
+            &self.device,
+        )?;
+        Ok(Some(loss.total))
+    }
+
+    fn weights(&self) -> Vec<StoredTensor> {
+        let mut out = state::weights(&self.params);
+        if let Some(gps) = &self.gps {
+            out.extend(gps.stored(""));
+        }
+        // Only a degenerate encoder (every sample alike) has no scale; loading such a checkpoint then names it.
+        if let Ok(scale) = self.frozen_scale() {
+            let d = scale.mean.len();
+            out.push(StoredTensor::f64(SCALE_MEAN, vec![d], scale.mean));
+            out.push(StoredTensor::f64(SCALE_STD, vec![d], scale.std));
+        }
+        out
+    }
+
+    fn state(&self) -> Vec<StoredTensor> {
+        let mut out = state::save(&self.params, &self.vae_adam);
+        if let Some(gps) = &self.gps {
+            out.extend(gps.stored("live."));
+            out.extend(state::save(&gps.raw_params(), &gps.adam).into_iter().map(|mut t| {
+                t.name = format!("{GP_OPTIMIZER_PREFIX}{}", t.name);
+                t
+            }));
+        }
+        out
+    }
+
+    fn restore(&mut self, saved: &[StoredTensor]) -> Result<()> {
+        state::restore(saved, &mut self.params, &mut self.vae_adam)?;
+        let vae = self.vae.take().expect("present between steps");
+        self.vae = Some(vae.with_params(&self.params, &self.device)?);
+        let has_gps = saved.iter().any(|t| t.name.starts_with(&format!("live.{REWARD_GP}.")));
+        self.gps = if has_gps {
+            let (transition, reward) =
+                gps_from_stored(saved, "live.", self.config.latent_dim, self.windows.action_dim)?;
+            let sizes: Vec<usize> = transition.iter().chain([&reward]).map(|h| raw_vector(h).len()).collect();
+            let mut gps = Gps { transition, reward, adam: gp_adam(&self.config, &sizes) };
+            let mut raw = gps.raw_params();
+            let optimizer: Vec<StoredTensor> = saved
+                .iter()
+                .filter_map(|t| {
+                    let name = t.name.strip_prefix(GP_OPTIMIZER_PREFIX)?;
+                    Some(StoredTensor { name: name.to_string(), ..t.clone() })
+                })
+                .collect();
+            state::restore(&optimizer, &mut raw, &mut gps.adam)?;
+            Some(gps)
+        } else {
+            None
+        };
+        Ok(())
+    }
+
+    fn step_scalars(&self) -> Vec<(&'static str, f64)> {
+        let Some(l) = &self.last else {
+            return Vec::new();
+        };
+        vec![
+            ("dlgpd/reconstruction", l.reconstruction),
+            ("dlgpd/entropy", l.entropy),
+            ("dlgpd/transition_gp_nll", l.gp.transition),
+            ("dlgpd/reward_gp_nll", l.gp.reward),
+            ("dlgpd/snr_penalty", l.gp.snr),
+        ]
+    }
+}
+
+/// Whether `stored` holds a tensor of f64 values named `name` with `len` entries.
+pub fn f64_tensor<'a>(stored: &'a [StoredTensor], name: &str, len: usize) -> Option<&'a Vec<f64>> {
+    match stored.iter().find(|t| t.name == name).map(|t| &t.data) {
+        Some(TensorData::F64(v)) if v.len() == len && v.iter().all(|x| x.is_finite()) => Some(v),
+        _ => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::data::collect::{collect_random, CollectSettings};
+    use crate::envs::parse_env;
+    use crate::models::dlgpd::config::Preset;
+    use crate::models::dlgpd::data::ObservationKind;
+    use crate::run::NullMonitor;
+
+    fn trainer(config: &DlgpdConfig) -> DlgpdTrainer {
+        let settings = CollectSettings {
+            env: parse_env("pendulum").unwrap(),
+            rollouts: 12,
+            steps: 10,
+            seed: 3,
+            command_line: "test".into(),
+        };
+        let data = collect_random(&settings, &NullMonitor).unwrap();
+        let windows = Windows::from_dataset(&data, ObservationKind::Angles, 3).unwrap();
+        let valid = windows.rows_where(|r| r < 2);
+        let train = windows.rows_where(|r| r >= 2);
+        DlgpdTrainer::new(config.clone(), 9, windows, train, valid).unwrap()
+    }
+
+    fn config() -> DlgpdConfig {
+        DlgpdConfig { batch_size: 32, ..DlgpdConfig::preset(Preset::Small) }
+    }
+
+    #[test]
+    fn steps_lower_the_validation_loss_and_a_restored_state_continues_identically() {
+        let config = config();
+        let mut a = trainer(&config);
+        assert_eq!(a.validate().unwrap(), None, "no GPs before the first step");
+        a.step(1).unwrap();
+        let first = a.validate().unwrap().unwrap();
+        for step in 2..=150 {
+            assert!(a.step(step).unwrap().is_finite());
+        }
+        let later = a.validate().unwrap().unwrap();
+        assert!(later < first, "validation loss {first} → {later}");
+        let names: Vec<String> = a.weights().into_iter().map(|t| t.name).collect();
+        for wanted in ["encoder.hidden1.weight", SCALE_MEAN, "transition_gp.2.covar_module.raw_outputscale"] {
+            assert!(names.iter().any(|n| n == wanted), "{wanted} missing from {names:?}");
+        }
+        crate::train::tensors::to_bytes(&a.state()).unwrap();
+
+        let mut b = trainer(&config);
+        b.restore(&a.state()).unwrap();
+        for step in 151..=155 {
+            assert_eq!(a.step(step).unwrap(), b.step(step).unwrap(), "step {step}");
+        }
+        assert_eq!(a.weights(), b.weights());
+    }
+
+    #[test]
+    fn the_stored_gps_load_back_with_their_bounds() {
+        let mut t = trainer(&config());
+        t.step(1).unwrap();
+        let (transition, reward) = gps_from_stored(&t.weights(), "", 3, 1).unwrap();
+        let gps = t.gps.as_ref().unwrap();
+        assert_eq!(transition, gps.transition);
+        assert_eq!(reward, gps.reward);
+    }
+}
