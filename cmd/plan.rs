@@ -5,7 +5,8 @@ use std::path::PathBuf;
 use anyhow::bail;
 use clap::Args;
 use mbrl::data::write_dataset;
-use mbrl::eval::swingup::{self, SwingupSettings};
+use mbrl::eval::swingup::{self, SwingupEpisode, SwingupSettings};
+use mbrl::models::dlgpd;
 
 use crate::cem_args::CemArgs;
 use crate::common::{command_line, file_stem, pendulum_variant, run_job, GlobalArgs};
@@ -19,6 +20,13 @@ Examples:
   mbrl plan --env pendulum:heavy --model true --noise colored --beta 0.5 --out datasets/heavy-plan.mcap
   mbrl plan --env pendulum --model models/pets-pendulum --particles 20 --propagation tsinf
   mbrl plan --env pendulum:quadrant --model models/context-pendulum-quadrant --context calib.mcap --instance-seed 3
+  mbrl collect --env pendulum:inverted --rollouts 20 --steps 29 --images --out datasets/evidence-inverted.mcap
+  mbrl plan --env pendulum:inverted --model models/dlgpd-medium --evidence datasets/evidence-inverted.mcap
+
+A DLGPD model plans from its observations (rendered frames, or pole angles for the small preset) in its
+latent space, on GPs conditioned on --evidence: rollouts of the system at hand (`collect --rollouts N`,
+with --images for image models), encoded without retraining. Its CEM also stops once the first action's
+std is ≤ 0.01; `--iters 30 --no-warm-start` is the authors' planner.
 
 The pendulum starts hanging (θ ~ U[π-0.05, π+0.05], θ̇ ~ U[-0.05, 0.05]); success means each of the
 last 25 rewards is above -1 (thesis 3.5.2).")]
@@ -33,6 +41,9 @@ pub struct PlanArgs {
     steps: usize,
     #[command(flatten)]
     cem: CemArgs,
+    /// DLGPD models: rollouts to condition the GPs on (a dataset written by `collect`).
+    #[arg(long)]
+    evidence: Option<PathBuf>,
     /// Plan in the instance (hidden parameters) this seed names, as `calibrate --instance-seed` does.
     #[arg(long)]
     instance_seed: Option<u64>,
@@ -53,8 +64,18 @@ pub fn run(global: &GlobalArgs, args: PlanArgs) -> anyhow::Result<()> {
     settings.cem.validate()?;
     let out = args
         .out
+        .clone()
         .unwrap_or_else(|| PathBuf::from(format!("datasets/plan-{}.mcap", file_stem(&settings.variant.env_name()))));
     let env = mbrl::envs::parse_env(&args.env)?;
+    let is_dlgpd = args.model.model != "true"
+        && mbrl::train::OpenedCheckpoint::open(std::path::Path::new(&args.model.model))
+            .is_ok_and(|c| c.manifest.method == dlgpd::job::METHOD);
+    if is_dlgpd {
+        return plan_dlgpd(global, &args, settings, &out);
+    }
+    if args.evidence.is_some() {
+        bail!("--evidence conditions a DLGPD model's GPs; {} is not a DLGPD checkpoint", args.model.model);
+    }
     let model = args.model.load(&env)?;
     let model = model.as_deref();
     let seed = global.seed;
@@ -72,6 +93,62 @@ pub fn run(global: &GlobalArgs, args: PlanArgs) -> anyhow::Result<()> {
         "return {:.2}, success: {} (last 25 rewards > -1); rollout saved to {}",
         episode.total_return,
         if episode.success { "yes" } else { "no" },
+        out.display()
+    );
+    Ok(())
+}
+
+fn plan_dlgpd(
+    global: &GlobalArgs,
+    args: &PlanArgs,
+    settings: SwingupSettings,
+    out: &std::path::Path,
+) -> anyhow::Result<()> {
+    let Some(evidence_path) = &args.evidence else {
+        bail!(
+            "{} is a DLGPD model: pass --evidence ROLLOUTS.mcap (rollouts of the system at hand, e.g. `mbrl collect \
+             --env {} --rollouts 20 --steps 29 --images`)",
+            args.model.model,
+            args.env
+        );
+    };
+    if args.instance_seed.is_some() || args.model.context.is_some() {
+        bail!("--instance-seed and --context are for context models; a DLGPD model adapts through --evidence");
+    }
+    let trained = dlgpd::job::load(std::path::Path::new(&args.model.model))?;
+    let evidence = mbrl::data::read_dataset(evidence_path)?;
+    let seed = global.seed;
+    let dynamics = dlgpd::control::condition_on(&trained, &evidence, seed)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", evidence_path.display()))?;
+    let mut control = dlgpd::control::ControlSettings::authors(settings.variant.clone());
+    control.steps = settings.steps;
+    control.cem = mbrl::planning::CemConfig { stop_std: Some(dlgpd::control::STOP_STD), ..settings.cem.clone() };
+    let title = format!(
+        "plan: {} swing-up with DLGPD on {} evidence transitions from {}",
+        settings.variant.env_name(),
+        dynamics.evidence_len(),
+        evidence.meta.env
+    );
+    let episode = run_job(global, "plan: DLGPD swing-up", |monitor| {
+        monitor.emit(&swingup::layout(&title, false));
+        dlgpd::control::swing_up(&trained, &dynamics, &control, seed, monitor)
+    })?;
+    let iterations = episode.iterations.iter().sum::<usize>() as f64 / episode.iterations.len().max(1) as f64;
+    let record = SwingupEpisode {
+        episode: 0,
+        instance: serde_json::json!({}),
+        rollout: episode.rollout,
+        total_return: episode.total_return,
+        success: episode.success,
+    };
+    write_dataset(out, &swingup::episodes_dataset(&settings, seed, &command_line(), std::slice::from_ref(&record)))?;
+    println!(
+        "return {:.2}, success: {} (last 25 rewards > -1); {:.1} CEM iterations per step; evidence: {} transitions of {}; rollout saved to {}",
+        record.total_return,
+        if record.success { "yes" } else { "no" },
+        iterations,
+        dynamics.evidence_len(),
+        evidence.meta.env,
         out.display()
     );
     Ok(())

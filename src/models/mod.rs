@@ -21,7 +21,7 @@ pub struct RolloutOptions {
 }
 
 /// The methods whose checkpoints `plan` can plan with.
-pub const PLANNING_METHODS: &str = "pets, context";
+pub const PLANNING_METHODS: &str = "pets, context, dlgpd (with --evidence)";
 
 /// A trained model from its checkpoint directory, as dynamics for a planner in `env`. Which method made it is
 /// read from the checkpoint, so callers never branch on methods.
@@ -51,6 +51,11 @@ pub fn load_planning_model(dir: &Path, env: &EnvName, options: RolloutOptions) -
             };
             Ok(Box::new(context::dynamics::ContextDynamics::new(model, &rows, env)?))
         }
+        dlgpd::job::METHOD => Err(Error::bad_file(
+            dir,
+            "is a DLGPD model, which plans from images in latent space: `mbrl plan --env pendulum[:variant] --model \
+             DIR --evidence ROLLOUTS.mcap`",
+        )),
         other => Err(Error::bad_file(
             dir,
             format!(

@@ -38,6 +38,10 @@ pub struct CemConfig {
     pub noise: NoiseKind,
     /// Start each MPC step from the previous mean shifted by one step instead of from zero.
     pub warm_start: bool,
+    /// Stop iterating once the refit std of every first-step action is at most this (DLGPD's planner stops
+    /// at 0.01); `None` runs all iterations.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stop_std: Option<f64>,
 }
 
 impl CemConfig {
@@ -54,6 +58,7 @@ impl CemConfig {
             init_std,
             noise: NoiseKind::White,
             warm_start: true,
+            stop_std: None,
         }
     }
 
@@ -80,6 +85,11 @@ impl CemConfig {
             let (lo, hi, sd) = (self.action_low[i], self.action_high[i], self.init_std[i]);
             if !(lo.is_finite() && hi.is_finite() && lo < hi && sd.is_finite() && sd > 0.0) {
                 return bad(format!("CEM: action dimension {i} needs finite low < high and std > 0"));
+            }
+        }
+        if let Some(s) = self.stop_std {
+            if !(s.is_finite() && s >= 0.0) {
+                return bad(format!("CEM: the stopping std must be finite and ≥ 0, got {s}"));
             }
         }
         if let NoiseKind::Colored { beta } = self.noise {
@@ -168,6 +178,9 @@ impl Cem {
             let best_cost = elite_idx.iter().map(|&i| costs[i]).fold(f64::INFINITY, f64::min);
             let elite_mean_cost = elite_idx.iter().map(|&i| costs[i]).sum::<f64>() / elites as f64;
             on_iteration(&CemIteration { iteration, best_cost, elite_mean_cost });
+            if self.config.stop_std.is_some_and(|limit| self.std[..d].iter().all(|&s| s <= limit)) {
+                break;
+            }
         }
         self.calls += 1;
         self.mean.clone()
@@ -249,6 +262,21 @@ mod tests {
             noise,
             ..CemConfig::for_box(&[-2.0], &[2.0])
         }
+    }
+
+    #[test]
+    fn stops_early_once_the_first_action_has_settled() {
+        let target: Vec<f64> = (0..8).map(|t| (t as f64 * 0.4).sin()).collect();
+        let objective = Quadratic { target };
+        let run = |stop_std| {
+            let mut cem = Cem::new(CemConfig { stop_std, iterations: 40, ..config(NoiseKind::White) }, 3).unwrap();
+            let mut iterations = 0;
+            cem.plan(&objective, |_| iterations += 1);
+            iterations
+        };
+        let (all, stopped) = (run(None), run(Some(0.01)));
+        assert_eq!(all, 40);
+        assert!(stopped < 40, "stopped after {stopped} iterations");
     }
 
     #[test]

@@ -141,6 +141,7 @@ pub fn calibrate(
         init_std: spec.action_low.iter().zip(&spec.action_high).map(|(l, h)| l.abs().max(h.abs())).collect(),
         noise: NoiseKind::White,
         warm_start: false,
+        stop_std: None,
     };
     let mut random = rng_for(seed, &[0]);
     let mut open_loop_plan: Vec<f64> = Vec::new();

@@ -67,6 +67,15 @@ impl LatentDynamics {
         Ok(LatentDynamics { scale, transition, reward, reward_floor, action_dim })
     }
 
+    /// Transitions the GPs are conditioned on.
+    pub fn evidence_len(&self) -> usize {
+        self.reward.len()
+    }
+
+    pub fn action_dim(&self) -> usize {
+        self.action_dim
+    }
+
     pub fn latent_dim(&self) -> usize {
         self.transition.len()
     }

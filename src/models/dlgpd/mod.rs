@@ -2,6 +2,7 @@
 //! processes, controlled with CEM and adapted to changed dynamics by swapping the GPs' evidence.
 
 pub mod config;
+pub mod control;
 pub mod data;
 pub mod dynamics;
 pub mod job;

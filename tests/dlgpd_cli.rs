@@ -1,0 +1,139 @@
+//! End to end: collect → train DLGPD → plan a swing-up on evidence, resume, and the errors a user can run into.
+
+mod common;
+
+use std::path::Path;
+
+use common::*;
+use mbrl::data::read_dataset;
+use mbrl::models::dlgpd::config::{DlgpdConfig, Preset};
+use mbrl::models::dlgpd::job as dlgpd;
+use mbrl::run::dir::Provenance;
+
+fn collect(dir: &Path, name: &str, env: &str, rollouts: &str, images: bool) {
+    let mut cmd = mbrl(dir);
+    cmd.args(["collect", "--env", env, "--rollouts", rollouts, "--steps", "12", "-q", "--out", name]);
+    if images {
+        cmd.arg("--images");
+    }
+    cmd.assert().success();
+}
+
+#[test]
+fn train_on_angles_then_plan_on_swapped_evidence() {
+    let dir = tempfile::tempdir().unwrap();
+    collect(dir.path(), "train.mcap", "pendulum", "30", false);
+    collect(dir.path(), "evidence.mcap", "pendulum:inverted", "3", false);
+    let out = mbrl(dir.path())
+        .args(["train", "--method", "dlgpd", "--data", "train.mcap", "--steps", "40", "--batch", "64"])
+        .args(["--out", "models/d", "--no-tui"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr_of(&out));
+    let text = stdout_of(&out);
+    assert!(text.contains("pole angles") && text.contains("best validation loss"), "{text}");
+    for file in ["loss.png", "losses.csv", "model.safetensors", "state.safetensors"] {
+        assert!(dir.path().join("models/d").join(file).is_file(), "{file} missing");
+    }
+
+    let out = mbrl(dir.path())
+        .args(["plan", "--env", "pendulum:inverted", "--model", "models/d", "--evidence", "evidence.mcap"])
+        .args(["--candidates", "40", "--elites", "5", "--iters", "2", "--steps", "8", "-q", "--out", "plan.mcap"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr_of(&out));
+    let text = stdout_of(&out);
+    assert!(text.contains("return") && text.contains("33 transitions of pendulum:inverted"), "{text}");
+    let plan = read_dataset(&dir.path().join("plan.mcap")).unwrap();
+    assert_eq!(plan.steps.len(), 8);
+    assert_eq!(plan.meta.env, "pendulum:inverted");
+
+    // The same seed plans the same actions.
+    let again = mbrl(dir.path())
+        .args(["plan", "--env", "pendulum:inverted", "--model", "models/d", "--evidence", "evidence.mcap"])
+        .args(["--candidates", "40", "--elites", "5", "--iters", "2", "--steps", "8", "-q", "--out", "again.mcap"])
+        .output()
+        .unwrap();
+    assert!(again.status.success(), "{}", stderr_of(&again));
+    let actions =
+        |p: &str| read_dataset(&dir.path().join(p)).unwrap().steps.iter().map(|s| s.action[0]).collect::<Vec<_>>();
+    assert_eq!(actions("plan.mcap"), actions("again.mcap"));
+
+    // Planning without evidence, or an image model's evidence without frames, is a one-line error.
+    let out = mbrl(dir.path()).args(["plan", "--env", "pendulum", "--model", "models/d", "-q"]).output().unwrap();
+    assert_one_line_error(&out, &["DLGPD", "--evidence"]);
+    let out = mbrl(dir.path())
+        .args(["plan", "--env", "pendulum", "--model", "true", "--evidence", "evidence.mcap", "-q"])
+        .output()
+        .unwrap();
+    assert_one_line_error(&out, &["--evidence", "not a DLGPD"]);
+}
+
+#[test]
+fn resume_ends_with_the_bytes_of_an_uninterrupted_run() {
+    let dir = tempfile::tempdir().unwrap();
+    collect(dir.path(), "train.mcap", "pendulum", "16", false);
+    let config = DlgpdConfig {
+        steps: 30,
+        batch_size: 32,
+        validate_every: 5,
+        checkpoint_every: 10,
+        ..DlgpdConfig::preset(Preset::Small)
+    };
+    let request = |out: &str| dlgpd::TrainRequest {
+        out: dir.path().join(out),
+        data: vec![dir.path().join("train.mcap")],
+        env: None,
+        config: config.clone(),
+        seed: 4,
+        provenance: Provenance::new("mbrl train …".into(), 4, 1),
+    };
+    dlgpd::train(&request("whole"), false, &mbrl::run::NullMonitor).unwrap();
+    let stop = StopAfter::new(25);
+    let err = dlgpd::train(&request("stopped"), false, &stop).err().unwrap();
+    assert!(matches!(err, mbrl::Error::Cancelled), "{err}");
+    let out = mbrl(dir.path()).args(["train", "--resume", "stopped", "--no-tui"]).output().unwrap();
+    assert!(out.status.success(), "{}", stderr_of(&out));
+    // The CLI adds its loss report after training; the library run writes none.
+    let model_files = |d: &str| -> Vec<(String, Vec<u8>)> {
+        dir_bytes(&dir.path().join(d)).into_iter().filter(|(n, _)| !n.starts_with("loss")).collect()
+    };
+    let (whole, resumed) = (model_files("whole"), model_files("stopped"));
+    let names = |files: &[(String, Vec<u8>)]| files.iter().map(|f| f.0.clone()).collect::<Vec<_>>();
+    assert_eq!(names(&whole), names(&resumed));
+    for ((name, a), (_, b)) in whole.iter().zip(&resumed) {
+        assert!(a == b, "{name} differs after resuming");
+    }
+}
+
+#[test]
+fn image_presets_need_frames_and_say_how_to_get_them() {
+    let dir = tempfile::tempdir().unwrap();
+    collect(dir.path(), "train.mcap", "pendulum", "4", false);
+    let out = mbrl(dir.path())
+        .args(["train", "--method", "dlgpd", "--data", "train.mcap", "--preset", "medium", "--out", "m", "-q"])
+        .output()
+        .unwrap();
+    assert_one_line_error(&out, &["train.mcap", "--images"]);
+    assert!(!dir.path().join("m").exists());
+    let out = mbrl(dir.path())
+        .args(["train", "--method", "dlgpd", "--data", "train.mcap", "--skills", "3", "--out", "m", "-q"])
+        .output()
+        .unwrap();
+    assert_one_line_error(&out, &["--skills", "dlgpd"]);
+}
+
+#[test]
+fn an_image_model_trains_a_few_steps_on_rendered_frames() {
+    let dir = tempfile::tempdir().unwrap();
+    collect(dir.path(), "frames.mcap", "pendulum", "6", true);
+    let out = mbrl(dir.path())
+        .args(["train", "--method", "dlgpd", "--data", "frames.mcap", "--preset", "medium", "--steps", "3"])
+        .args(["--batch", "16", "--out", "m", "--no-tui"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr_of(&out));
+    assert!(stdout_of(&out).contains("64×64 frames"), "{}", stdout_of(&out));
+    let trained = dlgpd::load(&dir.path().join("m")).unwrap();
+    assert_eq!(trained.scale.mean.len(), 3);
+}
