@@ -3,5 +3,6 @@
 
 pub mod alloc;
 pub mod atomic;
+pub mod fast_exp;
 pub mod seeding;
 pub mod table;

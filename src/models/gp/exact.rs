@@ -8,6 +8,7 @@ use faer::{Mat, Side};
 
 use super::kernel::SeArd;
 use crate::error::{Error, Result};
+use crate::util::fast_exp::scaled_exp_in_place;
 
 const LN_2PI: f64 = 1.837_877_066_409_345_5;
 /// Jitter added to the diagonal when the factorization fails, relative to the mean diagonal, tried in turn.
@@ -19,6 +20,9 @@ const JITTERS: [f64; 7] = [1e-10, 1e-9, 1e-8, 1e-7, 1e-6, 1e-5, 1e-4];
 #[derive(Clone, Debug)]
 pub struct ConditionedGp {
     inputs: Vec<f64>,
+    /// The inputs divided by their lengthscales, one contiguous column per dimension: the layout in which
+    /// the cross-covariances of a query against every point are computed in one vectorized sweep.
+    scaled_columns: Vec<Vec<f64>>,
     kernel: SeArd,
     noise: f64,
     jitter: f64,
@@ -52,6 +56,38 @@ fn check_finite(what: &str, values: &[f64]) -> Result<()> {
         Some(i) => Err(Error::data(format!("GP {what}: value {i} is {}, expected a finite number", values[i]))),
         None => Ok(()),
     }
+}
+
+/// `column[j] = outputscale · exp(−½ Σ_c (points_c[j] − query_c)²)`, in one sweep per dimension. Compiled
+/// twice: for AVX2 where the CPU has it (4 lanes instead of SSE2's 2) and for the baseline; both do the same
+/// IEEE operations in the same order, so the results are identical.
+fn cross_column(points: &[Vec<f64>], query: &[f64], outputscale: f64, column: &mut [f64]) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2, checked just above.
+            return unsafe { cross_column_avx2(points, query, outputscale, column) };
+        }
+    }
+    cross_column_portable(points, query, outputscale, column)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn cross_column_avx2(points: &[Vec<f64>], query: &[f64], outputscale: f64, column: &mut [f64]) {
+    cross_column_portable(points, query, outputscale, column)
+}
+
+#[inline(always)]
+fn cross_column_portable(points: &[Vec<f64>], query: &[f64], outputscale: f64, column: &mut [f64]) {
+    column.iter_mut().for_each(|k| *k = 0.0);
+    for (dimension, x) in points.iter().zip(query) {
+        for (k, p) in column.iter_mut().zip(dimension) {
+            *k += (p - x) * (p - x);
+        }
+    }
+    column.iter_mut().for_each(|k| *k *= -0.5);
+    scaled_exp_in_place(column, outputscale);
 }
 
 impl ConditionedGp {
@@ -108,7 +144,9 @@ impl ConditionedGp {
         let mut alpha = Mat::from_fn(n, 1, |i, _| residual[i]);
         factor.solve_in_place_with_conj(faer::Conj::No, alpha.as_mut());
         let alpha = (0..n).map(|i| alpha[(i, 0)]).collect();
-        Ok(ConditionedGp { inputs: inputs.to_vec(), kernel, noise, jitter, factor, residual, alpha })
+        let scaled_columns =
+            (0..d).map(|c| (0..n).map(|j| inputs[j * d + c] / kernel.lengthscales[c]).collect()).collect();
+        Ok(ConditionedGp { inputs: inputs.to_vec(), scaled_columns, kernel, noise, jitter, factor, residual, alpha })
     }
 
     pub fn len(&self) -> usize {
@@ -191,16 +229,25 @@ impl ConditionedGp {
         }
         check_finite("query inputs", queries)?;
         check_finite("query prior mean", prior_mean)?;
-        let cross = self.kernel.matrix(queries, &self.inputs);
+        // K(X, queries), N × q column-major: column i is query i against every point, contiguous.
+        let n = self.len();
+        let mut cross = vec![0.0; n * q];
+        let mut scaled_query = vec![0.0; d];
+        for (i, column) in cross.chunks_mut(n.max(1)).enumerate().take(q) {
+            for (c, x) in scaled_query.iter_mut().enumerate() {
+                *x = queries[i * d + c] / self.kernel.lengthscales[c];
+            }
+            cross_column(&self.scaled_columns, &scaled_query, self.kernel.outputscale, column);
+        }
         let mean = (0..q)
-            .map(|i| prior_mean[i] + (0..self.len()).map(|j| cross[(i, j)] * self.alpha[j]).sum::<f64>())
+            .map(|i| prior_mean[i] + cross[i * n..(i + 1) * n].iter().zip(&self.alpha).map(|(k, a)| k * a).sum::<f64>())
             .collect();
-        let variance = if with_variance {
-            let mut v = cross.transpose().to_owned();
+        let variance = if with_variance && n > 0 {
+            let mut v = faer::MatMut::from_column_major_slice_mut(&mut cross, n, q);
             self.factor.L().solve_lower_triangular_in_place(v.as_mut());
             (0..q)
                 .map(|i| {
-                    let explained: f64 = (0..self.len()).map(|j| v[(j, i)] * v[(j, i)]).sum();
+                    let explained: f64 = (0..n).map(|j| v[(j, i)] * v[(j, i)]).sum();
                     (self.kernel.outputscale - explained).max(0.0)
                 })
                 .collect()
