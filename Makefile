@@ -4,7 +4,7 @@
 MBRL := target/release/mbrl
 SEED ?= 0
 
-.PHONY: build test bench completions repro-quick repro-swingup repro-pendulum-data repro-boards repro-ball repro-pets repro-pets-loop repro-context repro-seads clean-reports
+.PHONY: build test bench completions repro-quick repro-swingup repro-pendulum-data repro-boards repro-ball repro-pets repro-pets-loop repro-context repro-seads repro-dlgpd clean-reports
 
 build:
 	cargo build --release
@@ -99,6 +99,15 @@ repro-seads: build
 		$(MBRL) eval seads --model models/seads-$$game-cursor --boards 20 --seed $(SEED) --no-tui -q \
 			--out reports/seads-$$game-cursor || exit 1; \
 	done
+
+# Thesis chapter 3: DLGPD on rendered pendulum frames, then swing-ups of the standard, inverted, light and heavy
+# pendulum on matching and mismatching evidence (Figs. 3.4/3.5 analogues).
+DLGPD_PRESET ?= medium
+DLGPD_EVAL ?= --evidence-rollouts 5,10,20 --runs 2 --candidates 300 --elites 30 --iters 10
+repro-dlgpd: build
+	$(MBRL) collect --env pendulum --images --rollouts 500 --steps 29 --seed $(SEED) --no-tui -q --out datasets/dlgpd/pendulum-frames.mcap
+	$(MBRL) train --method dlgpd --data datasets/dlgpd/pendulum-frames.mcap --preset $(DLGPD_PRESET) --seed $(SEED) --no-tui -q --out models/dlgpd-$(DLGPD_PRESET)
+	$(MBRL) eval dlgpd --model models/dlgpd-$(DLGPD_PRESET) $(DLGPD_EVAL) --seed $(SEED) --no-tui -q --out reports/dlgpd
 
 # Thesis chapter 7 environments: depth/split tables, board sets, embodied play with scripted controllers.
 repro-boards: build

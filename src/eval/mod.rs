@@ -4,6 +4,7 @@ pub mod ball;
 pub mod boards;
 pub mod context;
 pub mod dataset_report;
+pub mod dlgpd;
 pub mod plot;
 pub mod quick;
 pub mod seads;

@@ -55,6 +55,14 @@ pub const QUICK_CONTEXT_CANDIDATES: usize = 200;
 pub const QUICK_SEADS_BOARDS: usize = 10;
 pub const QUICK_SEADS_DEPTH: u8 = 3;
 
+/// The DLGPD slice: the small preset (MLP VAE on pole angles) on random pendulum rollouts, then the
+/// inverted-action pendulum swung up on matching and on mismatching evidence; `make repro-dlgpd` runs more.
+pub const QUICK_DLGPD_ROLLOUTS: usize = 500;
+pub const QUICK_DLGPD_TRAIN_STEPS: u64 = 3000;
+pub const QUICK_DLGPD_EVIDENCE_ROLLOUTS: usize = 10;
+pub const QUICK_DLGPD_SWINGUP_STEPS: usize = 150;
+pub const QUICK_DLGPD_CANDIDATES: usize = 200;
+
 pub struct QuickSummary {
     pub lines: Vec<String>,
 }
@@ -97,6 +105,7 @@ pub fn run_quick(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor)
         lines.push(context_slice(squash, provenance, out_dir, monitor)?);
     }
     lines.push(seads_slice(provenance, out_dir, monitor)?);
+    lines.push(dlgpd_slice(provenance, out_dir, monitor)?);
     let mut md = String::from("# mbrl quick reproduction\n\nSmall-scale runs of each implemented method.\n\n");
     for line in &lines {
         md.push_str(&format!("- {line}\n"));
@@ -295,5 +304,62 @@ fn seads_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) -
         "SEADS, tileswap:cursor (small preset, {} env steps, no game reward): the skills cover {}/{} moves; {solved}/{boards} \
          test boards of depth 1-{} solved by planning over the learned forward model; see seads-tileswap-cursor/eval/report.md",
         report.env_steps, summary.distinct_moves, summary.moves, QUICK_SEADS_DEPTH
+    ))
+}
+
+fn dlgpd_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) -> Result<String> {
+    use super::dlgpd::{evaluate, DlgpdEvalSettings, EVIDENCE_STEPS};
+    use crate::models::dlgpd::config::{DlgpdConfig, Preset as DlgpdPreset};
+    use crate::models::dlgpd::control::ControlSettings;
+    use crate::models::dlgpd::job as dlgpd;
+    let dir = out_dir.join("dlgpd");
+    let data_path = dir.join("pendulum-random.mcap");
+    let collect = CollectSettings {
+        env: EnvName::Pendulum(PendulumVariant::Standard),
+        rollouts: QUICK_DLGPD_ROLLOUTS,
+        steps: EVIDENCE_STEPS,
+        seed: provenance.seed,
+        command_line: provenance.command_line.clone(),
+    };
+    write_dataset(&data_path, &collect_random(&collect, monitor)?)?;
+    let request = dlgpd::TrainRequest {
+        out: dir.join("model"),
+        data: vec![data_path],
+        env: None,
+        config: DlgpdConfig { steps: QUICK_DLGPD_TRAIN_STEPS, ..DlgpdConfig::preset(DlgpdPreset::Small) },
+        seed: provenance.seed,
+        provenance: provenance.clone(),
+    };
+    dlgpd::train(&request, false, monitor)?;
+    let trained = dlgpd::load(&request.out)?;
+    let mut cem = ControlSettings::authors(PendulumVariant::Inverted).cem;
+    cem.candidates = QUICK_DLGPD_CANDIDATES;
+    cem.elites = QUICK_DLGPD_CANDIDATES / 10;
+    cem.iterations = 8;
+    let settings = DlgpdEvalSettings {
+        variants: vec![PendulumVariant::Inverted],
+        evidence_rollouts: vec![QUICK_DLGPD_EVIDENCE_ROLLOUTS],
+        runs: 1,
+        steps: QUICK_DLGPD_SWINGUP_STEPS,
+        cem,
+    };
+    let summary = evaluate(&trained, &settings, provenance, &dir.join("eval"), monitor)?;
+    let describe = |kind: &str| {
+        summary
+            .outcomes
+            .iter()
+            .find(|o| o.evidence == kind)
+            .map(|o| format!("return {:.1}, {}", o.total_return, if o.success { "swung up" } else { "not swung up" }))
+            .unwrap_or_else(|| "not run".into())
+    };
+    Ok(format!(
+        "DLGPD (small preset: MLP VAE on pole angles instead of images, {QUICK_DLGPD_TRAIN_STEPS} steps on {} random \
+         transitions of the standard pendulum), inverted-action pendulum, no retraining, {} steps: with {} matching \
+         evidence rollouts {}; with the standard pendulum's evidence {}; see dlgpd/eval/report.md",
+        trained.run.transitions.train,
+        QUICK_DLGPD_SWINGUP_STEPS,
+        QUICK_DLGPD_EVIDENCE_ROLLOUTS,
+        describe("matching"),
+        describe("mismatching")
     ))
 }
