@@ -88,8 +88,10 @@ enum Protocol {
     Seads(SeadsArgs),
     /// DLGPD (thesis 3.5.3): swing-up success and return vs evidence rollouts on the standard, inverted, light
     /// and heavy pendulum, with matching and mismatching evidence (Figs. 3.4/3.5 analogues).
-    #[command(after_help = "Examples:\n  mbrl eval dlgpd --model models/dlgpd-small --evidence-rollouts 5,10 --runs 2\n  \
-                            mbrl eval dlgpd --model models/dlgpd-medium --env pendulum:inverted --evidence-rollouts 10,20,50 --runs 3 --candidates 1000 --elites 100")]
+    #[command(
+        after_help = "Examples:\n  mbrl eval dlgpd --model models/dlgpd-small --evidence-rollouts 5,10 --runs 2\n  \
+                            mbrl eval dlgpd --model models/dlgpd-medium --env pendulum:inverted --evidence-rollouts 10,20,50 --runs 3 --candidates 1000 --elites 100"
+    )]
     Dlgpd(DlgpdArgs),
     /// Pendulum swing-up with MPC: success rate, returns, angle plots.
     #[command(
@@ -563,7 +565,8 @@ fn eval_dlgpd(global: &GlobalArgs, provenance: &Provenance, a: DlgpdArgs) -> any
     cem.candidates = a.candidates;
     cem.elites = a.elites;
     cem.iterations = a.iters;
-    let settings = DlgpdEvalSettings { variants, evidence_rollouts: a.evidence_rollouts, runs: a.runs, steps: a.steps, cem };
+    let settings =
+        DlgpdEvalSettings { variants, evidence_rollouts: a.evidence_rollouts, runs: a.runs, steps: a.steps, cem };
     let trained = mbrl::models::dlgpd::job::load(&a.model)?;
     let summary = run_job(global, "eval dlgpd", |monitor| evaluate(&trained, &settings, provenance, &a.out, monitor))?;
     println!("env                   evidence     rollouts  mean return  successes");

@@ -61,6 +61,9 @@ _mbrl() {
             mbrl__subcmd__eval,dataset)
                 cmd="mbrl__subcmd__eval__subcmd__dataset"
                 ;;
+            mbrl__subcmd__eval,dlgpd)
+                cmd="mbrl__subcmd__eval__subcmd__dlgpd"
+                ;;
             mbrl__subcmd__eval,embodied)
                 cmd="mbrl__subcmd__eval__subcmd__embodied"
                 ;;
@@ -87,6 +90,9 @@ _mbrl() {
                 ;;
             mbrl__subcmd__eval__subcmd__help,dataset)
                 cmd="mbrl__subcmd__eval__subcmd__help__subcmd__dataset"
+                ;;
+            mbrl__subcmd__eval__subcmd__help,dlgpd)
+                cmd="mbrl__subcmd__eval__subcmd__help__subcmd__dlgpd"
                 ;;
             mbrl__subcmd__eval__subcmd__help,embodied)
                 cmd="mbrl__subcmd__eval__subcmd__help__subcmd__embodied"
@@ -147,6 +153,9 @@ _mbrl() {
                 ;;
             mbrl__subcmd__help__subcmd__eval,dataset)
                 cmd="mbrl__subcmd__help__subcmd__eval__subcmd__dataset"
+                ;;
+            mbrl__subcmd__help__subcmd__eval,dlgpd)
+                cmd="mbrl__subcmd__help__subcmd__eval__subcmd__dlgpd"
                 ;;
             mbrl__subcmd__help__subcmd__eval,embodied)
                 cmd="mbrl__subcmd__help__subcmd__eval__subcmd__embodied"
@@ -367,7 +376,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval)
-            opts="-q -h -V --seed --threads --tui --no-tui --quiet --help --version quick dataset boards embodied ball context seads pendulum-swingup help"
+            opts="-q -h -V --seed --threads --tui --no-tui --quiet --help --version quick dataset boards embodied ball context seads dlgpd pendulum-swingup help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -572,6 +581,64 @@ _mbrl() {
             COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
             return 0
             ;;
+        mbrl__subcmd__eval__subcmd__dlgpd)
+            opts="-q -h -V --model --env --evidence-rollouts --runs --steps --candidates --elites --iters --out --seed --threads --tui --no-tui --quiet --help --version"
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                --model)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --env)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --evidence-rollouts)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --runs)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --steps)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --candidates)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --elites)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --iters)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --out)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --seed)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
         mbrl__subcmd__eval__subcmd__embodied)
             opts="-q -h -V --game --embodiment --max-depth --boards --split --out --seed --threads --tui --no-tui --quiet --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
@@ -619,7 +686,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__help)
-            opts="quick dataset boards embodied ball context seads pendulum-swingup help"
+            opts="quick dataset boards embodied ball context seads dlgpd pendulum-swingup help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -675,6 +742,20 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__help__subcmd__dataset)
+            opts=""
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 4 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mbrl__subcmd__eval__subcmd__help__subcmd__dlgpd)
             opts=""
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 4 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
@@ -1011,7 +1092,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__help__subcmd__eval)
-            opts="quick dataset boards embodied ball context seads pendulum-swingup"
+            opts="quick dataset boards embodied ball context seads dlgpd pendulum-swingup"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1067,6 +1148,20 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__help__subcmd__eval__subcmd__dataset)
+            opts=""
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 4 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mbrl__subcmd__help__subcmd__eval__subcmd__dlgpd)
             opts=""
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 4 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
@@ -1235,7 +1330,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__plan)
-            opts="-q -h -V --env --model --particles --propagation --context --steps --horizon --candidates --elites --iters --noise --beta --no-warm-start --instance-seed --out --seed --threads --tui --no-tui --quiet --help --version"
+            opts="-q -h -V --env --model --particles --propagation --context --steps --horizon --candidates --elites --iters --noise --beta --no-warm-start --evidence --instance-seed --out --seed --threads --tui --no-tui --quiet --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1286,6 +1381,10 @@ _mbrl() {
                     return 0
                     ;;
                 --beta)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --evidence)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
@@ -1432,7 +1531,7 @@ _mbrl() {
             fi
             case "${prev}" in
                 --method)
-                    COMPREPLY=($(compgen -W "pets ball-ekf context seads" -- "${cur}"))
+                    COMPREPLY=($(compgen -W "pets ball-ekf context seads dlgpd" -- "${cur}"))
                     return 0
                     ;;
                 --data)

@@ -83,6 +83,7 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l iters -d 'CEM iterati
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l noise -d 'Sampling noise' -r -f -a "white\t'Independent Gaussian samples (thesis Algorithm 1)'
 colored\t'Power spectral density ∝ 1/f^β along time (iCEM)'"
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l beta -d 'Exponent β of colored noise (used with --noise colored)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l evidence -d 'DLGPD models: rollouts to condition the GPs on (a dataset written by `collect`)' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l instance-seed -d 'Plan in the instance (hidden parameters) this seed names, as `calibrate --instance-seed` does' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l out -d 'Where to save the executed rollout (default: datasets/plan-<env>.mcap)' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
@@ -96,19 +97,20 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -s V -l version -d 'Prin
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l method -d 'What to train' -r -f -a "pets\t'Probabilistic ensemble of MLPs on (state, action) → state change (PETS, Chua et al. 2018), for any env that `collect` rolls out; plan with it via `mbrl plan --model DIR`'
 ball-ekf\t'Gray-box table-tennis ball EKF: learn the impact matrix, noise levels and initial values by maximizing the filter\'s marginal likelihood (thesis 6.4.4, eq. 6.24)'
 context\t'Context-conditional GRU dynamics with a context encoder (Explore the Context, thesis ch. 4), trained on instance-pair datasets (`collect --instances N`); calibrate with `mbrl calibrate`'
-seads\t'SEADS (thesis ch. 7): skill policies (SAC) and a symbolic forward model learned without reward in an embodied board game (--env lightsout:cursor|tileswap:cursor|lightsout:reacher|tileswap:reacher); needs no --data, it collects its own episodes'"
+seads\t'SEADS (thesis ch. 7): skill policies (SAC) and a symbolic forward model learned without reward in an embodied board game (--env lightsout:cursor|tileswap:cursor|lightsout:reacher|tileswap:reacher); needs no --data, it collects its own episodes'
+dlgpd\t'DLGPD (thesis ch. 3): a VAE on pendulum frames (`collect --images`) with Gaussian-process latent dynamics and reward; plan with `mbrl plan --model DIR --evidence E.mcap`. The small preset learns from the pole angle instead of frames'"
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l data -d 'Training data (repeatable). pets: rollout datasets (.mcap) of one env; ball-ekf: a ball dataset (.mcap) or a .csv recording. SEADS collects its own episodes and takes none' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l env -d 'The env the data must come from (pets; default: the dataset\'s env)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l out -d 'Checkpoint directory (default: models/<method>-<env>, models/ball-ekf)' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l resume -d 'Continue the stopped run in this checkpoint directory' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l config -d 'Hyperparameters from a TOML file (pets, context), over the preset\'s' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l preset -d 'Network size and training length (pets: small, medium; context: small, medium, paper)' -r -f -a "small\t'3 hidden layers × 64 SiLU units, 2000 steps (≈ 10 s on 2 cores)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l preset -d 'Network size and training length (pets: small, medium; context, seads, dlgpd: small, medium, paper)' -r -f -a "small\t'3 hidden layers × 64 SiLU units, 2000 steps (≈ 10 s on 2 cores)'
 medium\t'4 × 200 SiLU units, 5000 steps: mbrl-lib\'s PETS pendulum network'
-paper\t'Context model only: Table B.1 (toy 50k steps, pendulum and MountainCar 100k at batch 512)'"
+paper\t'The paper\'s scale (context: Table B.1; seads: 500k/10M env steps; dlgpd: batch 1024, 28 000 steps)'"
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l ensemble -d 'Ensemble members (pets; default 5)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l steps -d 'Optimizer steps (pets: preset\'s; ball-ekf: 1000)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l batch -d 'Batch size: transitions per member (pets, 256) or chunks (ball-ekf, thesis 64)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l lr -d 'Adam learning rate (pets: 1e-3; ball-ekf: thesis 5e-3)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l steps -d 'Optimizer steps (pets, context, dlgpd: the preset\'s; ball-ekf: 1000)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l batch -d 'Batch size: transitions per member (pets, 256), chunks (ball-ekf, thesis 64), transitions (dlgpd: the preset\'s; the paper 1024)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l lr -d 'Adam learning rate (pets, dlgpd: 1e-3; ball-ekf: thesis 5e-3)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l reward -d 'Where the model\'s reward comes from (pets; default: known where the env has a closed form)' -r -f -a "known\t'The env\'s closed-form reward (pendulum variants without hidden actuators)'
 learned\t'An extra output of the network, trained on the dataset\'s rewards'"
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l chunk -d 'Frames per chunk (ball-ekf; thesis: 50)' -r
@@ -191,22 +193,23 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l no-tui -d 'Pri
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -s V -l version -d 'Print version'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads pendulum-swingup help" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads pendulum-swingup help" -l threads -d 'Worker threads (0 = one per core)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads pendulum-swingup help" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads pendulum-swingup help" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads pendulum-swingup help" -s q -l quiet -d 'Print only results and errors'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads pendulum-swingup help" -s h -l help -d 'Print help'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads pendulum-swingup help" -s V -l version -d 'Print version'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads pendulum-swingup help" -f -a "quick" -d 'Small reproduction of every implemented method (about a minute)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads pendulum-swingup help" -f -a "dataset" -d 'Summarise a dataset: rollouts, returns, state ranges, plots'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads pendulum-swingup help" -f -a "boards" -d 'Depth and train/test split tables of LightsOut 5x5 and TileSwap (thesis Tables 7.1, 7.2)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads pendulum-swingup help" -f -a "embodied" -d 'A manipulator\'s scripted controller plays optimal plans of boards of depth 1..D'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads pendulum-swingup help" -f -a "ball" -d 'Ball prediction error vs horizon on simulated shots, default and unseen launcher poses (thesis 6.5)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads pendulum-swingup help" -f -a "context" -d 'Explore the Context (thesis 4.5): calibration strategies compared by prediction error after calibration'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads pendulum-swingup help" -f -a "seads" -d 'SEADS (thesis 7.4): skill coverage, boards solved per depth with and without replanning, planning time'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads pendulum-swingup help" -f -a "pendulum-swingup" -d 'Pendulum swing-up with MPC: success rate, returns, angle plots'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads pendulum-swingup help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads dlgpd pendulum-swingup help" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads dlgpd pendulum-swingup help" -l threads -d 'Worker threads (0 = one per core)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads dlgpd pendulum-swingup help" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads dlgpd pendulum-swingup help" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads dlgpd pendulum-swingup help" -s q -l quiet -d 'Print only results and errors'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads dlgpd pendulum-swingup help" -s h -l help -d 'Print help'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads dlgpd pendulum-swingup help" -s V -l version -d 'Print version'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads dlgpd pendulum-swingup help" -f -a "quick" -d 'Small reproduction of every implemented method (about a minute)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads dlgpd pendulum-swingup help" -f -a "dataset" -d 'Summarise a dataset: rollouts, returns, state ranges, plots'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads dlgpd pendulum-swingup help" -f -a "boards" -d 'Depth and train/test split tables of LightsOut 5x5 and TileSwap (thesis Tables 7.1, 7.2)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads dlgpd pendulum-swingup help" -f -a "embodied" -d 'A manipulator\'s scripted controller plays optimal plans of boards of depth 1..D'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads dlgpd pendulum-swingup help" -f -a "ball" -d 'Ball prediction error vs horizon on simulated shots, default and unseen launcher poses (thesis 6.5)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads dlgpd pendulum-swingup help" -f -a "context" -d 'Explore the Context (thesis 4.5): calibration strategies compared by prediction error after calibration'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads dlgpd pendulum-swingup help" -f -a "seads" -d 'SEADS (thesis 7.4): skill coverage, boards solved per depth with and without replanning, planning time'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads dlgpd pendulum-swingup help" -f -a "dlgpd" -d 'DLGPD (thesis 3.5.3): swing-up success and return vs evidence rollouts on the standard, inverted, light and heavy pendulum, with matching and mismatching evidence (Figs. 3.4/3.5 analogues)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads dlgpd pendulum-swingup help" -f -a "pendulum-swingup" -d 'Pendulum swing-up with MPC: success rate, returns, angle plots'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context seads dlgpd pendulum-swingup help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from quick" -l out -d 'Report directory' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from quick" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from quick" -l threads -d 'Worker threads (0 = one per core)' -r
@@ -301,6 +304,22 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -s V -l version -d 'Print version'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l model -d 'A DLGPD checkpoint (`mbrl train --method dlgpd`)' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l env -d 'Settings to swing up (repeatable; default: the thesis\' pendulum, pendulum:inverted, pendulum:light, pendulum:heavy)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l evidence-rollouts -d 'Evidence sizes in rollouts of 30 frames (thesis: 10, 20, 30, 50, 70, 100, 200)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l runs -d 'Runs per point, each with its own evidence pool and start state (thesis: 27)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l steps -d 'Steps per swing-up' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l candidates -d 'CEM candidates per iteration (the authors\': 1000, about 1.5 s a step on 2 cores at 10 evidence rollouts)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l elites -d 'CEM elites (the authors\': 100)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l iters -d 'At most this many CEM iterations per step (the authors\': 30, stopping at first-action std ≤ 0.01)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l out -d 'Report directory' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l threads -d 'Worker threads (0 = one per core)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -s q -l quiet -d 'Print only results and errors'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -s h -l help -d 'Print help'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -s V -l version -d 'Print version'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l model -d 'Dynamics the planner uses: `true` (the simulator\'s equations) or a checkpoint directory written by `mbrl train` (e.g. models/pets-pendulum)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l particles -d 'Particles per candidate for stochastic learned models (PETS: trajectory sampling)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l propagation -d 'How particles use the ensemble members' -r -f -a "ts1\t'TS-1: each particle draws an ensemble member anew at every step'
@@ -333,6 +352,7 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from help" -f -a "ball" -d 'Ball prediction error vs horizon on simulated shots, default and unseen launcher poses (thesis 6.5)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from help" -f -a "context" -d 'Explore the Context (thesis 4.5): calibration strategies compared by prediction error after calibration'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from help" -f -a "seads" -d 'SEADS (thesis 7.4): skill coverage, boards solved per depth with and without replanning, planning time'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from help" -f -a "dlgpd" -d 'DLGPD (thesis 3.5.3): swing-up success and return vs evidence rollouts on the standard, inverted, light and heavy pendulum, with matching and mismatching evidence (Figs. 3.4/3.5 analogues)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from help" -f -a "pendulum-swingup" -d 'Pendulum swing-up with MPC: success rate, returns, angle plots'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
@@ -367,4 +387,5 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from eval" -f -a "ball" -d 'Ball prediction error vs horizon on simulated shots, default and unseen launcher poses (thesis 6.5)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from eval" -f -a "context" -d 'Explore the Context (thesis 4.5): calibration strategies compared by prediction error after calibration'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from eval" -f -a "seads" -d 'SEADS (thesis 7.4): skill coverage, boards solved per depth with and without replanning, planning time'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from eval" -f -a "dlgpd" -d 'DLGPD (thesis 3.5.3): swing-up success and return vs evidence rollouts on the standard, inverted, light and heavy pendulum, with matching and mismatching evidence (Figs. 3.4/3.5 analogues)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from eval" -f -a "pendulum-swingup" -d 'Pendulum swing-up with MPC: success rate, returns, angle plots'

@@ -49,7 +49,12 @@ fn variant_names<S: serde::Serializer>(v: &[PendulumVariant], s: S) -> std::resu
 impl DlgpdEvalSettings {
     /// The thesis' four settings.
     pub fn thesis_variants() -> Vec<PendulumVariant> {
-        vec![PendulumVariant::Standard, PendulumVariant::Inverted, PendulumVariant::Mass(0.2), PendulumVariant::Mass(1.5)]
+        vec![
+            PendulumVariant::Standard,
+            PendulumVariant::Inverted,
+            PendulumVariant::Mass(0.2),
+            PendulumVariant::Mass(1.5),
+        ]
     }
 
     fn validate(&self) -> Result<()> {
@@ -155,9 +160,11 @@ pub fn evaluate(
                 }
                 let evidence = first_rollouts(&pool, rollouts);
                 let dynamics = condition_on(trained, &evidence, pool_seed)?;
-                let control = ControlSettings { variant: variant.clone(), steps: settings.steps, cem: settings.cem.clone() };
+                let control =
+                    ControlSettings { variant: variant.clone(), steps: settings.steps, cem: settings.cem.clone() };
                 let episode = swing_up(trained, &dynamics, &control, control_seed, &NullMonitor)?;
-                let iterations = episode.iterations.iter().sum::<usize>() as f64 / episode.iterations.len().max(1) as f64;
+                let iterations =
+                    episode.iterations.iter().sum::<usize>() as f64 / episode.iterations.len().max(1) as f64;
                 let outcome = Outcome {
                     env: variant.env_name(),
                     evidence: kind,
