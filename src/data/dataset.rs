@@ -454,6 +454,39 @@ mod tests {
         data
     }
 
+    /// Single bit flips anywhere in a file mbrl wrote (the class of input that made the MCAP library reserve
+    /// up to 3.6e18 bytes): every one reads back as the original or is a one-line error; none panics or aborts.
+    #[test]
+    fn bit_flipped_files_are_errors_never_crashes() {
+        use rand::{Rng, SeedableRng};
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("frames.mcap");
+        let data = with_frames();
+        write_dataset(&path, &data).unwrap();
+        let original = std::fs::read(&path).unwrap();
+        let mutated = dir.path().join("mutated.mcap");
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(13);
+        let mut errors = 0;
+        for _ in 0..400 {
+            let mut bytes = original.clone();
+            let bit = rng.random_range(0..bytes.len() * 8);
+            bytes[bit / 8] ^= 1 << (bit % 8);
+            std::fs::write(&mutated, &bytes).unwrap();
+            match read_dataset(&mutated) {
+                Ok(read) => assert_eq!(read, data, "flipping bit {bit} changed the data without an error"),
+                Err(e) => {
+                    assert_eq!(e.to_string().lines().count(), 1, "{e}");
+                    errors += 1;
+                }
+            }
+        }
+        assert!(errors > 350, "only {errors} of 400 flips were detected");
+        for cut in [0, 8, original.len() / 2, original.len() - 1] {
+            std::fs::write(&mutated, &original[..cut]).unwrap();
+            assert!(read_dataset(&mutated).is_err(), "a file cut at {cut} bytes was accepted");
+        }
+    }
+
     #[test]
     fn frames_round_trip_beside_the_timesteps() {
         let dir = tempfile::tempdir().unwrap();

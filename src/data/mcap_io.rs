@@ -154,33 +154,88 @@ fn decode<T: DeserializeOwned>(path: &Path, topic: &str, raw: Vec<(u32, Vec<u8>)
 
 type RawTopics = (BTreeMap<String, String>, Vec<Vec<(u32, Vec<u8>)>>);
 
-/// The named metadata record and the payloads of each of `topics`, with their sequence numbers.
+/// Largest MCAP file read (the whole file is held in memory).
+pub const MAX_MCAP_BYTES: u64 = 8 << 30;
+/// A record inside a chunk may be longer than the compressed file, but not by more than this factor (and never
+/// beyond 1 GiB): a flipped length field is refused before anything is reserved for it.
+const RECORD_EXPANSION: usize = 16;
+const MIN_RECORD_LIMIT: usize = 1 << 20;
+const MAX_RECORD_LIMIT: usize = 1 << 30;
+const MESSAGE_ENCODING: &str = "json";
+const SCHEMA_ENCODING: &str = "jsonschema";
+
+/// The named metadata record and the payloads of each of `topics`, with their sequence numbers. The file is
+/// read through the MCAP library's sans-io reader with every declared length bounded by the bytes present,
+/// chunk and data-section CRCs checked, and each wanted topic's channel checked to be JSON with a JSON Schema.
 fn read_raw(path: &Path, metadata_name: &str, topics: &[&str]) -> Result<RawTopics> {
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    use mcap::records::Record;
+    use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
+    let bytes = crate::util::bounded_read::read_bounded(path, MAX_MCAP_BYTES)?;
     let corrupt =
         |e: mcap::McapError| Error::bad_file(path, format!("not a readable MCAP file (truncated or corrupt?): {e}"));
+    let limit = bytes.len().saturating_mul(RECORD_EXPANSION).clamp(MIN_RECORD_LIMIT, MAX_RECORD_LIMIT);
+    let options = LinearReaderOptions::default()
+        .with_validate_chunk_crcs(true)
+        .with_validate_data_section_crc(true)
+        .with_validate_summary_section_crc(true)
+        .with_record_length_limit(limit);
+    let mut reader = LinearReader::new_with_options(options);
     let mut metadata = None;
     let mut other_names = Vec::new();
-    for record in mcap::read::LinearReader::new(&bytes).map_err(corrupt)? {
-        if let mcap::records::Record::Metadata(m) = record.map_err(corrupt)? {
-            if m.name == metadata_name {
-                metadata = Some(m.metadata);
-            } else {
-                other_names.push(m.name);
+    let mut schema_encodings: BTreeMap<u16, String> = BTreeMap::new();
+    // Channel id → index into `topics`, for the wanted topics only.
+    let mut wanted: BTreeMap<u16, usize> = BTreeMap::new();
+    let mut out = vec![Vec::new(); topics.len()];
+    let mut offset = 0;
+    loop {
+        let request = match reader.next_event() {
+            None => break,
+            Some(Err(e)) => return Err(corrupt(e)),
+            Some(Ok(LinearReadEvent::ReadRequest(n))) => n,
+            Some(Ok(LinearReadEvent::Record { data, opcode })) => {
+                match mcap::parse_record(opcode, data).map_err(corrupt)? {
+                    Record::Metadata(m) if m.name == metadata_name => metadata = Some(m.metadata),
+                    Record::Metadata(m) => other_names.push(m.name),
+                    Record::Schema { header, .. } => {
+                        schema_encodings.insert(header.id, header.encoding);
+                    }
+                    Record::Channel(channel) => {
+                        if let Some(k) = topics.iter().position(|t| *t == channel.topic) {
+                            let schema = schema_encodings.get(&channel.schema_id).map(String::as_str);
+                            if channel.message_encoding != MESSAGE_ENCODING || schema != Some(SCHEMA_ENCODING) {
+                                return Err(Error::bad_file(
+                                    path,
+                                    format!(
+                                        "channel '{}' has message encoding '{}' and schema encoding '{}'; mbrl \
+                                         reads '{MESSAGE_ENCODING}' messages with a '{SCHEMA_ENCODING}' schema",
+                                        channel.topic,
+                                        channel.message_encoding,
+                                        schema.unwrap_or("none")
+                                    ),
+                                ));
+                            }
+                            wanted.insert(channel.id, k);
+                        }
+                    }
+                    Record::Message { header, data } => {
+                        if let Some(&k) = wanted.get(&header.channel_id) {
+                            out[k].push((header.sequence, data.into_owned()));
+                        }
+                    }
+                    _ => {}
+                }
+                continue;
             }
-        }
+        };
+        let n = request.min(bytes.len() - offset);
+        reader.insert(n).copy_from_slice(&bytes[offset..offset + n]);
+        reader.notify_read(n);
+        offset += n;
     }
     let metadata = metadata.ok_or_else(|| {
         let found = if other_names.is_empty() { "none".to_string() } else { other_names.join(", ") };
         Error::bad_file(path, format!("expected a '{metadata_name}' metadata record, found {found}"))
     })?;
-    let mut out = vec![Vec::new(); topics.len()];
-    for message in mcap::MessageStream::new(&bytes).map_err(corrupt)? {
-        let message = message.map_err(corrupt)?;
-        if let Some(k) = topics.iter().position(|t| *t == message.channel.topic) {
-            out[k].push((message.sequence, message.data.into_owned()));
-        }
-    }
     Ok((metadata, out))
 }
 
@@ -213,4 +268,32 @@ pub fn metadata_seed(path: &Path, metadata: &BTreeMap<String, String>) -> Result
     metadata_field(path, metadata, "seed")?
         .parse()
         .map_err(|_| Error::bad_file(path, "metadata field 'seed': expected an integer"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A file whose wanted topic is not JSON with a JSON Schema is refused before any payload is decoded.
+    #[test]
+    fn a_topic_in_another_encoding_is_named_and_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("cbor.mcap");
+        {
+            let file = std::io::BufWriter::new(std::fs::File::create(&path).unwrap());
+            let mut writer = mcap::WriteOptions::new().create(file).unwrap();
+            let metadata = BTreeMap::from([("format_version".to_string(), "1".to_string())]);
+            writer.write_metadata(&mcap::records::Metadata { name: "meta".into(), metadata }).unwrap();
+            let schema = writer.add_schema("s", "protobuf", b"").unwrap();
+            let channel = writer.add_channel(schema, "/steps", "cbor", &BTreeMap::new()).unwrap();
+            let header =
+                mcap::records::MessageHeader { channel_id: channel, sequence: 0, log_time: 0, publish_time: 0 };
+            writer.write_to_known_channel(&header, b"\xa0").unwrap();
+            writer.finish().unwrap();
+        }
+        let e = read_raw(&path, "meta", &["/steps"]).unwrap_err().to_string();
+        assert!(e.contains("cbor.mcap") && e.contains("'/steps'") && e.contains("'cbor'"), "{e}");
+        // Another topic's encoding is none of the reader's business.
+        assert!(read_raw(&path, "meta", &["/other"]).is_ok());
+    }
 }

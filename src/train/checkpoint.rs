@@ -5,7 +5,6 @@
 //! model.
 
 use std::collections::BTreeMap;
-use std::io::Read;
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
@@ -140,24 +139,7 @@ impl CheckpointDir {
     }
 }
 
-/// Reads a regular file of at most `max` bytes (one more byte is read to detect a longer file), refusing FIFOs and
-/// devices before reading so a stray path can never block or fill memory.
-pub fn read_bounded(path: &Path, max: u64) -> Result<Vec<u8>> {
-    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
-    let meta = file.metadata().map_err(|e| Error::io(path, e))?;
-    if !meta.is_file() {
-        return Err(Error::bad_file(path, "not a regular file"));
-    }
-    if meta.len() > max {
-        return Err(Error::bad_file(path, format!("{} bytes; at most {max} expected", meta.len())));
-    }
-    let mut bytes = Vec::with_capacity(meta.len() as usize);
-    file.take(max + 1).read_to_end(&mut bytes).map_err(|e| Error::io(path, e))?;
-    if bytes.len() as u64 > max {
-        return Err(Error::bad_file(path, format!("grew past {max} bytes while being read")));
-    }
-    Ok(bytes)
-}
+pub use crate::util::bounded_read::read_bounded;
 
 /// Reads a small JSON file of a checkpoint (or a config) with the same bounds.
 pub fn read_json_file(path: &Path) -> Result<serde_json::Value> {

@@ -3,6 +3,7 @@
 
 pub mod alloc;
 pub mod atomic;
+pub mod bounded_read;
 pub mod fast_exp;
 pub mod seeding;
 pub mod table;
