@@ -14,7 +14,7 @@ pub const MAX_ACTION_BYTES: u64 = 64 << 20;
 /// Reads the actions in `path`, each row exactly `action_dim` finite numbers. The first row is taken as a
 /// header when it is not all numbers.
 pub fn read_actions(path: &Path, action_dim: usize) -> Result<Vec<Vec<f64>>> {
-    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    let file = crate::util::bounded_read::open_regular(path)?;
     parse_actions(path, file.take(MAX_ACTION_BYTES + 1), action_dim, Limits::DEFAULT)
 }
 

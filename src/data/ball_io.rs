@@ -179,15 +179,23 @@ fn check_enough_measurements(path: &Path, r: &Recording) -> Result<()> {
     Ok(())
 }
 
+/// Larger than any recording (a 10-minute capture at 180 Hz is ~5 MB); an endless input stops here.
+pub const MAX_BALL_CSV_BYTES: u64 = 256 << 20;
+
 /// Reads a CSV recording: a header with `frame` (camera frame index) or `t` (seconds), then `x`, `y`,
 /// `z` in metres (empty cells = lost frame), optionally the seven side-information columns
 /// `SIDE_INFO_COLUMNS` (read from the first row).
 pub fn read_ball_csv(path: &Path) -> Result<Recording> {
+    use std::io::Read;
+    let file = crate::util::bounded_read::open_regular(path)?;
+    let size = file.metadata().map_err(|e| Error::io(path, e))?.len();
+    if size > MAX_BALL_CSV_BYTES {
+        return Err(Error::bad_file(path, format!("{size} bytes; a recording is at most {MAX_BALL_CSV_BYTES}")));
+    }
     let mut reader = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
         .flexible(true)
-        .from_path(path)
-        .map_err(|e| Error::bad_file(path, format!("cannot read CSV: {e}")))?;
+        .from_reader(file.take(MAX_BALL_CSV_BYTES + 1));
     let header: Vec<String> = reader
         .headers()
         .map_err(|e| Error::bad_file(path, format!("cannot read the CSV header: {e}")))?

@@ -6,14 +6,19 @@ use std::path::Path;
 
 use crate::error::{Error, Result};
 
-/// Reads a regular file of at most `max` bytes (one more byte is read to detect a file that grows). The type
-/// is checked on the path before opening, because opening a FIFO for reading already blocks.
-pub fn read_bounded(path: &Path, max: u64) -> Result<Vec<u8>> {
+/// Opens a regular file for reading, refusing FIFOs and devices by their path's type first.
+pub fn open_regular(path: &Path) -> Result<std::fs::File> {
     let before = std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
     if !before.is_file() {
         return Err(Error::bad_file(path, "not a regular file"));
     }
-    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    std::fs::File::open(path).map_err(|e| Error::io(path, e))
+}
+
+/// Reads a regular file of at most `max` bytes (one more byte is read to detect a file that grows). The type
+/// is checked on the path before opening, because opening a FIFO for reading already blocks.
+pub fn read_bounded(path: &Path, max: u64) -> Result<Vec<u8>> {
+    let file = open_regular(path)?;
     let meta = file.metadata().map_err(|e| Error::io(path, e))?;
     if !meta.is_file() {
         return Err(Error::bad_file(path, "not a regular file"));
