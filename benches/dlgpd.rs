@@ -1,7 +1,7 @@
 //! DLGPD's training step at the paper's batch of 1024 transitions: the GP terms alone (three transition GPs
 //! and the reward GP conditioned on the batch, exact f64 Cholesky, with every gradient), and the whole step's
 //! loss and gradients (two encodings of 6 × 64 × 64 frames, one decoding, the GP terms injected, backward),
-//! without the optimizer update. PyTorch reference for the
+//! without the optimizer update; and one CEM iteration of the planner at two evidence sizes. PyTorch reference for the
 //! whole step on this kind of machine: 9.2 s at 2 threads (../shared/ARCHITECTURE.md).
 
 use criterion::{criterion_group, criterion_main, Criterion};
@@ -44,5 +44,36 @@ fn gp(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, gp);
+/// One CEM iteration of DLGPD's planner: 1000 candidates × horizon 20 rolled out as mean latents through the
+/// three transition GPs (with predictive variances) and scored by the reward GP at 5 latent samples per step,
+/// with 280 and 1400 evidence points (10 and 50 evidence rollouts of 28 transitions).
+fn planning(c: &mut Criterion) {
+    use mbrl::models::dlgpd::control::LatentObjective;
+    use mbrl::models::dlgpd::dynamics::{Evidence, LatentDynamics};
+    use mbrl::models::dlgpd::latent_gp::LatentScale;
+    use mbrl::planning::Objective;
+    let mut group = c.benchmark_group("dlgpd_cem_iteration_1000x20");
+    group.sample_size(10);
+    for points in [280usize, 1400] {
+        let mut rng = ChaCha8Rng::seed_from_u64(1);
+        let latents: Vec<f64> = (0..points * 3).map(|_| rng.random_range(-2.0..2.0)).collect();
+        let actions: Vec<f64> = (0..points).map(|_| rng.random_range(-2.0..2.0)).collect();
+        let next: Vec<f64> = latents.iter().enumerate().map(|(i, s)| s + 0.05 * actions[i / 3]).collect();
+        let rewards: Vec<f64> = (0..points).map(|b| -latents[b * 3].powi(2)).collect();
+        let transition: Vec<GpHypers> = (0..3).map(|_| GpHypers::new(&HyperInit::dlgpd(4, 1.0)).unwrap()).collect();
+        let reward = GpHypers::new(&HyperInit::dlgpd(4, 4.0)).unwrap();
+        let scale = LatentScale::of(&latents, 3).unwrap();
+        let evidence = Evidence { latents: &latents, actions: &actions, next_latents: &next, rewards: &rewards };
+        let dynamics = LatentDynamics::condition(&transition, &reward, scale, &evidence).unwrap();
+        let objective = LatentObjective::new(&dynamics, vec![0.1, -0.2, 0.3], vec![0.01; 3], 7);
+        let candidates: Vec<f64> = (0..1000 * 20).map(|_| rng.random_range(-2.0..2.0)).collect();
+        let mut costs = vec![0.0; 1000];
+        group.bench_function(format!("{points}_evidence_points"), |b| {
+            b.iter(|| objective.costs(&candidates, 20, &mut costs))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, gp, planning);
 criterion_main!(benches);

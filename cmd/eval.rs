@@ -576,6 +576,12 @@ fn eval_dlgpd(global: &GlobalArgs, provenance: &Provenance, a: DlgpdArgs) -> any
             p.env, p.evidence, p.rollouts, p.mean_return, p.successes, p.runs
         );
     }
+    for t in &summary.tests {
+        println!(
+            "Wilcoxon: {} with {} rollouts, matching evidence higher return than mismatching: p = {:.3e} ({} pairs)",
+            t.env, t.rollouts, t.p_value, t.pairs
+        );
+    }
     println!("report: {}", a.out.join("report.md").display());
     Ok(())
 }

@@ -120,6 +120,13 @@ fn plan_dlgpd(
     let seed = global.seed;
     let dynamics = dlgpd::control::condition_on(&trained, &evidence, seed)
         .map_err(|e| anyhow::anyhow!("{}: {e}", evidence_path.display()))?;
+    if dynamics.jitter() > 0.0 {
+        eprintln!(
+            "warning: the evidence's kernel matrix needed diagonal jitter {:.1e} to factor (near-duplicate \
+             evidence points)",
+            dynamics.jitter()
+        );
+    }
     let mut control = dlgpd::control::ControlSettings::authors(settings.variant.clone());
     control.steps = settings.steps;
     control.cem = mbrl::planning::CemConfig { stop_std: Some(dlgpd::control::STOP_STD), ..settings.cem.clone() };

@@ -192,10 +192,8 @@ pub fn read_ball_csv(path: &Path) -> Result<Recording> {
     if size > MAX_BALL_CSV_BYTES {
         return Err(Error::bad_file(path, format!("{size} bytes; a recording is at most {MAX_BALL_CSV_BYTES}")));
     }
-    let mut reader = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .flexible(true)
-        .from_reader(file.take(MAX_BALL_CSV_BYTES + 1));
+    let mut reader =
+        csv::ReaderBuilder::new().trim(csv::Trim::All).flexible(true).from_reader(file.take(MAX_BALL_CSV_BYTES + 1));
     let header: Vec<String> = reader
         .headers()
         .map_err(|e| Error::bad_file(path, format!("cannot read the CSV header: {e}")))?
