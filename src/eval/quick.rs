@@ -59,7 +59,7 @@ pub const QUICK_SEADS_DEPTH: u8 = 3;
 /// inverted-action pendulum swung up on matching and on mismatching evidence; `make repro-dlgpd` runs more.
 pub const QUICK_DLGPD_ROLLOUTS: usize = 500;
 pub const QUICK_DLGPD_TRAIN_STEPS: u64 = 3000;
-pub const QUICK_DLGPD_EVIDENCE_ROLLOUTS: usize = 10;
+pub const QUICK_DLGPD_EVIDENCE_ROLLOUTS: usize = 20;
 pub const QUICK_DLGPD_SWINGUP_STEPS: usize = 150;
 pub const QUICK_DLGPD_CANDIDATES: usize = 200;
 
