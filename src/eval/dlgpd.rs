@@ -9,7 +9,7 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use super::plot::{line_plot, Series};
+use super::plot::{line_plot, line_plot_in, Series};
 use super::stats::{wilcoxon_signed_rank, Alternative};
 use crate::data::collect::{collect_random, CollectSettings};
 use crate::data::collect_frames::add_pendulum_frames;
@@ -337,12 +337,13 @@ fn write_report(
         &format!("mean return ({} runs per point)", settings.runs),
         &curves(&|p| p.mean_return),
     )?;
-    line_plot(
+    line_plot_in(
         &run_dir.file("success.png"),
         "DLGPD swing-up success vs evidence (Fig. 3.5 analogue)",
         "rollouts in evidence",
         "success rate (last 25 rewards > -1)",
         &curves(&|p| p.successes as f64 / p.runs as f64),
+        (-0.05, 1.05),
     )?;
     let mut md = String::new();
     md.push_str("# DLGPD: swing-up on swapped evidence (thesis 3.5.3, Figs. 3.4/3.5)\n\n");

@@ -47,7 +47,8 @@ fn bounds(values: impl Iterator<Item = f64>) -> (f64, f64) {
     if !lo.is_finite() {
         return (0.0, 1.0);
     }
-    let pad = ((hi - lo) * 0.05).max(1e-6);
+    // A single value (one evidence size, one run) still needs an axis that reads as a range around it.
+    let pad = if hi - lo > 1e-9 * lo.abs().max(1.0) { (hi - lo) * 0.05 } else { (lo.abs() * 0.1).max(1.0) };
     (lo - pad, hi + pad)
 }
 
@@ -107,9 +108,14 @@ pub fn line_plot_in(
             let color = Palette99::pick(i).to_rgba();
             // A non-finite y breaks the line, so wrapped angles do not draw vertical jumps.
             for (j, segment) in s.points.split(|p| !p.1.is_finite()).filter(|seg| !seg.is_empty()).enumerate() {
-                let drawn = chart
-                    .draw_series(LineSeries::new(segment.iter().copied(), color))
-                    .map_err(|e| plot_err(path, e))?;
+                // A lone point has no line to show it: mark it.
+                let drawn = if segment.len() == 1 {
+                    chart
+                        .draw_series(segment.iter().map(|&p| Circle::new(p, 4, color.filled())))
+                        .map_err(|e| plot_err(path, e))?
+                } else {
+                    chart.draw_series(LineSeries::new(segment.iter().copied(), color)).map_err(|e| plot_err(path, e))?
+                };
                 if j == 0 {
                     drawn
                         .label(s.name.clone())
