@@ -119,7 +119,6 @@ fn evidence_tests(outcomes: &[Outcome]) -> Result<Vec<EvidenceTest>> {
     let mut tests = Vec::new();
     let mut keys: Vec<(String, usize)> =
         outcomes.iter().filter(|o| o.evidence == "mismatching").map(|o| (o.env.clone(), o.rollouts)).collect();
-    keys.dedup();
     keys.sort();
     keys.dedup();
     for (env, rollouts) in keys {
@@ -199,14 +198,19 @@ pub fn evaluate(
     for run in 0..settings.runs {
         let pool_seed = derive_seed(seed, &[EVIDENCE_STREAM, run as u64]);
         let control_seed = derive_seed(seed, &[CONTROL_STREAM, run as u64]);
+        // One pool per run and source env, shared by the settings that use it; smaller evidence sets are its
+        // first rollouts, as the authors' buckets.
+        let mut pools: Vec<(PendulumVariant, Dataset)> = Vec::new();
         for (variant, kind, source) in &plan {
-            // One pool per run and source; smaller evidence sets are its first rollouts, as the authors' buckets.
-            let pool = evidence_rollouts(source, largest, pool_seed, images)?;
+            if !pools.iter().any(|(v, _)| v == source) {
+                pools.push((source.clone(), evidence_rollouts(source, largest, pool_seed, images)?));
+            }
+            let pool = &pools.iter().find(|(v, _)| v == source).expect("pushed above").1;
             for &rollouts in &settings.evidence_rollouts {
                 if monitor.is_cancelled() {
                     return Err(Error::Cancelled);
                 }
-                let evidence = first_rollouts(&pool, rollouts);
+                let evidence = first_rollouts(pool, rollouts);
                 let dynamics = condition_on(trained, &evidence, pool_seed)?;
                 let control =
                     ControlSettings { variant: variant.clone(), steps: settings.steps, cem: settings.cem.clone() };
