@@ -134,7 +134,7 @@ pub fn run(global: &GlobalArgs, args: CalibrateArgs) -> anyhow::Result<()> {
     })?;
     let prior = gaussian_entropy(&model.fast.belief(&vec![0.0; model.fast.transition_features], 1).std);
     let last = calibration.entropies.last().copied().unwrap_or(prior);
-    println!(
+    say!(
         "calibrated {} instance {} ({}) with {} {} transitions: entropy of q(β | context) {:.3} → {:.3} nats",
         env.canonical(),
         args.instance_seed,
@@ -144,6 +144,6 @@ pub fn run(global: &GlobalArgs, args: CalibrateArgs) -> anyhow::Result<()> {
         prior,
         last
     );
-    println!("context set written to {}", out.display());
+    say!("context set written to {}", out.display());
     Ok(())
 }

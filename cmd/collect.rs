@@ -204,7 +204,7 @@ pub fn run(global: &GlobalArgs, args: CollectArgs) -> anyhow::Result<()> {
     };
     let frames =
         if dataset.frames.is_empty() { String::new() } else { format!(" with {} frames", dataset.frames.len()) };
-    println!(
+    say!(
         "wrote {} transitions in {grouping} of {}{frames} to {}",
         dataset.steps.len(),
         dataset.meta.env,
@@ -235,7 +235,7 @@ fn replay_actions(global: &GlobalArgs, env: EnvName, actions: &Path, args: &Coll
         add_pendulum_frames(&mut data, &mbrl::run::NullMonitor)?;
     }
     write_dataset(&out, &data)?;
-    println!("wrote a replay of {} actions in {} to {}", data.steps.len(), data.meta.env, out.display());
+    say!("wrote a replay of {} actions in {} to {}", data.steps.len(), data.meta.env, out.display());
     Ok(())
 }
 
@@ -283,7 +283,7 @@ fn collect_embodied_episodes(
         ),
     };
     let episodes = data.meta.instances.len();
-    println!("wrote {} steps in {episodes} skill episodes of {name} to {}", data.steps.len(), out.display());
+    say!("wrote {} steps in {episodes} skill episodes of {name} to {}", data.steps.len(), out.display());
     Ok(())
 }
 
@@ -314,13 +314,7 @@ fn collect_boards(global: &GlobalArgs, game: GameSpec, args: &CollectArgs) -> an
         per_depth[b.depth as usize] += 1;
     }
     let counts: Vec<String> = (1..=max_depth as usize).map(|d| format!("{d}: {}", per_depth[d])).collect();
-    println!(
-        "wrote {} boards of {} to {} (per depth {})",
-        set.boards.len(),
-        set.game,
-        out.display(),
-        counts.join(", ")
-    );
+    say!("wrote {} boards of {} to {} (per depth {})", set.boards.len(), set.game, out.display(), counts.join(", "));
     Ok(())
 }
 
@@ -358,7 +352,7 @@ fn collect_ball_shots(global: &GlobalArgs, trajectories: usize, args: &CollectAr
         Ok(data)
     })?;
     let frames: usize = data.recordings.iter().map(|r| r.frames.len()).sum();
-    println!(
+    say!(
         "wrote {} ball trajectories ({} shots from the {} pose, {} rotated copies), {frames} frames, to {}",
         data.recordings.len(),
         trajectories,

@@ -41,7 +41,13 @@ impl GlobalArgs {
     }
 }
 
+/// More worker threads than this only cost memory (a stack each) on any machine mbrl runs on.
+const MAX_THREADS: usize = 1024;
+
 pub fn init_threads(global: &GlobalArgs) -> anyhow::Result<()> {
+    if global.threads > MAX_THREADS {
+        anyhow::bail!("--threads {}: at most {MAX_THREADS} worker threads (0 = one per core)", global.threads);
+    }
     rayon::ThreadPoolBuilder::new()
         .num_threads(global.threads)
         .build_global()
@@ -153,4 +159,21 @@ pub fn parse_floats(flag: &str, text: &str) -> anyhow::Result<Vec<f64>> {
             _ => anyhow::bail!("{flag} '{text}': value {} ('{}') is not a finite number", i + 1, part.trim()),
         })
         .collect()
+}
+
+/// Prints one line of results. A reader that closed stdout early (`mbrl … | head -1`) does not stop the
+/// work, whose files are still written; any other failure to write ends the command with one error line.
+pub fn say(args: std::fmt::Arguments) {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    write_stdout(out.write_fmt(args).and_then(|()| out.write_all(b"\n")));
+}
+
+/// The policy of `say` for any write to stdout.
+pub fn write_stdout(result: std::io::Result<()>) {
+    match result {
+        Ok(()) => {}
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {}
+        Err(e) => mbrl::util::interrupt::abandon_and_exit_with(1, &format!("cannot write to stdout: {e}")),
+    }
 }

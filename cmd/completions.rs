@@ -23,6 +23,9 @@ pub fn run(args: CompletionsArgs) -> anyhow::Result<()> {
         _ => Shell::Fish,
     };
     let mut command = crate::Cli::command();
-    clap_complete::generate(shell, &mut command, "mbrl", &mut std::io::stdout());
+    let mut script = Vec::new();
+    clap_complete::generate(shell, &mut command, "mbrl", &mut script);
+    use std::io::Write;
+    crate::common::write_stdout(std::io::stdout().lock().write_all(&script));
     Ok(())
 }

@@ -201,21 +201,21 @@ pub fn run(global: &GlobalArgs, args: EvalArgs) -> anyhow::Result<()> {
         Protocol::Quick { out } => {
             let summary = run_job(global, "eval quick", |monitor| run_quick(&provenance, &out, monitor))?;
             for line in summary.lines {
-                println!("{line}");
+                say!("{line}");
             }
-            println!("report: {}", out.join("report.md").display());
+            say!("report: {}", out.join("report.md").display());
         }
         Protocol::Context(a) => eval_context(global, &provenance, a)?,
         Protocol::Seads(a) => eval_seads(global, &provenance, a)?,
         Protocol::Dlgpd(a) => eval_dlgpd(global, &provenance, a)?,
         Protocol::Boards { out } => {
             let rows = run_job(global, "eval boards", |monitor| boards::depth_report(&provenance, &out, monitor))?;
-            println!("game        depth   boards    train     test   thesis");
+            say!("game        depth   boards    train     test   thesis");
             for r in &rows {
                 let thesis = r.thesis.map(|t| t.to_string()).unwrap_or_else(|| "-".into());
-                println!("{:<11} {:>5} {:>8} {:>8} {:>8} {:>8}", r.game, r.depth, r.boards, r.train, r.test, thesis);
+                say!("{:<11} {:>5} {:>8} {:>8} {:>8} {:>8}", r.game, r.depth, r.boards, r.train, r.test, thesis);
             }
-            println!("report: {}", out.join("report.md").display());
+            say!("report: {}", out.join("report.md").display());
         }
         Protocol::Embodied(a) => {
             let settings = EmbodiedSettings {
@@ -236,7 +236,7 @@ pub fn run(global: &GlobalArgs, args: EvalArgs) -> anyhow::Result<()> {
                 }
             })?;
             for r in &rows {
-                println!(
+                say!(
                     "depth {}: {}/{} solved ({:.1} %), {:.1} control steps per board",
                     r.depth,
                     r.solved,
@@ -245,7 +245,7 @@ pub fn run(global: &GlobalArgs, args: EvalArgs) -> anyhow::Result<()> {
                     r.mean_control_steps
                 );
             }
-            println!("report: {}", a.out.join("report.md").display());
+            say!("report: {}", a.out.join("report.md").display());
         }
         Protocol::Ball(a) => {
             let models = a
@@ -266,9 +266,9 @@ pub fn run(global: &GlobalArgs, args: EvalArgs) -> anyhow::Result<()> {
             let summary = run_job(global, "eval ball", |monitor| {
                 ball::evaluate(&settings, models, &provenance, &a.out, monitor)
             })?;
-            println!("median prediction error at 1 s horizon:");
+            say!("median prediction error at 1 s horizon:");
             for r in summary.rows.iter().filter(|r| (r.horizon_s - 1.0).abs() < 1e-9) {
-                println!(
+                say!(
                     "  {:<32} {:<8} {:6.1} cm  (10-90 %: {:.1}-{:.1} cm, n = {})",
                     r.method,
                     r.group,
@@ -278,11 +278,11 @@ pub fn run(global: &GlobalArgs, args: EvalArgs) -> anyhow::Result<()> {
                     r.count
                 );
             }
-            println!("report: {}", a.out.join("report.md").display());
+            say!("report: {}", a.out.join("report.md").display());
         }
         Protocol::Dataset { input, out } => {
             let s = run_job(global, "eval dataset", |_| dataset_report::report(&input, &provenance, &out))?;
-            println!(
+            say!(
                 "{}: {} rollouts, {} transitions of {}, mean return {:.2}; report: {}",
                 input.display(),
                 s.rollouts,
@@ -304,7 +304,7 @@ pub fn run(global: &GlobalArgs, args: EvalArgs) -> anyhow::Result<()> {
             let summary = run_job(global, "eval pendulum-swingup", |monitor| {
                 swingup::evaluate(&settings, model, a.episodes, &provenance, &a.out, monitor)
             })?;
-            println!(
+            say!(
                 "{}/{} episodes succeeded; mean return {:.1}; report: {}",
                 summary.successes,
                 summary.episodes,
@@ -418,24 +418,24 @@ fn eval_context(global: &GlobalArgs, provenance: &Provenance, a: ContextArgs) ->
         mbrl::eval::context::evaluate(&model, &env, &settings, provenance, &a.out, monitor)
     })?;
     for (s, m) in strategies.iter().zip(&summary.mean_mse) {
-        println!("{:<10} mean prediction MSE {m:.4e}", s.name());
+        say!("{:<10} mean prediction MSE {m:.4e}", s.name());
     }
     for (better, worse, p) in &summary.tests {
-        println!("Wilcoxon: {} lower than {}: p = {p:.3e}", better.name(), worse.name());
+        say!("Wilcoxon: {} lower than {}: p = {p:.3e}", better.name(), worse.name());
     }
     if let Some(sw) = &summary.swingup {
         for (s, r) in strategies.iter().zip(&sw.mean_return) {
-            println!("{:<10} mean swing-up return {r:.1}", s.name());
+            say!("{:<10} mean swing-up return {r:.1}", s.name());
         }
-        println!("ground truth mean swing-up return {:.1}", sw.ground_truth_mean_return);
+        say!("ground truth mean swing-up return {:.1}", sw.ground_truth_mean_return);
         for (better, worse, p) in &sw.tests {
-            println!("Wilcoxon: {} higher swing-up return than {}: p = {p:.3e}", better.name(), worse.name());
+            say!("Wilcoxon: {} higher swing-up return than {}: p = {p:.3e}", better.name(), worse.name());
         }
     }
     if let Some((informative, non_informative)) = summary.toy_entropy {
-        println!("entropy after one transition: informative actions {informative:.3}, non-informative {non_informative:.3} nats");
+        say!("entropy after one transition: informative actions {informative:.3}, non-informative {non_informative:.3} nats");
     }
-    println!("report: {}", a.out.join("report.md").display());
+    say!("report: {}", a.out.join("report.md").display());
     Ok(())
 }
 
@@ -477,7 +477,7 @@ fn eval_seads(global: &GlobalArgs, provenance: &Provenance, a: SeadsArgs) -> any
         let report_dir = if a.model.len() == 1 { out.clone() } else { out.join(name_of(dir)) };
         let s =
             run_job(global, "eval seads", |monitor| seads_report(model, &settings, provenance, &report_dir, monitor))?;
-        println!(
+        say!(
             "{} ({}): the skills' most frequent moves cover {} of {} game moves",
             name_of(dir),
             s.env,
@@ -486,7 +486,7 @@ fn eval_seads(global: &GlobalArgs, provenance: &Provenance, a: SeadsArgs) -> any
         );
         for r in &s.depths {
             let n = r.boards.max(1) as f64;
-            println!(
+            say!(
                 "  depth {}: {:.1} % solved with ≤ {} replans, {:.1} % without; planning {:.4} s per board",
                 r.depth,
                 100.0 * r.solved_with_replanning as f64 / n,
@@ -508,13 +508,17 @@ fn eval_seads(global: &GlobalArgs, provenance: &Provenance, a: SeadsArgs) -> any
             bail!("runs to compare must share one env, got {}", envs.join(", "));
         }
         for t in compare_runs(&runs, &out)? {
-            println!(
+            say!(
                 "{} > {} on {}: Mann-Whitney U = {}, one-sided p = {:.3e}",
-                t.better, t.worse, t.metric, t.u, t.p_value
+                t.better,
+                t.worse,
+                t.metric,
+                t.u,
+                t.p_value
             );
         }
     }
-    println!("report: {}", out.join("report.md").display());
+    say!("report: {}", out.join("report.md").display());
     Ok(())
 }
 
@@ -569,19 +573,27 @@ fn eval_dlgpd(global: &GlobalArgs, provenance: &Provenance, a: DlgpdArgs) -> any
         DlgpdEvalSettings { variants, evidence_rollouts: a.evidence_rollouts, runs: a.runs, steps: a.steps, cem };
     let trained = mbrl::models::dlgpd::job::load(&a.model)?;
     let summary = run_job(global, "eval dlgpd", |monitor| evaluate(&trained, &settings, provenance, &a.out, monitor))?;
-    println!("env                   evidence     rollouts  mean return  successes");
+    say!("env                   evidence     rollouts  mean return  successes");
     for p in &summary.points {
-        println!(
+        say!(
             "{:<21} {:<12} {:>8} {:>12.1} {:>7}/{}",
-            p.env, p.evidence, p.rollouts, p.mean_return, p.successes, p.runs
+            p.env,
+            p.evidence,
+            p.rollouts,
+            p.mean_return,
+            p.successes,
+            p.runs
         );
     }
     for t in &summary.tests {
-        println!(
+        say!(
             "Wilcoxon: {} with {} rollouts, matching evidence higher return than mismatching: p = {:.3e} ({} pairs)",
-            t.env, t.rollouts, t.p_value, t.pairs
+            t.env,
+            t.rollouts,
+            t.p_value,
+            t.pairs
         );
     }
-    println!("report: {}", a.out.join("report.md").display());
+    say!("report: {}", a.out.join("report.md").display());
     Ok(())
 }

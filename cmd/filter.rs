@@ -66,11 +66,11 @@ pub fn run(global: &GlobalArgs, args: FilterArgs) -> anyhow::Result<()> {
         Ok((estimates, likelihoods))
     })?;
     for (id, ll, frames) in &likelihoods {
-        println!("trajectory {id}: {frames} frames filtered, log-likelihood {ll:.2}");
+        say!("trajectory {id}: {frames} frames filtered, log-likelihood {ll:.2}");
     }
-    println!("wrote {} estimates to {}", estimates.len(), args.out.display());
+    say!("wrote {} estimates to {}", estimates.len(), args.out.display());
     if let Some(path) = &args.mcap {
-        println!("wrote means and covariances to {}", path.display());
+        say!("wrote means and covariances to {}", path.display());
     }
     Ok(())
 }

@@ -1,5 +1,15 @@
 //! The `mbrl` command line: parses flags and hands each subcommand to the library.
 
+/// `println!` for results, through `common::say` (a closed stdout is not a crash).
+macro_rules! say {
+    () => {
+        $crate::common::say(format_args!(""))
+    };
+    ($($arg:tt)*) => {
+        $crate::common::say(format_args!($($arg)*))
+    };
+}
+
 mod calibrate;
 mod cem_args;
 mod collect;
@@ -14,7 +24,7 @@ mod solve_board;
 mod train;
 mod watch;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, Parser, Subcommand};
 
 use common::GlobalArgs;
 
@@ -54,7 +64,11 @@ enum Command {
 }
 
 fn main() {
-    let cli = Cli::parse();
+    let cli = Cli::try_parse().unwrap_or_else(|err| exit_on_usage_error(err));
+    if let Err(e) = mbrl::util::interrupt::install() {
+        eprintln!("error: could not install the Ctrl-C handler: {e}");
+        std::process::exit(1);
+    }
     let outcome = common::init_threads(&cli.global).and_then(|()| match cli.command {
         Command::Collect(args) => collect::run(&cli.global, args),
         Command::Plan(args) => plan::run(&cli.global, args),
@@ -69,7 +83,35 @@ fn main() {
     });
     if let Err(err) = outcome {
         let cancelled = err.downcast_ref::<mbrl::Error>().is_some_and(|e| matches!(e, mbrl::Error::Cancelled));
-        eprintln!("error: {err:#}");
+        eprintln!("error: {}", one_line(&format!("{err:#}")));
         std::process::exit(if cancelled { 130 } else { 1 });
     }
+}
+
+/// Help and version print as clap renders them; a usage error becomes one line: clap's message and where to
+/// read more, so scripts that grep stderr see one line per failure like every other error.
+fn exit_on_usage_error(err: clap::Error) -> ! {
+    use clap::error::ErrorKind;
+    if matches!(
+        err.kind(),
+        ErrorKind::DisplayHelp | ErrorKind::DisplayVersion | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
+    ) {
+        err.exit();
+    }
+    let rendered = err.to_string();
+    let first = rendered.lines().find(|l| !l.trim().is_empty()).unwrap_or("invalid command line");
+    let message = first.strip_prefix("error: ").unwrap_or(first);
+    let command = std::env::args().nth(1).filter(|a| Cli::command().find_subcommand(a).is_some());
+    let help = match command {
+        Some(name) => format!("mbrl {name} --help"),
+        None => "mbrl --help".to_string(),
+    };
+    eprintln!("error: {} (see '{}')", one_line(message), one_line(&help));
+    std::process::exit(2);
+}
+
+/// Control characters from inputs (a file name with a newline, bytes of a corrupt header) are escaped, so
+/// an error is always exactly one line and cannot drive the terminal.
+fn one_line(message: &str) -> String {
+    message.chars().map(|c| if c.is_control() { c.escape_default().to_string() } else { c.to_string() }).collect()
 }

@@ -89,7 +89,7 @@ pub fn run(global: &GlobalArgs, args: PlanArgs) -> anyhow::Result<()> {
         )?;
         Ok(episode)
     })?;
-    println!(
+    say!(
         "return {:.2}, success: {} (last 25 rewards > -1); rollout saved to {}",
         episode.total_return,
         if episode.success { "yes" } else { "no" },
@@ -149,7 +149,7 @@ fn plan_dlgpd(
         success: episode.success,
     };
     write_dataset(out, &swingup::episodes_dataset(&settings, seed, &command_line(), std::slice::from_ref(&record)))?;
-    println!(
+    say!(
         "return {:.2}, success: {} (last 25 rewards > -1); {:.1} CEM iterations per step; evidence: {} transitions of {}; rollout saved to {}",
         record.total_return,
         if record.success { "yes" } else { "no" },

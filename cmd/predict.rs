@@ -107,8 +107,8 @@ pub fn run(global: &GlobalArgs, args: PredictArgs) -> anyhow::Result<()> {
         if let Some((t, p)) = crossing {
             line += &format!("; crosses y = {:.3} at x = {:.3}, z = {:.3} m, t = {t:.3} s", p[1], p[0], p[2]);
         }
-        println!("{line}");
+        say!("{line}");
     }
-    println!("wrote predictions to {}", args.out.display());
+    say!("wrote predictions to {}", args.out.display());
     Ok(())
 }

@@ -182,9 +182,9 @@ fn solve_learned<G: DenseIndex>(
             monitor,
         )
     })?;
-    println!("board {} ({}):\n{}", game.canonical_string(board), loaded.env.name(), game.render(board));
+    say!("board {} ({}):\n{}", game.canonical_string(board), loaded.env.name(), game.render(board));
     for (i, plan) in outcome.plans.iter().enumerate() {
-        println!("plan {} ({} skills): {:?}", i + 1, plan.len(), plan);
+        say!("plan {} ({} skills): {:?}", i + 1, plan.len(), plan);
     }
     let moves: Vec<String> = outcome
         .executed
@@ -194,8 +194,8 @@ fn solve_learned<G: DenseIndex>(
             format!("skill {} → {performed} ({} steps)", e.skill, e.steps)
         })
         .collect();
-    println!("executed: {}", moves.join(", "));
-    println!(
+    say!("executed: {}", moves.join(", "));
+    say!(
         "search: {}, planning {:.3} s; {} replans; {} control steps; final board:\n{}\nsolved: {}",
         if outcome.bidirectional { "bidirectional (model verified self-inverse)" } else { "breadth-first" },
         outcome.planning_seconds,
@@ -242,10 +242,10 @@ fn solve<G: DenseIndex>(global: &GlobalArgs, args: &SolveBoardArgs, game: G) -> 
         Ok((result, execution))
     })?;
     let plan = result.plan.unwrap_or_default();
-    println!("board {} ({}):\n{}", game.canonical_string(board), game.name(), game.render(board));
-    println!("plan ({} moves): {}", plan.len(), plan.iter().map(|&m| game.move_name(m)).collect::<Vec<_>>().join(", "));
+    say!("board {} ({}):\n{}", game.canonical_string(board), game.name(), game.render(board));
+    say!("plan ({} moves): {}", plan.len(), plan.iter().map(|&m| game.move_name(m)).collect::<Vec<_>>().join(", "));
     let s = result.stats;
-    println!(
+    say!(
         "search: {:?}, {} states expanded, {} generated, {} stored, {:.1} MiB",
         args.search,
         s.expanded,
@@ -255,14 +255,14 @@ fn solve<G: DenseIndex>(global: &GlobalArgs, args: &SolveBoardArgs, game: G) -> 
     );
     let solved_symbolically = plan.iter().fold(board, |b, &m| game.apply(b, m)) == game.goal();
     match execution {
-        None => println!(
+        None => say!(
             "solved board:\n{}\nsolved: {}",
             game.render(game.goal()),
             if solved_symbolically { "yes" } else { "no" }
         ),
         Some(run) => {
             let performed = run.moves.iter().filter(|m| m.performed.is_some()).count();
-            println!(
+            say!(
                 "embodiment: {} of {} moves performed in {} control steps; final board:\n{}\nsolved: {}",
                 performed,
                 plan.len(),

@@ -257,7 +257,7 @@ fn print_pets_report(report: &pets::TrainReport, out: &Path) -> anyhow::Result<(
     write_loss_report(out, "PETS training loss (Gaussian NLL summed over members)", "loss")?;
     let run = &report.run;
     let c = &run.config;
-    println!(
+    say!(
         "trained a PETS ensemble of {} ({}×{} {}, {} parameters, reward {}) on {} transitions of {} ({} rollouts; {} held out)",
         c.ensemble,
         c.hidden_layers,
@@ -275,12 +275,12 @@ fn print_pets_report(report: &pets::TrainReport, out: &Path) -> anyhow::Result<(
     );
     let o = &report.outcome;
     if let Some(loss) = o.last_train_loss {
-        println!("final training loss (Gaussian NLL) {loss:.4} after {} steps", o.steps);
+        say!("final training loss (Gaussian NLL) {loss:.4} after {} steps", o.steps);
     }
     if let (Some(step), Some(v)) = (o.best_step, o.best_valid_loss) {
-        println!("best validation MSE {v:.3e} at step {step} (saved as model.safetensors)");
+        say!("best validation MSE {v:.3e} at step {step} (saved as model.safetensors)");
     }
-    println!("checkpoint: {}", out.display());
+    say!("checkpoint: {}", out.display());
     Ok(())
 }
 
@@ -344,7 +344,7 @@ fn print_context_report(report: &context::TrainReport, out: &Path) -> anyhow::Re
     write_loss_report(out, "Context-model training loss (eq. 4.32)", "loss")?;
     let run = &report.run;
     let c = &run.config;
-    println!(
+    say!(
         "trained a context model (embedding {}, D_F {}, D_β {}, {} parameters) on {} instances of {} ({} held out), batch {} × {} states",
         c.embedding,
         c.transition_features,
@@ -358,12 +358,12 @@ fn print_context_report(report: &context::TrainReport, out: &Path) -> anyhow::Re
     );
     let o = &report.outcome;
     if let Some(loss) = o.last_train_loss {
-        println!("final training loss {loss:.4} after {} steps", o.steps);
+        say!("final training loss {loss:.4} after {} steps", o.steps);
     }
     if let (Some(step), Some(v)) = (o.best_step, o.best_valid_loss) {
-        println!("best validation loss {v:.4} at step {step} (saved as model.safetensors)");
+        say!("best validation loss {v:.4} at step {step} (saved as model.safetensors)");
     }
-    println!("checkpoint: {}", out.display());
+    say!("checkpoint: {}", out.display());
     Ok(())
 }
 
@@ -410,26 +410,23 @@ fn finish_ball(report: &BallTrainReport, out: &Path) -> anyhow::Result<()> {
     let p = &report.params;
     let thesis = BallModelParams::thesis_learned();
     let run = &report.run;
-    println!(
-        "trained on {} chunks of {} frames from {} recordings",
-        run.chunks, run.settings.chunk_len, run.recordings
-    );
+    say!("trained on {} chunks of {} frames from {} recordings", run.chunks, run.settings.chunk_len, run.recordings);
     if let (Some(first), Some(last)) = (losses.first(), losses.last()) {
-        println!("loss {:.3} -> {:.3}", first.1, last.1);
+        say!("loss {:.3} -> {:.3}", first.1, last.1);
     }
-    println!("learned C (thesis eq. 6.26 in brackets):");
+    say!("learned C (thesis eq. 6.26 in brackets):");
     for (row, thesis_row) in p.c.iter().zip(&thesis.c) {
         let cells: Vec<String> = row.iter().zip(thesis_row).map(|(v, t)| format!("{v:6.2} [{t:5.2}]")).collect();
-        println!("  {}", cells.join(" "));
+        say!("  {}", cells.join(" "));
     }
-    println!(
+    say!(
         "a_d {:.4} (k_d {:.4}), a_m {:.4} (k_m {:.4})",
         p.a_d0,
         p.a_d0 * p.a_d0 + 0.05,
         p.a_m0,
         p.a_m0 * p.a_m0 + 0.05
     );
-    println!("checkpoint: {}", out.display());
+    say!("checkpoint: {}", out.display());
     Ok(())
 }
 
@@ -509,18 +506,24 @@ fn print_seads_report(report: &seads::TrainReport, out: &Path) -> anyhow::Result
     write_loss_report(out, "SEADS forward-model NLL per bit on each epoch's new episodes", "nats per bit")?;
     let run = &report.run;
     let c = &run.config;
-    println!(
+    say!(
         "trained SEADS on {}: {} skills, {} epochs, {} env steps (budget {}), SAC {:?}, forward model {} units",
-        run.env, c.skills, report.outcome.steps, report.env_steps, c.env_steps, c.sac_hidden, c.model_hidden
+        run.env,
+        c.skills,
+        report.outcome.steps,
+        report.env_steps,
+        c.env_steps,
+        c.sac_hidden,
+        c.model_hidden
     );
     let last = &report.last;
-    println!(
+    say!(
         "last epoch: the skills execute {} distinct game moves; forward-model NLL {:.4} nats per bit{}",
         last.distinct_moves,
         last.model_loss,
         last.mean_final_reward.map(|r| format!("; mean intrinsic reward {r:.3}")).unwrap_or_default()
     );
-    println!("checkpoint: {}", out.display());
+    say!("checkpoint: {}", out.display());
     Ok(())
 }
 
@@ -589,7 +592,7 @@ fn print_dlgpd_report(report: &dlgpd::TrainReport, out: &Path) -> anyhow::Result
         mbrl::models::dlgpd::data::ObservationKind::Images { side } => format!("{side}×{side} frames (conv VAE)"),
         mbrl::models::dlgpd::data::ObservationKind::Angles => "pole angles (MLP VAE, small preset)".to_string(),
     };
-    println!(
+    say!(
         "trained DLGPD ({} parameters, latent {}) on {} transitions of {} from {observed} ({} rollouts; {} held out), batch {}",
         report.parameters,
         c.latent_dim,
@@ -601,11 +604,11 @@ fn print_dlgpd_report(report: &dlgpd::TrainReport, out: &Path) -> anyhow::Result
     );
     let o = &report.outcome;
     if let Some(loss) = o.last_train_loss {
-        println!("final training loss {loss:.3} after {} steps", o.steps);
+        say!("final training loss {loss:.3} after {} steps", o.steps);
     }
     if let (Some(step), Some(v)) = (o.best_step, o.best_valid_loss) {
-        println!("best validation loss {v:.3} at step {step} (saved as model.safetensors)");
+        say!("best validation loss {v:.3} at step {step} (saved as model.safetensors)");
     }
-    println!("checkpoint: {}", out.display());
+    say!("checkpoint: {}", out.display());
     Ok(())
 }

@@ -66,7 +66,7 @@ fn print_summary(events: &[Event]) -> anyhow::Result<()> {
     let mut status = "running (or stopped without finishing)";
     for event in events {
         match event {
-            Event::Layout { title, .. } => println!("{title}"),
+            Event::Layout { title, .. } => say!("{title}"),
             Event::Scalar { name, step, value } => {
                 let entry = last.entry(name).or_insert((0, 0.0, 0));
                 *entry = (*step, *value, entry.2 + 1);
@@ -75,7 +75,7 @@ fn print_summary(events: &[Event]) -> anyhow::Result<()> {
                 Some(p) => (p.1, p.2) = (*done, *total),
                 None => progress.push((phase, *done, *total)),
             },
-            Event::Message { text } => println!("{text}"),
+            Event::Message { text } => say!("{text}"),
             Event::Text { panel, text } => match texts.iter_mut().find(|t| t.0 == panel) {
                 Some(t) => t.1 = text,
                 None => texts.push((panel, text)),
@@ -84,15 +84,15 @@ fn print_summary(events: &[Event]) -> anyhow::Result<()> {
         }
     }
     for (phase, done, total) in progress {
-        println!("{phase}: {done}/{total}");
+        say!("{phase}: {done}/{total}");
     }
     for (name, (step, value, count)) in last {
-        println!("{name}: {value:.6} at step {step} ({count} points)");
+        say!("{name}: {value:.6} at step {step} ({count} points)");
     }
     for (panel, text) in texts {
-        println!("== {panel} ==");
-        println!("{}", text.trim_end_matches('\n'));
+        say!("== {panel} ==");
+        say!("{}", text.trim_end_matches('\n'));
     }
-    println!("status: {status}");
+    say!("status: {status}");
     Ok(())
 }

@@ -65,8 +65,11 @@ pub fn read_hdf5_recordings(path: &Path) -> Result<Vec<ImportedTrajectory>> {
         };
         // Measured frames only in the file: lost frames between them become explicit gaps.
         for (k, (&frame, p)) in frames.iter().zip(positions.chunks(3)).enumerate() {
-            if frame < 0 || recording.frames.last().is_some_and(|&last| frame as u64 <= last) {
-                return Err(Error::bad_file(path, at(&format!("frame index {frame} at {k} does not increase"))));
+            if frame < 0 {
+                return Err(Error::bad_file(path, at(&format!("frame index {frame} at {k} is negative"))));
+            }
+            if let Some(why) = super::ball_io::frame_step_error(recording.frames.last().copied(), frame as u64) {
+                return Err(Error::bad_file(path, at(&format!("index {k}: {why}"))));
             }
             if p.iter().any(|v| !v.is_finite()) {
                 return Err(Error::bad_file(path, at(&format!("non-finite position at index {k}"))));

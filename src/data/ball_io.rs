@@ -13,6 +13,28 @@ pub const METADATA_NAME: &str = "mbrl.balls";
 pub const TOPIC: &str = "/ball/frames";
 /// Camera frame rate of the recordings (thesis 6.5.1), the same the simulator's camera uses.
 pub use crate::envs::ball::camera::FRAME_RATE;
+/// The longest stretch of lost frames inside one trajectory: 10 s at 180 Hz, several times a table-tennis
+/// flight. A larger jump is a corrupt frame index, and the filter would step through every missing frame.
+pub const MAX_FRAME_GAP: u64 = 1800;
+
+/// Why `frame` cannot follow `last` in one trajectory, if it cannot.
+pub fn frame_step_error(last: Option<u64>, frame: u64) -> Option<String> {
+    let last = last?;
+    if frame <= last {
+        Some(format!(
+            "frame {frame} does not follow the previous frame {last} (indices must increase within a trajectory)"
+        ))
+    } else if frame - last > MAX_FRAME_GAP {
+        Some(format!(
+            "frame {frame} follows frame {last}: a gap of {} frames, longer than any flight (at most {MAX_FRAME_GAP} = {} s at {FRAME_RATE} Hz)",
+            frame - last,
+            MAX_FRAME_GAP as f64 / FRAME_RATE
+        ))
+    } else {
+        None
+    }
+}
+
 /// Launcher side information in the layout of the authors' public release.
 pub const SIDE_INFO_COLUMNS: [&str; 7] = ["sin_phi_f", "cos_phi_f", "s_phi", "s_theta", "s_tl", "s_tr", "s_b"];
 
@@ -146,8 +168,8 @@ pub fn read_ball_dataset(path: &Path) -> Result<BallDataset> {
             recordings.push(Recording { id: frame.trajectory, frames: Vec::new(), positions: Vec::new(), truth, info });
         }
         let r = recordings.last_mut().expect("pushed above");
-        if r.frames.last().is_some_and(|&last| frame.frame <= last) {
-            return Err(Error::bad_file(path, format!("{where_}: frame indices must increase within a trajectory")));
+        if let Some(why) = frame_step_error(r.frames.last().copied(), frame.frame) {
+            return Err(Error::bad_file(path, format!("{where_}: {why}")));
         }
         r.frames.push(frame.frame);
         r.positions.push(frame.position);
@@ -239,8 +261,8 @@ pub fn read_ball_csv(path: &Path) -> Result<Recording> {
             ));
         }
         let frame = frame.round() as u64;
-        if rec.frames.last().is_some_and(|&last| frame <= last) {
-            return Err(Error::bad_file(path, format!("row {line}: frame {frame} does not follow the previous frame")));
+        if let Some(why) = frame_step_error(rec.frames.last().copied(), frame) {
+            return Err(Error::bad_file(path, format!("row {line}: {why}")));
         }
         let cells = [&row[xc], &row[yc], &row[zc]];
         let position = if cells.iter().all(|c| c.is_empty()) {
@@ -319,6 +341,7 @@ mod tests {
         let cases = [
             ("t,x,y,z\n0,0,0,0\n0.0055555555555556,nan,0,0\n", "row 3: x is NaN"),
             ("frame,x,y,z\n5,0,0,0\n4,0,0,0\n", "row 3: frame 4 does not follow"),
+            ("frame,x,y,z\n1,0,0,0\n100000000000,0,0,0\n", "row 3: frame 100000000000 follows frame 1: a gap of"),
             ("frame,x,y,z\n5,0,0,0\n", "1 measured positions"),
             ("frame,x,y,z\n1,0,0\n2,0,0,0\n", "row 2: 3 columns, expected 4"),
             ("time,a,b\n1,2,3\n", "expected columns frame (or t), x, y, z"),
@@ -351,5 +374,30 @@ mod tests {
         let p = dir.path().join("b.mcap");
         write_ball_dataset(&p, &data).unwrap();
         assert_eq!(read_ball_dataset(&p).unwrap(), data);
+    }
+
+    #[test]
+    fn a_frame_index_jump_in_a_dataset_is_an_error_not_an_allocation() {
+        let dir = tempfile::tempdir().unwrap();
+        let rec = |frames: Vec<u64>| Recording {
+            id: 0,
+            positions: vec![Some([0.0, 1.0, 0.3]); frames.len()],
+            frames,
+            truth: None,
+            info: RecordingInfo::default(),
+        };
+        let data = |frames| BallDataset {
+            source: "simulator".into(),
+            seed: 1,
+            command_line: "mbrl collect".into(),
+            mbrl_version: crate::VERSION.into(),
+            recordings: vec![rec(frames)],
+        };
+        let p = dir.path().join("b.mcap");
+        write_ball_dataset(&p, &data(vec![0, 1, 1 + MAX_FRAME_GAP])).unwrap();
+        assert_eq!(read_ball_dataset(&p).unwrap().recordings[0].frames.len(), 3);
+        write_ball_dataset(&p, &data(vec![0, 1, 2, 100_000_000_000])).unwrap();
+        let err = read_ball_dataset(&p).unwrap_err().to_string();
+        assert!(err.contains("frame 100000000000 follows frame 2") && err.contains("longer than any flight"), "{err}");
     }
 }

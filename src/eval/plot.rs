@@ -33,12 +33,10 @@ fn plot_err(path: &Path, e: impl std::fmt::Display) -> Error {
 /// Draws into a temporary PNG beside `path`, then renames it into place.
 fn render_atomic(path: &Path, draw: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
     register_font();
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    let tmp =
-        crate::util::atomic::partial_file_builder().suffix(".png").tempfile_in(dir).map_err(|e| Error::io(dir, e))?;
+    let target = crate::util::atomic::Target::of(path)?;
+    let tmp = crate::util::atomic::partial_file_in(&target.temp_dir()?, ".png")?;
     draw(tmp.path())?;
-    tmp.persist(path).map_err(|e| Error::io(path, e.error))?;
-    Ok(())
+    target.finish(tmp)
 }
 
 fn bounds(values: impl Iterator<Item = f64>) -> (f64, f64) {

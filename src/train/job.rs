@@ -39,6 +39,8 @@ pub fn run_training(
         if opened.dir.read_verified(CONFIG_FILE, &entry)? != config_bytes {
             return Err(Error::bad_file(&opened.dir.file(CONFIG_FILE), "differs from the run being resumed"));
         }
+        // A checkpoint killed halfway into place is finished first, so this run stages its own cleanly.
+        opened.dir.settle()?;
         method.restore(&opened.tensors(STATE_FILE)?)?;
         let metrics_path = opened.dir.file(METRICS_FILE);
         let metrics = JsonlMonitor::resume(&metrics_path, opened.manifest.metrics_bytes)

@@ -64,6 +64,7 @@ struct Screen {
 impl Screen {
     fn take() -> io::Result<Self> {
         install_panic_hook();
+        crate::util::interrupt::on_interrupt(release_after_interrupt);
         TERMINAL_TAKEN.store(true, Ordering::SeqCst);
         // Armed before the first switch, so failing halfway still undoes what was switched on.
         let restore = RestoreOnDrop;
@@ -95,6 +96,10 @@ fn release_terminal() -> io::Result<()> {
     let raw = term::disable_raw_mode();
     execute!(io::stdout(), term::LeaveAlternateScreen, cursor::Show)?;
     raw
+}
+
+fn release_after_interrupt() {
+    let _ = release_terminal();
 }
 
 /// Installed once per process and inert while no live view runs, so repeated `run_live` calls do not

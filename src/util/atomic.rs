@@ -1,8 +1,9 @@
 //! Outputs appear whole or not at all: write into a temporary file beside the target, then rename.
 
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
+use super::interrupt::{create_partial, PartialGuard};
 use crate::error::{Error, Result};
 
 /// Writes `path` through `fill`. On any error the temporary file is removed and `path` is untouched.
@@ -10,19 +11,14 @@ pub fn write_atomic<F>(path: &Path, fill: F) -> Result<()>
 where
     F: FnOnce(&mut dyn Write) -> Result<()>,
 {
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-    let mut tmp = partial_file_builder().tempfile_in(dir).map_err(|e| Error::io(dir, e))?;
+    let target = Target::of(path)?;
+    let mut tmp = partial_file_in(&target.temp_dir()?, "")?;
     {
         let mut buffered = std::io::BufWriter::new(tmp.as_file_mut());
         fill(&mut buffered)?;
         buffered.flush().map_err(|e| Error::io(path, e))?;
     }
-    tmp.persist(path).map_err(|e| Error::io(path, e.error))?;
-    Ok(())
+    target.finish(tmp)
 }
 
 /// Same as `write_atomic` for writers that need `Seek` (MCAP writes its summary offsets back).
@@ -30,21 +26,99 @@ pub fn write_atomic_seekable<F>(path: &Path, fill: F) -> Result<()>
 where
     F: FnOnce(&mut std::fs::File) -> Result<()>,
 {
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-    let mut tmp = partial_file_builder().tempfile_in(dir).map_err(|e| Error::io(dir, e))?;
+    let target = Target::of(path)?;
+    let mut tmp = partial_file_in(&target.temp_dir()?, "")?;
     fill(tmp.as_file_mut())?;
     tmp.as_file_mut().sync_all().map_err(|e| Error::io(path, e))?;
-    tmp.persist(path).map_err(|e| Error::io(path, e.error))?;
-    Ok(())
+    target.finish(tmp)
+}
+
+/// Where finished bytes go. A regular file (or a new path) is replaced by a rename; a device, FIFO or socket
+/// (`--out /dev/null`, a pipe) is written into, since renaming over it would replace the device node with a
+/// plain file. A symlink is followed, so the file it names is replaced and the link stays.
+pub enum Target {
+    Replace(PathBuf),
+    WriteInto(PathBuf),
+}
+
+impl Target {
+    pub fn of(path: &Path) -> Result<Target> {
+        match std::fs::metadata(path) {
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(Target::Replace(path.to_path_buf())),
+            Err(e) => Err(Error::io(path, e)),
+            Ok(m) if m.is_dir() => Err(Error::bad_file(path, "is a directory; expected a file path")),
+            Ok(m) if m.is_file() => {
+                let resolved = std::fs::canonicalize(path).map_err(|e| Error::io(path, e))?;
+                Ok(Target::Replace(resolved))
+            }
+            Ok(_) => Ok(Target::WriteInto(path.to_path_buf())),
+        }
+    }
+
+    /// Beside the target, so the rename stays on one file system; for special files the system's temp dir.
+    pub fn temp_dir(&self) -> Result<PathBuf> {
+        match self {
+            Target::Replace(path) => {
+                let dir = match path.parent() {
+                    Some(p) if !p.as_os_str().is_empty() => p,
+                    _ => Path::new("."),
+                };
+                std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+                Ok(dir.to_path_buf())
+            }
+            Target::WriteInto(_) => Ok(std::env::temp_dir()),
+        }
+    }
+
+    pub fn finish(self, mut tmp: PartialFile) -> Result<()> {
+        match self {
+            Target::Replace(path) => tmp.persist(&path),
+            Target::WriteInto(path) => {
+                use std::io::Seek;
+                let source = tmp.as_file_mut();
+                source.seek(std::io::SeekFrom::Start(0)).map_err(|e| Error::io(&path, e))?;
+                let mut sink = std::fs::OpenOptions::new().write(true).open(&path).map_err(|e| Error::io(&path, e))?;
+                std::io::copy(source, &mut sink).map_err(|e| Error::io(&path, e))?;
+                sink.flush().map_err(|e| Error::io(&path, e))
+            }
+        }
+    }
+}
+
+/// A temporary file that an interruption removes (see `interrupt`) until it is renamed into place or
+/// deleted. Fields drop in order: the file (deleting it) before its registration.
+pub struct PartialFile {
+    file: tempfile::NamedTempFile,
+    _registered: PartialGuard,
+}
+
+impl PartialFile {
+    pub fn path(&self) -> &Path {
+        self.file.path()
+    }
+
+    pub fn as_file_mut(&mut self) -> &mut std::fs::File {
+        self.file.as_file_mut()
+    }
+
+    /// Renames the file to `path`; the registration ends only afterwards.
+    pub fn persist(self, path: &Path) -> Result<()> {
+        let PartialFile { file, _registered } = self;
+        file.persist(path).map_err(|e| Error::io(path, e.error))?;
+        Ok(())
+    }
+}
+
+/// A registered temporary file in `dir`, its name ending in `suffix`.
+pub fn partial_file_in(dir: &Path, suffix: &str) -> Result<PartialFile> {
+    let (file, registered) = create_partial(|| partial_file_builder().suffix(suffix).tempfile_in(dir), |f| f.path())
+        .map_err(|e| Error::io(dir, e))?;
+    Ok(PartialFile { file, _registered: registered })
 }
 
 /// Temporary files named so a leftover is recognisable, with the permissions of an ordinary output file
 /// (tempfile's default 0600 would carry over through the rename).
-pub fn partial_file_builder() -> tempfile::Builder<'static, 'static> {
+fn partial_file_builder() -> tempfile::Builder<'static, 'static> {
     let mut builder = tempfile::Builder::new();
     builder.prefix(".mbrl-partial-");
     #[cfg(unix)]
@@ -91,5 +165,26 @@ mod tests {
         std::fs::write(&target, "old").unwrap();
         write_atomic(&target, |w| w.write_all(b"new").map_err(|e| Error::io(&target, e))).unwrap();
         assert_eq!(std::fs::read_to_string(&target).unwrap(), "new");
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_symlink_is_followed_and_a_device_is_written_into_not_replaced() {
+        let dir = tempfile::tempdir().unwrap();
+        let real = dir.path().join("real.txt");
+        std::fs::write(&real, "old").unwrap();
+        let link = dir.path().join("link.txt");
+        std::os::unix::fs::symlink(&real, &link).unwrap();
+        write_atomic(&link, |w| w.write_all(b"new").map_err(|e| Error::io(&link, e))).unwrap();
+        assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
+        assert_eq!(std::fs::read_to_string(&real).unwrap(), "new");
+
+        let null = Path::new("/dev/null");
+        write_atomic(null, |w| w.write_all(b"discarded").map_err(|e| Error::io(null, e))).unwrap();
+        let meta = std::fs::metadata(null).unwrap();
+        assert!(!meta.is_file(), "/dev/null must stay a device");
+
+        let err = write_atomic(dir.path(), |_| Ok(())).unwrap_err().to_string();
+        assert!(err.contains("is a directory"), "{err}");
     }
 }

@@ -5,5 +5,6 @@ pub mod alloc;
 pub mod atomic;
 pub mod bounded_read;
 pub mod fast_exp;
+pub mod interrupt;
 pub mod seeding;
 pub mod table;

@@ -154,6 +154,17 @@ impl BallModelParams {
                 return bad(field, "must be finite and > 0");
             }
         }
+        // Bounds that any table-tennis set-up meets; beyond them the flight arithmetic overflows or the
+        // time-of-impact search never ends.
+        for (field, x, range) in [
+            ("physics.dt", p.dt, 1e-5..=0.1),
+            ("physics.gravity", p.gravity, 1e-3..=100.0),
+            ("physics.ball_radius", p.ball_radius, 1e-4..=1.0),
+        ] {
+            if !range.contains(&x) {
+                return bad(field, &format!("{x} is outside [{}, {}]", range.start(), range.end()));
+            }
+        }
         for (field, x) in [("physics.coeff_offset", p.coeff_offset), ("physics.table_z", p.table_z)] {
             if !x.is_finite() {
                 return bad(field, "must be finite");
