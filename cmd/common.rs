@@ -26,6 +26,16 @@ pub struct GlobalArgs {
     /// Print only results and errors.
     #[arg(short, long, global = true)]
     pub quiet: bool,
+    /// Refuse work whose flags ask for more memory than this (estimated before it starts).
+    #[arg(long, global = true, value_name = "GIB", default_value_t = mbrl::util::budget::DEFAULT_LIMIT_GIB, value_parser = memory_gib)]
+    pub max_memory_gib: f64,
+}
+
+fn memory_gib(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 && v <= 1e6 => Ok(v),
+        _ => Err(format!("'{text}': expected a size in GiB between 0 and 1e6")),
+    }
 }
 
 impl GlobalArgs {
@@ -48,6 +58,7 @@ pub fn init_threads(global: &GlobalArgs) -> anyhow::Result<()> {
     if global.threads > MAX_THREADS {
         anyhow::bail!("--threads {}: at most {MAX_THREADS} worker threads (0 = one per core)", global.threads);
     }
+    mbrl::util::budget::set_limit_gib(global.max_memory_gib);
     rayon::ThreadPoolBuilder::new()
         .num_threads(global.threads)
         .build_global()

@@ -299,6 +299,11 @@ pub fn run(global: &GlobalArgs, args: EvalArgs) -> anyhow::Result<()> {
             if a.episodes == 0 || a.steps < swingup::SUCCESS_WINDOW {
                 bail!("--episodes must be at least 1 and --steps at least {}", swingup::SUCCESS_WINDOW);
             }
+            mbrl::util::budget::check(
+                &format!("--episodes {} × --steps {}", a.episodes, a.steps),
+                mbrl::util::budget::times(&[a.episodes, a.steps], crate::plan::STEP_RECORD_BYTES),
+                "evaluate fewer or shorter episodes",
+            )?;
             let settings = swingup_settings(variant, a.steps, &a.cem);
             settings.cem.validate()?;
             let summary = run_job(global, "eval pendulum-swingup", |monitor| {

@@ -7,6 +7,7 @@ use clap::Args;
 use mbrl::data::write_dataset;
 use mbrl::eval::swingup::{self, SwingupEpisode, SwingupSettings};
 use mbrl::models::dlgpd;
+use mbrl::util::budget;
 
 use crate::cem_args::CemArgs;
 use crate::common::{command_line, file_stem, pendulum_variant, run_job, GlobalArgs};
@@ -52,11 +53,20 @@ pub struct PlanArgs {
     out: Option<PathBuf>,
 }
 
+/// Generous bytes kept per executed step (state, action, reward, planner statistics).
+pub const STEP_RECORD_BYTES: usize = 512;
+
 pub fn run(global: &GlobalArgs, args: PlanArgs) -> anyhow::Result<()> {
     let variant = pendulum_variant(&args.env)?;
     if args.steps == 0 {
         bail!("--steps must be at least 1");
     }
+    // The executed rollout and per-step planner records are kept until the file is written.
+    budget::check(
+        &format!("--steps {}", args.steps),
+        budget::times(&[args.steps], STEP_RECORD_BYTES),
+        "plan fewer steps",
+    )?;
     let mut settings = SwingupSettings::thesis(variant);
     settings.steps = args.steps;
     settings.instance_seed = args.instance_seed;

@@ -63,6 +63,12 @@ pub fn run(global: &GlobalArgs, args: PredictArgs) -> anyhow::Result<()> {
     let model = load_ball_model(&args.model)?;
     let steps = horizon_frames(&args.horizon)?;
     let recordings = read_recordings(&args.input)?;
+    // Every predicted point (mean and covariance) is kept until the CSV is written.
+    mbrl::util::budget::check(
+        &format!("--horizon {} for {} trajectories", args.horizon, recordings.len()),
+        mbrl::util::budget::times(&[steps as usize, recordings.len()], 1024),
+        "predict a shorter horizon",
+    )?;
     let summaries = run_job(global, "predict", |monitor| {
         let mut rows = Vec::new();
         let mut summaries = Vec::new();

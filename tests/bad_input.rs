@@ -102,3 +102,58 @@ fn watch_of_a_missing_run_is_an_error() {
     let out = mbrl(dir.path()).args(["watch", "models/none", "--no-tui"]).output().unwrap();
     assert_one_line_error(&out, &["models/none", "metrics.jsonl"]);
 }
+
+/// Flags that ask for absurd amounts of memory are refused by name before any work starts (each of these
+/// once aborted on an allocation or ran for minutes), and the limit can be raised.
+#[test]
+fn absurd_sizes_are_refused_before_work_naming_the_flag() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let run = |args: &[&str]| {
+        let started = std::time::Instant::now();
+        let out = mbrl(d).args(args).args(["--no-tui", "-q"]).output().unwrap();
+        assert!(started.elapsed() < std::time::Duration::from_secs(10), "{args:?} took {:?}", started.elapsed());
+        out
+    };
+    let big = "1000000000";
+    let plan = ["plan", "--env", "pendulum", "--model", "true", "--steps", "2"];
+    for (extra, needle) in [
+        (vec!["--candidates", big], "--candidates"),
+        (vec!["--horizon", big], "--horizon"),
+        (vec!["--iters", big, "--elites", "10"], "iterations"),
+    ] {
+        let args: Vec<&str> = plan.iter().copied().chain(extra).collect();
+        assert_one_line_error(&run(&args), &[needle]);
+    }
+    assert_one_line_error(&run(&["plan", "--env", "pendulum", "--model", "true", "--steps", big]), &["--steps"]);
+    assert_one_line_error(
+        &run(&["collect", "--env", "ball", "--trajectories", "2", "--augment-rotations", big, "--out", "b.mcap"]),
+        &["--augment-rotations", "--max-memory-gib"],
+    );
+    assert_one_line_error(
+        &run(&["collect", "--env", "pendulum", "--rollouts", big, "--out", "r.mcap"]),
+        &["--rollouts"],
+    );
+    assert_one_line_error(
+        &run(&["eval", "pendulum-swingup", "--model", "true", "--episodes", big, "--out", "rep"]),
+        &["--episodes"],
+    );
+    // The same work fits once the limit allows it.
+    let out = run(&["plan", "--env", "pendulum", "--model", "true", "--steps", "2", "--candidates", "20000"]);
+    assert!(out.status.success(), "{}", stderr_of(&out));
+    let out = run(&[
+        "--max-memory-gib",
+        "0.001",
+        "plan",
+        "--env",
+        "pendulum",
+        "--model",
+        "true",
+        "--steps",
+        "2",
+        "--candidates",
+        "20000",
+    ]);
+    assert_one_line_error(&out, &["--max-memory-gib"]);
+    assert!(files_in(d).iter().all(|f| !f.ends_with(".mcap") || f.contains("plan-")), "{:?}", files_in(d));
+}

@@ -14,7 +14,6 @@ use crate::util::seeding::{derive_seed, rng_for};
 pub(super) const REPLAY_STREAM: u64 = u64::from_be_bytes(*b"replay\0\0");
 
 /// Refuse before allocating: a dataset is built in memory before it is written.
-const MAX_DATASET_BYTES: f64 = 16.0 * (1u64 << 30) as f64;
 
 pub struct CollectSettings {
     pub env: EnvName,
@@ -228,16 +227,12 @@ pub(super) fn meta(
 /// A transition in memory: the struct, its vectors' heap blocks, and the f64s in them.
 pub(super) fn check_size(spec: &EnvSpec, rollouts: usize, steps: usize, flags: &str) -> Result<()> {
     let values = 2 * spec.state_dim() + spec.action_dim() + 2 * spec.obs_names.len();
-    let per_step = (std::mem::size_of::<Timestep>() + 5 * 16 + 8 * values) as f64;
-    let bytes = rollouts as f64 * steps as f64 * per_step;
-    if bytes > MAX_DATASET_BYTES {
-        return Err(Error::Budget(format!(
-            "{flags} would hold about {:.0} GiB in memory; the limit is {:.0} GiB: collect in several files",
-            bytes / (1u64 << 30) as f64,
-            MAX_DATASET_BYTES / (1u64 << 30) as f64
-        )));
-    }
-    Ok(())
+    let per_step = std::mem::size_of::<Timestep>() + 5 * 16 + 8 * values;
+    crate::util::budget::check(
+        flags,
+        crate::util::budget::times(&[rollouts, steps], per_step),
+        "collect in several files",
+    )
 }
 
 #[cfg(test)]

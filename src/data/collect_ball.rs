@@ -40,10 +40,19 @@ fn to_recording(id: u32, t: &BallTrajectory, rotated_from: Option<(u32, f64)>) -
 
 /// Shots from the launcher in the given orientation. Like the real recordings (whose impact detector
 /// assumes one bounce), only shots with exactly one table impact are kept.
+/// A shot in memory, generously: a few hundred frames of measurement, true state and bookkeeping.
+const SHOT_BYTES: usize = 400 * 256;
+
 pub fn collect_ball(settings: &BallCollectSettings, monitor: &dyn Monitor) -> Result<BallDataset> {
     if settings.trajectories == 0 {
         return Err(Error::config("--trajectories must be at least 1"));
     }
+    let shots = settings.augment_rotations.saturating_add(1);
+    crate::util::budget::check(
+        &format!("--trajectories {} × (1 + --augment-rotations {})", settings.trajectories, settings.augment_rotations),
+        crate::util::budget::times(&[settings.trajectories, shots], SHOT_BYTES),
+        "collect fewer shots per file",
+    )?;
     let camera = CameraModel::default();
     let mut originals = Vec::with_capacity(settings.trajectories);
     for k in 0..settings.trajectories {

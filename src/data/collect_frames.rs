@@ -8,8 +8,6 @@ use crate::error::{Error, Result};
 use crate::run::Monitor;
 
 pub const PENDULUM_RENDERER: &str = "gym-pendulum";
-/// Frames held in memory before the file is written; beyond this the flags ask for too much.
-const MAX_FRAME_BYTES: f64 = 8.0 * (1u64 << 30) as f64;
 
 /// Refuses before any work when the frames of `states` states would not fit the budget.
 pub fn check_frames_size(env: &EnvName, states: f64) -> Result<()> {
@@ -19,15 +17,11 @@ pub fn check_frames_size(env: &EnvName, states: f64) -> Result<()> {
             env.canonical()
         )));
     }
-    let bytes = states * FRAME_BYTES as f64;
-    if bytes > MAX_FRAME_BYTES {
-        return Err(Error::Budget(format!(
-            "--images: {states} frames would take {:.1} GiB in memory (limit {:.0} GiB); collect fewer rollouts or steps",
-            bytes / (1u64 << 30) as f64,
-            MAX_FRAME_BYTES / (1u64 << 30) as f64
-        )));
-    }
-    Ok(())
+    crate::util::budget::check(
+        &format!("--images: {states} frames"),
+        states * FRAME_BYTES as f64,
+        "collect fewer rollouts or steps",
+    )
 }
 
 /// Renders θ (the first state dimension) of every state, t = 0 … T of each rollout, into `data.frames`.

@@ -10,6 +10,7 @@ use serde::{Deserialize, Serialize};
 use super::colored_noise::ColoredNoise;
 use super::Objective;
 use crate::error::{Error, Result};
+use crate::util::budget;
 use crate::util::seeding::rng_for;
 
 /// Candidates that share one random stream. Fixed, so results do not depend on the thread count.
@@ -43,6 +44,9 @@ pub struct CemConfig {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub stop_std: Option<f64>,
 }
+
+/// Far beyond what CEM needs to settle; a larger count is a typo that would run for hours.
+pub const MAX_ITERATIONS: usize = 10_000;
 
 impl CemConfig {
     /// Algorithm 1 defaults for a box action space: μ = 0, σ = a_max, white noise, warm start on.
@@ -81,6 +85,19 @@ impl CemConfig {
         if d == 0 || self.action_high.len() != d || self.init_std.len() != d {
             return bad("CEM: action bounds and initial std must have the same nonzero length".into());
         }
+        if self.iterations > MAX_ITERATIONS {
+            return bad(format!(
+                "CEM: {} iterations; at most {MAX_ITERATIONS} (CEM settles within tens)",
+                self.iterations
+            ));
+        }
+        // Sampled sequences, their noise and the warm start, plus per-candidate costs and ranks.
+        let bytes = budget::times(&[self.candidates, self.horizon, d], 24) + budget::times(&[self.candidates], 64);
+        budget::check(
+            &format!("CEM with {} candidates (--candidates) × horizon {} (--horizon)", self.candidates, self.horizon),
+            bytes,
+            "plan with fewer candidates or a shorter horizon",
+        )?;
         for i in 0..d {
             let (lo, hi, sd) = (self.action_low[i], self.action_high[i], self.init_std[i]);
             if !(lo.is_finite() && hi.is_finite() && lo < hi && sd.is_finite() && sd > 0.0) {

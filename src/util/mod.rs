@@ -4,6 +4,7 @@
 pub mod alloc;
 pub mod atomic;
 pub mod bounded_read;
+pub mod budget;
 pub mod fast_exp;
 pub mod interrupt;
 pub mod seeding;
