@@ -324,6 +324,13 @@ fn records<G: DenseIndex>(
     split: Option<Split>,
     monitor: &dyn mbrl::run::Monitor,
 ) -> mbrl::Result<Vec<mbrl::envs::boards::sets::BoardRecord>> {
+    // Refused before the depth table (seconds of work) is built; the upper bound needs the table.
+    if max_depth == 0 {
+        return Err(mbrl::Error::config(format!(
+            "--max-depth D (at least 1) is needed for board sets of {}",
+            game.name()
+        )));
+    }
     monitor.message(&format!("building the depth table of {}", game.name()));
     let table = DepthTable::build(game)?;
     if max_depth == 0 || max_depth > table.max_depth() {

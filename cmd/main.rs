@@ -98,9 +98,17 @@ fn exit_on_usage_error(err: clap::Error) -> ! {
     ) {
         err.exit();
     }
+    // clap's message can continue on the next lines (the missing arguments, a tip); the usage block after it
+    // is what the help hint points to.
     let rendered = err.to_string();
-    let first = rendered.lines().find(|l| !l.trim().is_empty()).unwrap_or("invalid command line");
-    let message = first.strip_prefix("error: ").unwrap_or(first);
+    let message = rendered
+        .lines()
+        .map(str::trim)
+        .take_while(|l| !l.starts_with("Usage:") && !l.starts_with("For more information"))
+        .filter(|l| !l.is_empty())
+        .collect::<Vec<_>>()
+        .join(" ");
+    let message = message.strip_prefix("error: ").unwrap_or(&message);
     let command = std::env::args().nth(1).filter(|a| Cli::command().find_subcommand(a).is_some());
     let help = match command {
         Some(name) => format!("mbrl {name} --help"),
