@@ -193,6 +193,14 @@ fn read_raw(path: &Path, metadata_name: &str, topics: &[&str]) -> Result<RawTopi
             Some(Err(e)) => return Err(corrupt(e)),
             Some(Ok(LinearReadEvent::ReadRequest(n))) => n,
             Some(Ok(LinearReadEvent::Record { data, opcode })) => {
+                // Only the records mbrl uses are decoded, and only once every length inside them fits the
+                // record: the mcap crate allocates a string's declared length before reading it.
+                if !RECORDS_READ.contains(&opcode) {
+                    continue;
+                }
+                check_inner_lengths(opcode, data).map_err(|why| {
+                    Error::bad_file(path, format!("not a readable MCAP file (corrupt record 0x{opcode:02x}): {why}"))
+                })?;
                 match mcap::parse_record(opcode, data).map_err(corrupt)? {
                     Record::Metadata(m) if m.name == metadata_name => metadata = Some(m.metadata),
                     Record::Metadata(m) => other_names.push(m.name),
@@ -239,6 +247,54 @@ fn read_raw(path: &Path, metadata_name: &str, topics: &[&str]) -> Result<RawTopi
     Ok((metadata, out))
 }
 
+/// Schema, Channel, Message and Metadata: the record opcodes `read_raw` decodes.
+const RECORDS_READ: [u8; 4] = [0x03, 0x04, 0x05, 0x0C];
+
+/// Walks the length-prefixed fields of a record of `RECORDS_READ` (MCAP spec layouts) and fails when a
+/// declared length runs past the record's end.
+fn check_inner_lengths(opcode: u8, body: &[u8]) -> std::result::Result<(), String> {
+    #[derive(Clone, Copy)]
+    enum Field {
+        Fixed(usize),
+        Str,
+        Bytes,
+        StringMap,
+    }
+    use Field::*;
+    let layout: &[Field] = match opcode {
+        0x03 => &[Fixed(2), Str, Str, Bytes],
+        0x04 => &[Fixed(4), Str, Str, StringMap],
+        0x05 => &[Fixed(22)],
+        0x0C => &[Str, StringMap],
+        _ => &[],
+    };
+    fn prefixed(rest: &[u8]) -> std::result::Result<(&[u8], &[u8]), String> {
+        let len_bytes: [u8; 4] =
+            rest.get(..4).and_then(|b| b.try_into().ok()).ok_or("a length past the record's end")?;
+        let len = u32::from_le_bytes(len_bytes) as usize;
+        let after = &rest[4..];
+        if len > after.len() {
+            return Err(format!("a field claims {len} bytes, {} remain in the record", after.len()));
+        }
+        Ok(after.split_at(len))
+    }
+    let mut rest = body;
+    for field in layout {
+        rest = match *field {
+            Fixed(n) => rest.get(n..).ok_or("the record is shorter than its fixed fields")?,
+            Str | Bytes => prefixed(rest)?.1,
+            StringMap => {
+                let (mut map, after) = prefixed(rest)?;
+                while !map.is_empty() {
+                    map = prefixed(prefixed(map)?.1)?.1;
+                }
+                after
+            }
+        };
+    }
+    Ok(())
+}
+
 /// Reads the `format_version` field and rejects versions this build does not know.
 pub fn check_version(path: &Path, metadata: &BTreeMap<String, String>, supported: u32) -> Result<u32> {
     let version: u32 = metadata
@@ -273,6 +329,33 @@ pub fn metadata_seed(path: &Path, metadata: &BTreeMap<String, String>) -> Result
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A string inside a record that claims gigabytes (found by the fuzz harness: the mcap crate reserved the
+    /// declared length and aborted) is a clean error.
+    #[test]
+    fn a_string_length_past_its_record_is_refused_before_decoding() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("m.mcap");
+        {
+            let file = std::io::BufWriter::new(std::fs::File::create(&path).unwrap());
+            let mut writer = mcap::WriteOptions::new().create(file).unwrap();
+            let metadata = BTreeMap::from([("format_version".to_string(), "1".to_string())]);
+            writer.write_metadata(&mcap::records::Metadata { name: "meta".into(), metadata }).unwrap();
+            writer.finish().unwrap();
+        }
+        let mut bytes = std::fs::read(&path).unwrap();
+        // Records after the 8-byte magic: opcode, u64 length, body; the metadata body opens with its name.
+        let mut at = 8;
+        while bytes[at] != 0x0C {
+            at += 9 + u64::from_le_bytes(bytes[at + 1..at + 9].try_into().unwrap()) as usize;
+        }
+        bytes[at + 9..at + 13].copy_from_slice(&0xFF00_0005u32.to_le_bytes());
+        std::fs::write(&path, &bytes).unwrap();
+        let err = read_raw(&path, "meta", &[]).unwrap_err().to_string();
+        assert!(err.contains("corrupt record 0x0c") && err.contains("claims 4278190085 bytes"), "{err}");
+        assert!(check_inner_lengths(0x04, &[0; 4]).is_err());
+        assert!(check_inner_lengths(0x05, &[0; 22]).is_ok());
+    }
 
     /// A file whose wanted topic is not JSON with a JSON Schema is refused before any payload is decoded.
     #[test]
