@@ -10,6 +10,9 @@ use crate::error::{Error, Result};
 use crate::run::dir::METRICS_FILE;
 use crate::run::{Event, JsonlMonitor, Monitor, Tee};
 
+/// A billion optimizer steps: beyond any training budget, so a larger count is a typo or a corrupt config.
+pub const MAX_TRAIN_STEPS: u64 = 1_000_000_000;
+
 /// Runs `method` to the end in `dir`. A fresh run writes `config` (the full description a resumed run is rebuilt
 /// from) and starts the metrics log with `layout`; with `resume`, `dir` must hold an unfinished checkpoint of
 /// the same config, and the run continues from it so that it ends with the bytes an uninterrupted run would.
@@ -22,10 +25,25 @@ pub fn run_training(
     layout: &Event,
     monitor: &dyn Monitor,
 ) -> Result<FitOutcome> {
+    if settings.total_steps > MAX_TRAIN_STEPS {
+        return Err(Error::config(format!(
+            "{} training steps; at most {MAX_TRAIN_STEPS} (months on any machine mbrl runs on)",
+            settings.total_steps
+        )));
+    }
     let config_bytes = config_bytes(config)?;
     monitor.emit(layout);
     if resume {
         let opened = OpenedCheckpoint::open(dir)?;
+        if opened.manifest.total_steps != settings.total_steps {
+            return Err(Error::bad_file(
+                &opened.dir.file(CONFIG_FILE),
+                format!(
+                    "asks for {} steps, but the checkpoint belongs to a run of {}: the config was changed",
+                    settings.total_steps, opened.manifest.total_steps
+                ),
+            ));
+        }
         if opened.manifest.complete {
             return Err(Error::bad_file(
                 dir,

@@ -39,6 +39,21 @@ impl OpenedCheckpoint {
         Ok(OpenedCheckpoint { dir, manifest, config })
     }
 
+    /// A resumed run must ask for the steps the checkpointed run was started with; checked before any data is
+    /// loaded or network built, so a changed or corrupt step count never starts a run of the wrong length.
+    pub fn expect_total_steps(&self, config_steps: u64) -> Result<()> {
+        if config_steps != self.manifest.total_steps || config_steps > job::MAX_TRAIN_STEPS {
+            return Err(Error::bad_file(
+                &self.dir.file(CONFIG_FILE),
+                format!(
+                    "asks for {config_steps} training steps, but the checkpoint belongs to a run of {}: the config was changed",
+                    self.manifest.total_steps
+                ),
+            ));
+        }
+        Ok(())
+    }
+
     /// Refuses checkpoints of another method, and models still in training.
     pub fn expect_finished(&self, method: &str) -> Result<()> {
         let path = self.dir.path();

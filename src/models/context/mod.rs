@@ -180,14 +180,47 @@ pub fn train(request: &TrainRequest, resume: bool, monitor: &dyn Monitor) -> Res
 }
 
 pub fn read_run(opened: &OpenedCheckpoint) -> Result<ContextRun> {
-    serde_json::from_value(opened.config.clone())
-        .map_err(|e| Error::bad_file(&opened.dir.file("config.json"), format!("not a context-model run config: {e}")))
+    let path = opened.dir.file("config.json");
+    let run: ContextRun = serde_json::from_value(opened.config.clone())
+        .map_err(|e| Error::bad_file(&path, format!("not a context-model run config: {e}")))?;
+    run.model.validate().map_err(|e| Error::bad_file(&path, format!("model: {e}")))?;
+    if run.data.is_empty() {
+        return Err(Error::bad_file(&path, "lists no training data file"));
+    }
+    Ok(run)
+}
+
+/// Far above any env mbrl simulates; beyond it a size in config.json is corrupt.
+const MAX_MODEL_DIM: usize = 256;
+
+impl ModelSpec {
+    /// The sizes agree with each other (angles take two model dimensions) and are plausible, so that
+    /// nothing is allocated from a corrupt count.
+    pub fn validate(&self) -> Result<()> {
+        let states = self.state_names.len();
+        if !(1..=MAX_MODEL_DIM).contains(&states) || !(1..=MAX_MODEL_DIM).contains(&self.action_dim) {
+            return Err(Error::config(format!(
+                "{states} state and {} action dimensions; expected 1..={MAX_MODEL_DIM} of each",
+                self.action_dim
+            )));
+        }
+        let features: usize = self.angular.iter().map(|&a| if a { 2 } else { 1 }).sum();
+        if self.angular.len() != states || features != self.feature_dim {
+            return Err(Error::config(format!(
+                "{} angular flags and feature_dim {} do not fit {states} states ({features} features)",
+                self.angular.len(),
+                self.feature_dim
+            )));
+        }
+        Ok(())
+    }
 }
 
 /// Continues the run in `dir` from its last checkpoint, with the config and data it was started with.
 pub fn resume(dir: &Path, monitor: &dyn Monitor) -> Result<TrainReport> {
     let opened = OpenedCheckpoint::open(dir)?;
     let run = read_run(&opened)?;
+    opened.expect_total_steps(run.config.steps as u64)?;
     for file in &run.data {
         file.verify_unchanged()?;
     }

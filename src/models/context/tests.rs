@@ -179,3 +179,20 @@ fn training_lowers_the_loss_and_resumes_identically() {
         assert_eq!(a.step(step).unwrap(), b.step(step).unwrap());
     }
 }
+
+/// Sizes in config.json are checked against each other before a network is sized from them (a flipped
+/// `angular` flag once reached the fast path's GEMM with the wrong width; a huge action_dim aborted).
+#[test]
+fn model_spec_sizes_must_agree_and_be_plausible() {
+    let spec = super::ModelSpec {
+        state_names: vec!["theta".into(), "omega".into()],
+        angular: vec![true, false],
+        action_dim: 1,
+        feature_dim: 3,
+    };
+    assert!(spec.validate().is_ok());
+    let flipped = super::ModelSpec { angular: vec![true, true], ..spec.clone() };
+    assert!(flipped.validate().unwrap_err().to_string().contains("do not fit"));
+    let huge = super::ModelSpec { action_dim: usize::MAX, ..spec };
+    assert!(huge.validate().unwrap_err().to_string().contains("1..=256"));
+}

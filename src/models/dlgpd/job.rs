@@ -150,6 +150,7 @@ fn read_run(opened: &OpenedCheckpoint) -> Result<DlgpdRun> {
 pub fn resume(dir: &Path, monitor: &dyn Monitor) -> Result<TrainReport> {
     let opened = OpenedCheckpoint::open(dir)?;
     let run = read_run(&opened)?;
+    opened.expect_total_steps(run.config.steps as u64)?;
     for file in &run.data {
         file.verify_unchanged()?;
     }

@@ -192,11 +192,52 @@ pub fn train(request: &TrainRequest, resume: bool, monitor: &dyn Monitor) -> Res
     Ok(TrainReport { run, outcome, parameters })
 }
 
+fn read_run(opened: &OpenedCheckpoint) -> Result<PetsRun> {
+    let path = opened.dir.file("config.json");
+    let run: PetsRun = serde_json::from_value(opened.config.clone())
+        .map_err(|e| Error::bad_file(&path, format!("not a PETS run config: {e}")))?;
+    run.model.validate(run.config.reward).map_err(|e| Error::bad_file(&path, format!("model: {e}")))?;
+    if run.data.is_empty() {
+        return Err(Error::bad_file(&path, "lists no training data file"));
+    }
+    Ok(run)
+}
+
+/// Far above any env mbrl simulates; beyond it a size in config.json is corrupt.
+const MAX_MODEL_DIM: usize = 256;
+
+impl ModelSpec {
+    /// The sizes agree with each other and with the reward source, and are plausible, so that no network
+    /// is sized from a corrupt count.
+    pub fn validate(&self, reward: RewardSource) -> Result<()> {
+        let states = self.state_names.len();
+        if !(1..=MAX_MODEL_DIM).contains(&states) || !(1..=MAX_MODEL_DIM).contains(&self.action_dim) {
+            return Err(Error::config(format!(
+                "{states} state and {} action dimensions; expected 1..={MAX_MODEL_DIM} of each",
+                self.action_dim
+            )));
+        }
+        let input = data::feature_dim(&self.angular, self.action_dim);
+        let target = states + usize::from(reward == RewardSource::Learned);
+        if self.angular.len() != states || self.input_dim != input || self.target_dim != target {
+            return Err(Error::config(format!(
+                "{} angular flags, input_dim {} and target_dim {} do not fit {states} states and {} actions \
+                 (expected input_dim {input}, target_dim {target})",
+                self.angular.len(),
+                self.input_dim,
+                self.target_dim,
+                self.action_dim
+            )));
+        }
+        Ok(())
+    }
+}
+
 /// Continues the run in `dir` from its last checkpoint, with the config and data it was started with.
 pub fn resume(dir: &Path, monitor: &dyn Monitor) -> Result<TrainReport> {
     let opened = OpenedCheckpoint::open(dir)?;
-    let run: PetsRun = serde_json::from_value(opened.config.clone())
-        .map_err(|e| Error::bad_file(&opened.dir.file("config.json"), format!("not a PETS run config: {e}")))?;
+    let run = read_run(&opened)?;
+    opened.expect_total_steps(run.config.steps as u64)?;
     for file in &run.data {
         file.verify_unchanged()?;
     }
@@ -215,8 +256,7 @@ pub fn resume(dir: &Path, monitor: &dyn Monitor) -> Result<TrainReport> {
 pub fn load_dynamics(dir: &Path, env: &EnvName, propagation: Propagation, particles: usize) -> Result<PetsDynamics> {
     let opened = OpenedCheckpoint::open(dir)?;
     opened.expect_finished(METHOD)?;
-    let run: PetsRun = serde_json::from_value(opened.config.clone())
-        .map_err(|e| Error::bad_file(&opened.dir.file("config.json"), format!("not a PETS run config: {e}")))?;
+    let run = read_run(&opened)?;
     if run.env != env.canonical() {
         return Err(Error::bad_file(
             dir,
@@ -263,4 +303,26 @@ fn layout_of(run: &PetsRun) -> Result<crate::nn::ParamSet> {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0);
     let net = net::PetsNet::init(&run.config, run.model.input_dim, run.model.target_dim, &device, &mut rng);
     Ok(crate::nn::ParamSet::<f32>::from_module(&net, net::torch_name))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn model_spec_sizes_must_agree_with_the_states_and_reward() {
+        let spec = ModelSpec {
+            state_names: vec!["theta".into(), "omega".into()],
+            angular: vec![true, false],
+            action_dim: 1,
+            input_dim: 4,
+            target_dim: 2,
+        };
+        assert!(spec.validate(RewardSource::Known).is_ok());
+        assert!(spec.validate(RewardSource::Learned).is_err());
+        let huge = ModelSpec { target_dim: 2_147_483_648, ..spec.clone() };
+        assert!(huge.validate(RewardSource::Known).unwrap_err().to_string().contains("target_dim 2147483648"));
+        let none = ModelSpec { state_names: vec![], angular: vec![], ..spec };
+        assert!(none.validate(RewardSource::Known).is_err());
+    }
 }

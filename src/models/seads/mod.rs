@@ -166,6 +166,7 @@ pub fn read_run(opened: &OpenedCheckpoint) -> Result<SeadsRun> {
 pub fn resume(dir: &Path, monitor: &dyn Monitor) -> Result<TrainReport> {
     let opened = OpenedCheckpoint::open(dir)?;
     let run = read_run(&opened)?;
+    opened.expect_total_steps(run.config.max_epochs() as u64)?;
     let request = TrainRequest {
         out: dir.to_path_buf(),
         env: EmbodiedGame::parse(&run.env)?,

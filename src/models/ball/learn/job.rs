@@ -77,6 +77,7 @@ pub fn resume(dir: &Path, monitor: &dyn Monitor) -> Result<BallTrainReport> {
     let opened = OpenedCheckpoint::open(dir)?;
     let run: BallRun = serde_json::from_value(opened.config.clone())
         .map_err(|e| Error::bad_file(&opened.dir.file("config.json"), format!("not a ball-EKF run config: {e}")))?;
+    opened.expect_total_steps(run.settings.steps as u64)?;
     run.data.verify_unchanged()?;
     let request = BallTrainRequest {
         out: dir.to_path_buf(),
