@@ -77,9 +77,11 @@ pub fn run(global: &GlobalArgs, args: PlanArgs) -> anyhow::Result<()> {
         .clone()
         .unwrap_or_else(|| PathBuf::from(format!("datasets/plan-{}.mcap", file_stem(&settings.variant.env_name()))));
     let env = mbrl::envs::parse_env(&args.env)?;
+    // With --evidence the model can only be DLGPD, so its loader reports why a checkpoint does not open.
     let is_dlgpd = args.model.model != "true"
-        && mbrl::train::OpenedCheckpoint::open(std::path::Path::new(&args.model.model))
-            .is_ok_and(|c| c.manifest.method == dlgpd::job::METHOD);
+        && (args.evidence.is_some()
+            || mbrl::train::OpenedCheckpoint::open(std::path::Path::new(&args.model.model))
+                .is_ok_and(|c| c.manifest.method == dlgpd::job::METHOD));
     if is_dlgpd {
         return plan_dlgpd(global, &args, settings, &out);
     }
