@@ -139,7 +139,10 @@ mod tests {
         let path = dir.path().join("bad.hdf5");
         write_sample(&path, &[3, 2], &[[0.0; 3], [0.0; 3]]);
         let err = read_hdf5_recordings(&path).err().unwrap().to_string();
-        assert!(err.contains("bad.hdf5") && err.contains("does not increase"), "{err}");
+        assert!(err.contains("bad.hdf5") && err.contains("frame 2 does not follow"), "{err}");
+        write_sample(&path, &[3, 4, 100_000_000_000], &[[0.0; 3], [0.0; 3], [0.0; 3]]);
+        let err = read_hdf5_recordings(&path).err().unwrap().to_string();
+        assert!(err.contains("longer than any flight"), "{err}");
         std::fs::write(dir.path().join("text.hdf5"), "not hdf5").unwrap();
         let err = read_hdf5_recordings(&dir.path().join("text.hdf5")).err().unwrap().to_string();
         assert!(err.contains("text.hdf5") && err.contains("not a readable HDF5 file"), "{err}");
