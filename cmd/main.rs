@@ -64,11 +64,11 @@ enum Command {
 }
 
 fn main() {
-    let cli = Cli::try_parse().unwrap_or_else(|err| exit_on_usage_error(err));
     if let Err(e) = mbrl::util::interrupt::install() {
         eprintln!("error: could not install the Ctrl-C handler: {e}");
         std::process::exit(1);
     }
+    let cli = Cli::try_parse().unwrap_or_else(|err| exit_on_usage_error(err));
     let outcome = common::init_threads(&cli.global).and_then(|()| match cli.command {
         Command::Collect(args) => collect::run(&cli.global, args),
         Command::Plan(args) => plan::run(&cli.global, args),
