@@ -53,15 +53,7 @@ fn collect_filter_predict_pipeline() {
 fn csv_recordings_are_filtered_and_bad_ones_rejected() {
     let dir = tempfile::tempdir().unwrap();
     // A falling ball sampled at 180 Hz with one lost frame; estimates start at the second measurement.
-    let mut text = String::from("frame,x,y,z\n");
-    for f in 0..40u32 {
-        let t = f as f64 / 180.0;
-        if f == 5 {
-            text += &format!("{f},,,\n");
-        } else {
-            text += &format!("{f},{:.5},{:.5},{:.5}\n", 0.1, 2.5 - 4.0 * t, 0.3 + 1.0 * t - 4.9 * t * t);
-        }
-    }
+    let text = falling_ball_csv();
     std::fs::write(dir.path().join("ok.csv"), &text).unwrap();
     let out = mbrl(dir.path()).args(["filter", "--model", "thesis", "--input", "ok.csv", "-q"]).output().unwrap();
     assert!(out.status.success(), "{}", stderr_of(&out));

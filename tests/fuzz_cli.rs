@@ -341,7 +341,7 @@ fn generate_seeds(dir: &Path) {
     write("pets.toml", PETS_TOML);
     write("context.toml", CONTEXT_TOML);
     write("seads.toml", SEADS_TOML);
-    write("ball.csv", &ball_csv());
+    write("ball.csv", &common::falling_ball_csv());
     write("actions.csv", "u\n0.5\n-2\n1.5\n1e-3\n");
     write("cursor.csv", "dx,dy,push\n0.2,-0.2,-1\n0.1,-0.1,0.9\n0,0,-1\n");
 
@@ -382,20 +382,6 @@ fn generate_seeds(dir: &Path) {
         let table = without_nulls(config["config"].clone());
         fs::write(dir.join(format!("{name}-full.toml")), toml::to_string(&table).unwrap()).unwrap();
     }
-}
-
-/// A falling ball at 180 Hz with one lost frame (as tests/ball_cli.rs).
-fn ball_csv() -> String {
-    let mut text = String::from("frame,x,y,z\n");
-    for f in 0..40u32 {
-        let t = f as f64 / 180.0;
-        if f == 5 {
-            text += &format!("{f},,,\n");
-        } else {
-            text += &format!("{f},{:.5},{:.5},{:.5}\n", 0.1, 2.5 - 4.0 * t, 0.3 + 1.0 * t - 4.9 * t * t);
-        }
-    }
-    text
 }
 
 /// TOML has no null; an absent key means the same to the config reader.

@@ -330,19 +330,25 @@ pub fn metadata_seed(path: &Path, metadata: &BTreeMap<String, String>) -> Result
 mod tests {
     use super::*;
 
+    type FileWriter = mcap::Writer<std::io::BufWriter<std::fs::File>>;
+
+    /// A file holding the metadata record `meta` and whatever `more` writes after it.
+    fn write_with_meta(path: &Path, more: impl FnOnce(&mut FileWriter)) {
+        let file = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
+        let mut writer = mcap::WriteOptions::new().create(file).unwrap();
+        let metadata = BTreeMap::from([("format_version".to_string(), "1".to_string())]);
+        writer.write_metadata(&mcap::records::Metadata { name: "meta".into(), metadata }).unwrap();
+        more(&mut writer);
+        writer.finish().unwrap();
+    }
+
     /// A string inside a record that claims gigabytes (found by the fuzz harness: the mcap crate reserved the
     /// declared length and aborted) is a clean error.
     #[test]
     fn a_string_length_past_its_record_is_refused_before_decoding() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("m.mcap");
-        {
-            let file = std::io::BufWriter::new(std::fs::File::create(&path).unwrap());
-            let mut writer = mcap::WriteOptions::new().create(file).unwrap();
-            let metadata = BTreeMap::from([("format_version".to_string(), "1".to_string())]);
-            writer.write_metadata(&mcap::records::Metadata { name: "meta".into(), metadata }).unwrap();
-            writer.finish().unwrap();
-        }
+        write_with_meta(&path, |_| {});
         let mut bytes = std::fs::read(&path).unwrap();
         // Records after the 8-byte magic: opcode, u64 length, body; the metadata body opens with its name.
         let mut at = 8;
@@ -362,18 +368,13 @@ mod tests {
     fn a_topic_in_another_encoding_is_named_and_refused() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("cbor.mcap");
-        {
-            let file = std::io::BufWriter::new(std::fs::File::create(&path).unwrap());
-            let mut writer = mcap::WriteOptions::new().create(file).unwrap();
-            let metadata = BTreeMap::from([("format_version".to_string(), "1".to_string())]);
-            writer.write_metadata(&mcap::records::Metadata { name: "meta".into(), metadata }).unwrap();
+        write_with_meta(&path, |writer| {
             let schema = writer.add_schema("s", "protobuf", b"").unwrap();
             let channel = writer.add_channel(schema, "/steps", "cbor", &BTreeMap::new()).unwrap();
             let header =
                 mcap::records::MessageHeader { channel_id: channel, sequence: 0, log_time: 0, publish_time: 0 };
             writer.write_to_known_channel(&header, b"\xa0").unwrap();
-            writer.finish().unwrap();
-        }
+        });
         let e = read_raw(&path, "meta", &["/steps"]).unwrap_err().to_string();
         assert!(e.contains("cbor.mcap") && e.contains("'/steps'") && e.contains("'cbor'"), "{e}");
         // Another topic's encoding is none of the reader's business.

@@ -90,3 +90,17 @@ pub fn dir_bytes(dir: &Path) -> Vec<(String, Vec<u8>)> {
     names.sort();
     names.into_iter().map(|n| (n.clone(), std::fs::read(dir.join(&n)).unwrap())).collect()
 }
+
+/// A falling ball sampled at 180 Hz for 40 frames, frame 5 lost: a ball CSV recording.
+pub fn falling_ball_csv() -> String {
+    let mut text = String::from("frame,x,y,z\n");
+    for f in 0..40u32 {
+        let t = f as f64 / 180.0;
+        if f == 5 {
+            text += &format!("{f},,,\n");
+        } else {
+            text += &format!("{f},{:.5},{:.5},{:.5}\n", 0.1, 2.5 - 4.0 * t, 0.3 + 1.0 * t - 4.9 * t * t);
+        }
+    }
+    text
+}
