@@ -12,6 +12,37 @@ pub trait DenseIndex: BoardGame {
     fn state_count(&self) -> usize;
     fn index_of(&self, state: Self::State) -> usize;
     fn state_at(&self, index: usize) -> Self::State;
+
+    /// Solution depth per board index (`UNREACHED` for unsolvable boards). Games with more structure
+    /// than a move function override this.
+    fn solution_depths(&self) -> Vec<u8> {
+        reverse_bfs(self)
+    }
+}
+
+/// Breadth-first search backwards from the goal: the depth of every board from its shortest path.
+fn reverse_bfs<G: DenseIndex + ?Sized>(game: &G) -> Vec<u8> {
+    let mut depths = vec![UNREACHED; game.state_count()];
+    let goal = game.index_of(game.goal());
+    depths[goal] = 0;
+    let mut frontier = vec![goal];
+    let mut depth = 0u8;
+    while !frontier.is_empty() {
+        depth += 1;
+        let mut next = Vec::new();
+        for &index in &frontier {
+            let state = game.state_at(index);
+            for mv in 0..game.num_moves() {
+                let successor = game.index_of(game.apply(state, mv));
+                if depths[successor] == UNREACHED {
+                    depths[successor] = depth;
+                    next.push(successor);
+                }
+            }
+        }
+        frontier = next;
+    }
+    depths
 }
 
 impl DenseIndex for LightsOut {
@@ -25,6 +56,33 @@ impl DenseIndex for LightsOut {
 
     fn state_at(&self, index: usize) -> LightsOutState {
         LightsOutState([index as u64, 0, 0])
+    }
+
+    /// Presses commute and a press done twice cancels, so a shortest solution presses each field at most
+    /// once, and a board's depth is the fewest presses of any press set that produces it. Walking all
+    /// 2^fields press sets in Gray-code order changes one press per step, which makes the whole table one
+    /// XOR and one compare per press set (≈ 0.2 s for 5×5, against ≈ 18 s for a BFS over the moves).
+    fn solution_depths(&self) -> Vec<u8> {
+        let fields = self.fields();
+        let masks: Vec<u64> = (0..fields).map(|mv| self.apply(LightsOutState::default(), mv).low_bits()).collect();
+        let mut depths = vec![UNREACHED; 1usize << fields];
+        let mut board = 0u64;
+        let mut presses = 0u8;
+        depths[0] = 0;
+        for step in 1u64..(1u64 << fields) {
+            let flipped = step.trailing_zeros() as usize;
+            board ^= masks[flipped];
+            // In Gray-code order the flipped press is now on iff bit `flipped` of the code is set.
+            let code = step ^ (step >> 1);
+            if code >> flipped & 1 == 1 {
+                presses += 1;
+            } else {
+                presses -= 1;
+            }
+            let slot = &mut depths[board as usize];
+            *slot = (*slot).min(presses);
+        }
+        depths
     }
 }
 
@@ -73,27 +131,7 @@ impl DepthTable {
                 game.name()
             )));
         }
-        let mut depths = vec![UNREACHED; count];
-        let goal = game.index_of(game.goal());
-        depths[goal] = 0;
-        let mut frontier = vec![goal];
-        let mut depth = 0u8;
-        while !frontier.is_empty() {
-            depth += 1;
-            let mut next = Vec::new();
-            for &index in &frontier {
-                let state = game.state_at(index);
-                for mv in 0..game.num_moves() {
-                    let successor = game.index_of(game.apply(state, mv));
-                    if depths[successor] == UNREACHED {
-                        depths[successor] = depth;
-                        next.push(successor);
-                    }
-                }
-            }
-            frontier = next;
-        }
-        Ok(DepthTable { depths })
+        Ok(DepthTable { depths: game.solution_depths() })
     }
 
     pub fn depth_of_index(&self, index: usize) -> Option<u8> {
@@ -143,6 +181,14 @@ mod tests {
         let table = DepthTable::build(&game).unwrap();
         assert_eq!(table.counts().iter().sum::<u64>(), 512);
         assert_eq!(table.counts()[1], 9);
+    }
+
+    #[test]
+    fn press_set_enumeration_agrees_with_the_move_bfs() {
+        for n in 2..=4 {
+            let game = LightsOut::new(n).unwrap();
+            assert_eq!(game.solution_depths(), reverse_bfs(&game), "lightsout {n}x{n}");
+        }
     }
 
     #[test]
