@@ -16,6 +16,7 @@ mod collect;
 mod common;
 mod completions;
 mod eval;
+mod export;
 mod filter;
 mod model_args;
 mod plan;
@@ -38,7 +39,8 @@ Examples:
   mbrl solve-board --game lightsout --random-depth 9 --model true
   mbrl collect --env ball --trajectories 20 --out datasets/ball.mcap
   mbrl predict --model thesis --input datasets/ball.mcap --horizon 1s
-  mbrl watch reports/quick/pendulum-swingup";
+  mbrl watch reports/quick/pendulum-swingup
+  mbrl export --input datasets/heavy.mcap --out heavy.npz";
 
 #[derive(Parser)]
 #[command(name = "mbrl", version, about = ABOUT, after_help = AFTER_HELP, propagate_version = true)]
@@ -60,6 +62,7 @@ enum Command {
     SolveBoard(solve_board::SolveBoardArgs),
     Eval(eval::EvalArgs),
     Watch(watch::WatchArgs),
+    Export(export::ExportArgs),
     Completions(completions::CompletionsArgs),
 }
 
@@ -79,6 +82,7 @@ fn main() {
         Command::SolveBoard(args) => solve_board::run(&cli.global, args),
         Command::Eval(args) => eval::run(&cli.global, args),
         Command::Watch(args) => watch::run(&cli.global, args),
+        Command::Export(args) => export::run(args),
         Command::Completions(args) => completions::run(args),
     });
     if let Err(err) = outcome {

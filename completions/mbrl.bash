@@ -28,6 +28,9 @@ _mbrl() {
             mbrl,eval)
                 cmd="mbrl__subcmd__eval"
                 ;;
+            mbrl,export)
+                cmd="mbrl__subcmd__export"
+                ;;
             mbrl,filter)
                 cmd="mbrl__subcmd__filter"
                 ;;
@@ -121,6 +124,9 @@ _mbrl() {
             mbrl__subcmd__help,eval)
                 cmd="mbrl__subcmd__help__subcmd__eval"
                 ;;
+            mbrl__subcmd__help,export)
+                cmd="mbrl__subcmd__help__subcmd__export"
+                ;;
             mbrl__subcmd__help,filter)
                 cmd="mbrl__subcmd__help__subcmd__filter"
                 ;;
@@ -176,7 +182,7 @@ _mbrl() {
 
     case "${cmd}" in
         mbrl)
-            opts="-q -h -V --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version collect plan train calibrate filter predict solve-board eval watch completions help"
+            opts="-q -h -V --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version collect plan train calibrate filter predict solve-board eval watch export completions help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 1 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1053,6 +1059,44 @@ _mbrl() {
             COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
             return 0
             ;;
+        mbrl__subcmd__export)
+            opts="-q -h -V --input --out --format --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                --input)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --out)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --format)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --seed)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --max-memory-gib)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
         mbrl__subcmd__filter)
             opts="-q -h -V --model --input --out --mcap --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
@@ -1096,7 +1140,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__help)
-            opts="collect plan train calibrate filter predict solve-board eval watch completions help"
+            opts="collect plan train calibrate filter predict solve-board eval watch export completions help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1280,6 +1324,20 @@ _mbrl() {
         mbrl__subcmd__help__subcmd__eval__subcmd__seads)
             opts=""
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 4 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mbrl__subcmd__help__subcmd__export)
+            opts=""
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
             fi

@@ -41,6 +41,7 @@ complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "predict" -d 'Predict tabl
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "solve-board" -d 'Find a shortest solution of a LightsOut or TileSwap board and optionally play it with a manipulator'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "eval" -d 'Run an evaluation protocol and write a report directory (report.md, CSV, PNG)'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "watch" -d 'Follow a running or finished run (training or eval) in the live view'
+complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "export" -d 'Convert a dataset, board set, ball recording or filter-estimate file to CSV or NumPy `.npz`'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "completions" -d 'Print a shell completion script'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l env -d 'Environment: pendulum[:light|heavy|mass=<m>|inverted|quadrant], toy:inner|outer, mountaincar, lightsout, tileswap, <game>:cursor|reacher (e.g. lightsout:cursor, tileswap:reacher), ball' -r
@@ -381,6 +382,17 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -l no-tui -d 'Print pla
 complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -s V -l version -d 'Print version'
+complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l input -d 'An mbrl MCAP file: a dataset (`collect`), board set, ball recording or `filter --out *.mcap` output' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l out -d 'Output file; its extension (.csv or .npz) chooses the format unless --format is given' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l format -d 'csv or npz; must agree with --out\'s extension when that names a format' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l threads -d 'Worker threads (0 = one per core)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand export" -s q -l quiet -d 'Print only results and errors'
+complete -c mbrl -n "__fish_mbrl_using_subcommand export" -s h -l help -d 'Print help'
+complete -c mbrl -n "__fish_mbrl_using_subcommand export" -s V -l version -d 'Print version'
 complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
@@ -389,17 +401,18 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -l no-tui -d 'Pri
 complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -s V -l version -d 'Print version'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch completions help" -f -a "collect" -d 'Collect rollouts from a simulator into an MCAP dataset'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch completions help" -f -a "plan" -d 'Plan with CEM on a model and execute the plan in the simulator (MPC)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch completions help" -f -a "train" -d 'Train a model and write it to a checkpoint directory (config.json, weights, metrics.jsonl)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch completions help" -f -a "calibrate" -d 'Calibrate a context model in an instance of its env by expected information gain'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch completions help" -f -a "filter" -d 'Filter table-tennis ball recordings with the gray-box EKF (thesis chapter 6)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch completions help" -f -a "predict" -d 'Predict table-tennis ball trajectories: filter until a horizon before the end, then predict ahead'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch completions help" -f -a "solve-board" -d 'Find a shortest solution of a LightsOut or TileSwap board and optionally play it with a manipulator'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch completions help" -f -a "eval" -d 'Run an evaluation protocol and write a report directory (report.md, CSV, PNG)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch completions help" -f -a "watch" -d 'Follow a running or finished run (training or eval) in the live view'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch completions help" -f -a "completions" -d 'Print a shell completion script'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch completions help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "collect" -d 'Collect rollouts from a simulator into an MCAP dataset'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "plan" -d 'Plan with CEM on a model and execute the plan in the simulator (MPC)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "train" -d 'Train a model and write it to a checkpoint directory (config.json, weights, metrics.jsonl)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "calibrate" -d 'Calibrate a context model in an instance of its env by expected information gain'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "filter" -d 'Filter table-tennis ball recordings with the gray-box EKF (thesis chapter 6)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "predict" -d 'Predict table-tennis ball trajectories: filter until a horizon before the end, then predict ahead'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "solve-board" -d 'Find a shortest solution of a LightsOut or TileSwap board and optionally play it with a manipulator'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "eval" -d 'Run an evaluation protocol and write a report directory (report.md, CSV, PNG)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "watch" -d 'Follow a running or finished run (training or eval) in the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "export" -d 'Convert a dataset, board set, ball recording or filter-estimate file to CSV or NumPy `.npz`'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "completions" -d 'Print a shell completion script'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from eval" -f -a "quick" -d 'Small reproduction of every implemented method (about a minute)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from eval" -f -a "dataset" -d 'Summarise a dataset: rollouts, returns, state ranges, plots'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from eval" -f -a "boards" -d 'Depth and train/test split tables of LightsOut 5x5 and TileSwap (thesis Tables 7.1, 7.2)'

@@ -166,6 +166,8 @@ fn targets() -> Vec<Target> {
         target("ball-predict", mcap("ball.mcap"), "predict --model ekf --input {in} --horizon 0.2s"),
         target("ball-train", mcap("ball.mcap"), "train --method ball-ekf --data {in} --steps 1 --batch 4 --out {out}"),
         // Text files.
+        target("estimates-export", mcap("filtered.mcap"), "export --input {in} --format npz --out {out}"),
+        target("images-export", mcap("img.mcap"), "export --input {in} --format npz --out {out}"),
         target("ball-csv", text("ball.csv"), "filter --model thesis --input {in} --out {out}"),
         target("actions-pendulum", text("actions.csv"), "collect --env pendulum --actions {in} --out {out}"),
         target(

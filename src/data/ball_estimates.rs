@@ -6,12 +6,14 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use super::mcap_io::{write_messages, Layout};
-use crate::error::Result;
+use super::mcap_io::{check_version, metadata_field, read_messages, write_messages, Layout};
+use crate::error::{Error, Result};
 use crate::util::table::write_csv;
 
 pub const STATE_NAMES: [&str; 11] = ["px", "py", "pz", "vx", "vy", "vz", "wx", "wy", "wz", "a_d", "a_m"];
 pub const METADATA_NAME: &str = "mbrl.ball_estimates";
+pub const TOPIC: &str = "/ball/estimates";
+const FORMAT_VERSION: u32 = 1;
 const SCHEMA: &str = r#"{
   "$schema": "https://json-schema.org/draft/2020-12/schema",
   "title": "mbrl.BallEstimate",
@@ -68,16 +70,49 @@ pub fn write_estimates_csv(path: &Path, estimates: &[BallEstimate]) -> Result<()
 pub fn write_estimates_mcap(path: &Path, model: &str, command_line: &str, estimates: &[BallEstimate]) -> Result<()> {
     let layout = Layout {
         metadata_name: METADATA_NAME,
-        topic: "/ball/estimates",
+        topic: TOPIC,
         schema_name: "mbrl.BallEstimate",
         schema: SCHEMA,
         tick_ns: (1e9 / super::ball_io::FRAME_RATE) as u64,
     };
     let metadata = BTreeMap::from([
-        ("format_version".to_string(), "1".to_string()),
+        ("format_version".to_string(), FORMAT_VERSION.to_string()),
         ("model".to_string(), model.to_string()),
         ("command_line".to_string(), command_line.to_string()),
         ("mbrl_version".to_string(), crate::VERSION.to_string()),
     ]);
     write_messages(path, &layout, metadata, estimates)
+}
+
+/// An estimates file as `filter --out F.mcap` writes it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EstimatesFile {
+    pub model: String,
+    pub command_line: String,
+    pub estimates: Vec<BallEstimate>,
+}
+
+pub fn read_estimates_mcap(path: &Path) -> Result<EstimatesFile> {
+    let (meta, messages) = read_messages::<BallEstimate>(path, METADATA_NAME, TOPIC)?;
+    check_version(path, &meta, FORMAT_VERSION)?;
+    let mut estimates = Vec::with_capacity(messages.len());
+    for (sequence, estimate) in messages {
+        let dim = STATE_NAMES.len();
+        if estimate.covariance.len() != dim * dim {
+            return Err(Error::bad_file(
+                path,
+                format!(
+                    "message {sequence}: covariance has {} entries; expected {} (row-major {dim} × {dim})",
+                    estimate.covariance.len(),
+                    dim * dim
+                ),
+            ));
+        }
+        estimates.push(estimate);
+    }
+    Ok(EstimatesFile {
+        model: metadata_field(path, &meta, "model")?,
+        command_line: metadata_field(path, &meta, "command_line")?,
+        estimates,
+    })
 }

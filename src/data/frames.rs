@@ -46,7 +46,7 @@ struct FrameMessage {
 
 /// The (rollout, t) of every frame a dataset with these steps must hold, in order, with the index of the
 /// step whose clock each frame shares (for t = T: the rollout's last step).
-fn frame_slots(steps: &[Timestep]) -> Vec<(u32, u32, usize)> {
+pub fn frame_slots(steps: &[Timestep]) -> Vec<(u32, u32, usize)> {
     let mut slots = Vec::with_capacity(steps.len() + steps.len() / 8);
     for (i, step) in steps.iter().enumerate() {
         slots.push((step.rollout, step.t, i));

@@ -168,6 +168,28 @@ const SCHEMA_ENCODING: &str = "jsonschema";
 /// read through the MCAP library's sans-io reader with every declared length bounded by the bytes present,
 /// chunk and data-section CRCs checked, and each wanted topic's channel checked to be JSON with a JSON Schema.
 fn read_raw(path: &Path, metadata_name: &str, topics: &[&str]) -> Result<RawTopics> {
+    let scan = scan(path, metadata_name, topics)?;
+    let metadata = scan.metadata.ok_or_else(|| {
+        let found = if scan.other_names.is_empty() { "none".to_string() } else { scan.other_names.join(", ") };
+        Error::bad_file(path, format!("expected a '{metadata_name}' metadata record, found {found}"))
+    })?;
+    Ok((metadata, scan.payloads))
+}
+
+/// The names of every metadata record in the file, in file order: what kind of mbrl file it is.
+pub fn metadata_names(path: &Path) -> Result<Vec<String>> {
+    Ok(scan(path, "", &[])?.other_names)
+}
+
+struct Scan {
+    metadata: Option<BTreeMap<String, String>>,
+    other_names: Vec<String>,
+    payloads: Vec<Vec<(u32, Vec<u8>)>>,
+}
+
+/// One pass over the file: the metadata record named `metadata_name` (an empty name matches none), the
+/// names of the others, and the payloads of `topics`.
+fn scan(path: &Path, metadata_name: &str, topics: &[&str]) -> Result<Scan> {
     use mcap::records::Record;
     use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
     let bytes = crate::util::bounded_read::read_bounded(path, MAX_MCAP_BYTES)?;
@@ -202,7 +224,9 @@ fn read_raw(path: &Path, metadata_name: &str, topics: &[&str]) -> Result<RawTopi
                     Error::bad_file(path, format!("not a readable MCAP file (corrupt record 0x{opcode:02x}): {why}"))
                 })?;
                 match mcap::parse_record(opcode, data).map_err(corrupt)? {
-                    Record::Metadata(m) if m.name == metadata_name => metadata = Some(m.metadata),
+                    Record::Metadata(m) if !metadata_name.is_empty() && m.name == metadata_name => {
+                        metadata = Some(m.metadata)
+                    }
                     Record::Metadata(m) => other_names.push(m.name),
                     Record::Schema { header, .. } => {
                         schema_encodings.insert(header.id, header.encoding);
@@ -240,11 +264,7 @@ fn read_raw(path: &Path, metadata_name: &str, topics: &[&str]) -> Result<RawTopi
         reader.notify_read(n);
         offset += n;
     }
-    let metadata = metadata.ok_or_else(|| {
-        let found = if other_names.is_empty() { "none".to_string() } else { other_names.join(", ") };
-        Error::bad_file(path, format!("expected a '{metadata_name}' metadata record, found {found}"))
-    })?;
-    Ok((metadata, out))
+    Ok(Scan { metadata, other_names, payloads: out })
 }
 
 /// Schema, Channel, Message and Metadata: the record opcodes `read_raw` decodes.

@@ -11,6 +11,7 @@ pub mod collect_ball;
 pub mod collect_embodied;
 pub mod collect_frames;
 pub mod dataset;
+pub mod export;
 pub mod frames;
 pub mod frames_png;
 pub mod mcap_io;
