@@ -12,7 +12,7 @@ use mbrl::models::context::calibration::{
 };
 use mbrl::models::context::{self, fast::gaussian_entropy};
 
-use crate::common::{command_line, file_stem, parse_floats, run_job, GlobalArgs};
+use crate::common::{check_output_file, command_line, file_stem, parse_floats, run_job, GlobalArgs};
 
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
 pub enum StrategyChoice {
@@ -110,6 +110,7 @@ pub fn run(global: &GlobalArgs, args: CalibrateArgs) -> anyhow::Result<()> {
             args.instance_seed
         ))
     });
+    check_output_file("--out", &out, "mcap")?;
     let request = CalibrationRequest {
         env: env.clone(),
         instance_seed: args.instance_seed,

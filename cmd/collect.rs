@@ -23,7 +23,7 @@ use mbrl::envs::boards::{GameSpec, LightsOut, Split, TileSwap};
 use mbrl::envs::embodiments::Embodiment;
 use mbrl::envs::{parse_env, EnvName};
 
-use crate::common::{command_line, file_stem, run_job, GlobalArgs};
+use crate::common::{check_output_file, command_line, file_stem, run_job, GlobalArgs};
 
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
 pub enum Policy {
@@ -164,6 +164,7 @@ pub fn run(global: &GlobalArgs, args: CollectArgs) -> anyhow::Result<()> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from(format!("datasets/{}-{mode}.mcap", file_stem(&env.canonical()))));
+    check_output_file("--out", &out, "mcap")?;
     if args.images {
         let rollouts = args.instances.map_or(args.rollouts, |n| 2 * n);
         check_frames_size(&env, rollouts as f64 * (args.steps as f64 + 1.0))?;
@@ -221,6 +222,7 @@ fn replay_actions(global: &GlobalArgs, env: EnvName, actions: &Path, args: &Coll
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from(format!("datasets/{}-replay.mcap", file_stem(&env.canonical()))));
+    check_output_file("--out", &out, "mcap")?;
     let settings = ReplaySettings {
         env,
         actions,
@@ -251,6 +253,7 @@ fn collect_embodied_episodes(
     }
     let mode = if args.actions.is_some() { "replay" } else { "random" };
     let out = args.out.clone().unwrap_or_else(|| PathBuf::from(format!("datasets/{}-{mode}.mcap", file_stem(&name))));
+    check_output_file("--out", &out, "mcap")?;
     let data = match (&args.actions, args.episodes) {
         (Some(actions), _) => {
             let init_state =
@@ -293,6 +296,7 @@ fn collect_boards(global: &GlobalArgs, game: GameSpec, args: &CollectArgs) -> an
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from(format!("datasets/{}-boards-d{max_depth}.mcap", file_stem(&game.name()))));
+    check_output_file("--out", &out, "mcap")?;
     let split = args.split.map(Split::from);
     let set = run_job(global, "collect boards", |monitor| {
         let boards = match game {
@@ -346,6 +350,7 @@ fn records<G: DenseIndex>(
 fn collect_ball_shots(global: &GlobalArgs, trajectories: usize, args: &CollectArgs) -> anyhow::Result<()> {
     let orientation = Orientation::parse(&args.orientation)?;
     let out = args.out.clone().unwrap_or_else(|| PathBuf::from(format!("datasets/ball-{}.mcap", orientation.name())));
+    check_output_file("--out", &out, "mcap")?;
     let settings = BallCollectSettings {
         trajectories,
         orientation,

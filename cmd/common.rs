@@ -188,3 +188,22 @@ pub fn write_stdout(result: std::io::Result<()>) {
         Err(e) => mbrl::util::interrupt::abandon_and_exit_with(1, &format!("cannot write to stdout: {e}")),
     }
 }
+
+/// Extensions of the files mbrl reads or writes: an output named with one of them promises that format.
+const KNOWN_EXTENSIONS: [&str; 10] = ["mcap", "csv", "npz", "json", "jsonl", "png", "md", "txt", "toml", "safetensors"];
+
+/// Checks an output file before any work starts: not a directory, and not named for another format
+/// (`plan --out p.csv` would otherwise get MCAP bytes). Names without a known extension are taken as given.
+pub fn check_output_file(flag: &str, path: &std::path::Path, extension: &str) -> anyhow::Result<()> {
+    let named = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    if let Some(named) = named.filter(|n| KNOWN_EXTENSIONS.contains(&n.as_str()) && n != extension) {
+        let hint = if extension == "mcap" { "; `mbrl export` turns MCAP into CSV or .npz" } else { "" };
+        anyhow::bail!(
+            "{flag} {}: this writes {} and the name says .{named}; name it .{extension}{hint}",
+            path.display(),
+            extension.to_ascii_uppercase()
+        );
+    }
+    mbrl::util::atomic::Target::of(path)?;
+    Ok(())
+}

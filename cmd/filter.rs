@@ -9,7 +9,7 @@ use mbrl::models::ball::checkpoint::load_ball_model;
 use mbrl::models::ball::track::filter_recording;
 use mbrl::models::ball::Phase;
 
-use crate::common::{command_line, run_job, GlobalArgs};
+use crate::common::{check_output_file, command_line, run_job, GlobalArgs};
 
 /// Filter table-tennis ball recordings with the gray-box EKF (thesis chapter 6).
 #[derive(Args, Debug)]
@@ -37,6 +37,10 @@ pub struct FilterArgs {
 
 pub fn run(global: &GlobalArgs, args: FilterArgs) -> anyhow::Result<()> {
     let model = load_ball_model(&args.model)?;
+    check_output_file("--out", &args.out, "csv")?;
+    if let Some(path) = &args.mcap {
+        check_output_file("--mcap", path, "mcap")?;
+    }
     let recordings = read_recordings(&args.input)?;
     let (estimates, likelihoods) = run_job(global, "filter", |monitor| {
         let mut estimates = Vec::new();

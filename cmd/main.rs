@@ -25,7 +25,7 @@ mod solve_board;
 mod train;
 mod watch;
 
-use clap::{CommandFactory, Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
 use common::GlobalArgs;
 
@@ -71,7 +71,10 @@ fn main() {
         eprintln!("error: could not install the Ctrl-C handler: {e}");
         std::process::exit(1);
     }
-    let cli = Cli::try_parse().unwrap_or_else(|err| exit_on_usage_error(err));
+    let cli = accept_negative_numbers(Cli::command())
+        .try_get_matches()
+        .and_then(|matches| Cli::from_arg_matches(&matches))
+        .unwrap_or_else(|err| exit_on_usage_error(err));
     let outcome = common::init_threads(&cli.global).and_then(|()| match cli.command {
         Command::Collect(args) => collect::run(&cli.global, args),
         Command::Plan(args) => plan::run(&cli.global, args),
@@ -90,6 +93,14 @@ fn main() {
         eprintln!("error: {}", one_line(&format!("{err:#}")));
         std::process::exit(if cancelled { 130 } else { 1 });
     }
+}
+
+/// Negative values reach each flag's own check (`--lr -1` → "--lr must be positive") instead of clap's
+/// "unexpected argument '-1'"; flags that take no value still start with a dash.
+fn accept_negative_numbers(command: clap::Command) -> clap::Command {
+    command
+        .mut_args(|arg| if arg.get_action().takes_values() { arg.allow_negative_numbers(true) } else { arg })
+        .mut_subcommands(accept_negative_numbers)
 }
 
 /// Help and version print as clap renders them; a usage error becomes one line: clap's message and where to
@@ -113,12 +124,19 @@ fn exit_on_usage_error(err: clap::Error) -> ! {
         .collect::<Vec<_>>()
         .join(" ");
     let message = message.strip_prefix("error: ").unwrap_or(&message);
+    // Rust's integer parser says "invalid digit found in string"; for the unsigned counts and seeds this
+    // means the value, as the user typed it, is negative or not a whole number.
+    let negative = message.starts_with("invalid value '-");
+    let message = message.replace(
+        "invalid digit found in string",
+        if negative { "must be a whole number ≥ 0" } else { "not a whole number" },
+    );
     let command = std::env::args().nth(1).filter(|a| Cli::command().find_subcommand(a).is_some());
     let help = match command {
         Some(name) => format!("mbrl {name} --help"),
         None => "mbrl --help".to_string(),
     };
-    eprintln!("error: {} (see '{}')", one_line(message), one_line(&help));
+    eprintln!("error: {} (see '{}')", one_line(&message), one_line(&help));
     std::process::exit(2);
 }
 

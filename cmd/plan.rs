@@ -10,7 +10,7 @@ use mbrl::models::dlgpd;
 use mbrl::util::budget;
 
 use crate::cem_args::CemArgs;
-use crate::common::{command_line, file_stem, pendulum_variant, run_job, GlobalArgs};
+use crate::common::{check_output_file, command_line, file_stem, pendulum_variant, run_job, GlobalArgs};
 use crate::model_args::ModelArgs;
 
 /// Plan with CEM on a model and execute the plan in the simulator (MPC).
@@ -76,6 +76,7 @@ pub fn run(global: &GlobalArgs, args: PlanArgs) -> anyhow::Result<()> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from(format!("datasets/plan-{}.mcap", file_stem(&settings.variant.env_name()))));
+    check_output_file("--out", &out, "mcap")?;
     let env = mbrl::envs::parse_env(&args.env)?;
     // With --evidence the model can only be DLGPD, so its loader reports why a checkpoint does not open.
     let is_dlgpd = args.model.model != "true"

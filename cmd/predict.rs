@@ -12,7 +12,7 @@ use mbrl::models::ball::track::{
 };
 use mbrl::util::table::write_csv;
 
-use crate::common::{run_job, GlobalArgs};
+use crate::common::{check_output_file, run_job, GlobalArgs};
 
 /// Predict table-tennis ball trajectories: filter until a horizon before the end, then predict ahead.
 #[derive(Args, Debug)]
@@ -60,6 +60,7 @@ fn horizon_frames(text: &str) -> anyhow::Result<u64> {
 }
 
 pub fn run(global: &GlobalArgs, args: PredictArgs) -> anyhow::Result<()> {
+    check_output_file("--out", &args.out, "csv")?;
     let model = load_ball_model(&args.model)?;
     let steps = horizon_frames(&args.horizon)?;
     let recordings = read_recordings(&args.input)?;
@@ -110,8 +111,12 @@ pub fn run(global: &GlobalArgs, args: PredictArgs) -> anyhow::Result<()> {
         if let Some(l) = land {
             line += &format!("; lands at ({:.3}, {:.3}) m, t = {:.3} s", l.position[0], l.position[1], l.t);
         }
-        if let Some((t, p)) = crossing {
-            line += &format!("; crosses y = {:.3} at x = {:.3}, z = {:.3} m, t = {t:.3} s", p[1], p[0], p[2]);
+        match (crossing, args.plane_y) {
+            (Some((t, p)), _) => {
+                line += &format!("; crosses y = {:.3} at x = {:.3}, z = {:.3} m, t = {t:.3} s", p[1], p[0], p[2])
+            }
+            (None, Some(y)) => line += &format!("; does not cross y = {y:.3} within the {} horizon", args.horizon),
+            (None, None) => {}
         }
         say!("{line}");
     }

@@ -157,3 +157,57 @@ fn absurd_sizes_are_refused_before_work_naming_the_flag() {
     assert_one_line_error(&out, &["--max-memory-gib"]);
     assert!(files_in(d).iter().all(|f| !f.ends_with(".mcap") || f.contains("plan-")), "{:?}", files_in(d));
 }
+
+/// Output names are checked before any work: a directory, or an extension that names another format than
+/// the command writes, is refused at once and nothing is written.
+#[test]
+fn outputs_named_for_another_format_or_a_directory_are_refused_before_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::create_dir(d.join("sub")).unwrap();
+    let cases: [(&[&str], &[&str]); 4] = [
+        (&["plan", "--env", "pendulum", "--model", "true", "--out", "p.csv"], &["p.csv", "MCAP", ".mcap", "export"]),
+        (&["plan", "--env", "pendulum", "--model", "true", "--out", "sub"], &["sub", "directory"]),
+        (&["collect", "--env", "pendulum", "--rollouts", "2", "--out", "c.npz"], &["c.npz", ".mcap"]),
+        (&["filter", "--model", "thesis", "--input", "missing.csv", "--out", "f.mcap"], &["f.mcap", "CSV", ".csv"]),
+    ];
+    for (args, needles) in cases {
+        let started = std::time::Instant::now();
+        let out = mbrl(d).args(args).output().unwrap();
+        assert_one_line_error(&out, needles);
+        // Refused before the 150-step episode (seconds) would have run.
+        assert!(started.elapsed().as_secs_f64() < 2.0, "{args:?} took {:?}", started.elapsed());
+    }
+    assert_eq!(files_in(d), Vec::<String>::new());
+}
+
+/// A negative value reaches the flag's own check instead of clap's "unexpected argument '-1'".
+#[test]
+fn negative_values_get_a_message_about_the_value() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = mbrl(d).args(["plan", "--env", "pendulum", "--model", "true", "--steps", "-3"]).output().unwrap();
+    assert_one_line_error(&out, &["'-3'", "--steps", "≥ 0"]);
+    let out = mbrl(d).args(["plan", "--env", "pendulum", "--model", "true", "--beta", "-1"]).output().unwrap();
+    assert!(!stderr_of(&out).contains("unexpected argument"), "{}", stderr_of(&out));
+    let out =
+        mbrl(d).args(["train", "--method", "pets", "--data", "x.mcap", "--lr", "-1", "--out", "m"]).output().unwrap();
+    let err = stderr_of(&out);
+    assert!(!out.status.success() && !err.contains("unexpected argument"), "{err}");
+}
+
+#[test]
+fn gym_ids_map_to_the_same_dynamics_or_name_the_mbrl_env() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = mbrl(d).args(["plan", "--env", "Pendulum-v1", "--model", "true"]).output().unwrap();
+    assert_one_line_error(&out, &["Pendulum-v1", "Pendulum-v0", "--env pendulum"]);
+    let out = mbrl(d).args(["collect", "--env", "MountainCarContinuous-v0", "--instances", "2"]).output().unwrap();
+    assert_one_line_error(&out, &["MountainCarContinuous-v0", "--env mountaincar"]);
+    mbrl(d)
+        .args(["collect", "--env", "Pendulum-v0", "--rollouts", "1", "--steps", "3", "--out", "p.mcap", "-q"])
+        .assert()
+        .success();
+    let data = mbrl::data::dataset::read_dataset(&d.join("p.mcap")).unwrap();
+    assert_eq!(data.meta.env, "pendulum");
+}

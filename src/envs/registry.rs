@@ -36,6 +36,9 @@ pub enum EnvName {
 }
 
 pub fn parse_env(name: &str) -> Result<EnvName> {
+    if let Some(alias) = gym_alias(name) {
+        return parse_env(alias?);
+    }
     if let Some((game, manipulator)) = name.rsplit_once(':') {
         if let Ok(embodiment) = Embodiment::parse(manipulator) {
             return Ok(EnvName::Embodied(GameSpec::parse(game)?, embodiment));
@@ -49,6 +52,25 @@ pub fn parse_env(name: &str) -> Result<EnvName> {
         "lightsout" | "tileswap" => Ok(EnvName::Board(GameSpec::parse(name)?)),
         "ball" if variant.is_empty() => Ok(EnvName::Ball),
         _ => Err(Error::config(format!("unknown env '{name}'; supported: {KNOWN_ENVS}"))),
+    }
+}
+
+/// Gym / Gymnasium ids that users bring from Python. The one whose dynamics mbrl reproduces step for step
+/// names that env; the others are refused with the nearest mbrl env and how it differs.
+fn gym_alias(name: &str) -> Option<Result<&'static str>> {
+    let lower = name.to_ascii_lowercase();
+    match lower.as_str() {
+        "pendulum-v0" => Some(Ok("pendulum")),
+        "pendulum-v1" => Some(Err(Error::config(format!(
+            "'{name}': mbrl's pendulum is gym's Pendulum-v0 (the version of the thesis and its authors' code), which \
+             clips the angular velocity after the angle update; Pendulum-v1 clips it before, so the two part above \
+             8 rad/s. Use --env pendulum"
+        )))),
+        _ if lower.starts_with("mountaincar") && lower.contains("-v") => Some(Err(Error::config(format!(
+            "'{name}': gym's MountainCar is not provided; mbrl's mountaincar is the thesis' variant (eq. 4.41) over a \
+             random Gaussian-bump terrain per instance. Use --env mountaincar"
+        )))),
+        _ => None,
     }
 }
 
@@ -121,6 +143,15 @@ mod tests {
     fn unknown_family_names_supported_envs() {
         let err = parse_env("cartpole").unwrap_err().to_string();
         assert!(err.contains("cartpole") && err.contains("pendulum"), "{err}");
+    }
+
+    #[test]
+    fn gym_ids_name_the_same_dynamics_or_say_which_mbrl_env_is_nearest() {
+        assert_eq!(parse_env("Pendulum-v0").unwrap().canonical(), "pendulum");
+        for (id, suggestion) in [("Pendulum-v1", "--env pendulum"), ("MountainCarContinuous-v0", "--env mountaincar")] {
+            let err = parse_env(id).unwrap_err().to_string();
+            assert!(err.contains(id) && err.contains(suggestion), "{err}");
+        }
     }
 
     #[test]
