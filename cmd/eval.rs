@@ -269,13 +269,15 @@ pub fn run(global: &GlobalArgs, args: EvalArgs) -> anyhow::Result<()> {
             say!("median prediction error at 1 s horizon:");
             for r in summary.rows.iter().filter(|r| (r.horizon_s - 1.0).abs() < 1e-9) {
                 say!(
-                    "  {:<32} {:<8} {:6.1} cm  (10-90 %: {:.1}-{:.1} cm, n = {})",
+                    "  {:<32} {:<8} {:6.1} cm  (10-90 %: {:.1}-{:.1} cm, n = {}, failed {}, too short {})",
                     r.method,
                     r.group,
                     100.0 * r.median,
                     100.0 * r.q10,
                     100.0 * r.q90,
-                    r.count
+                    r.count,
+                    r.failed,
+                    r.too_short
                 );
             }
             say!("report: {}", a.out.join("report.md").display());

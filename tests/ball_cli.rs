@@ -110,11 +110,12 @@ fn eval_ball_compares_models_and_the_baseline() {
         assert!(dir.path().join("rep").join(file).is_file(), "missing {file}");
     }
     let summary = std::fs::read_to_string(dir.path().join("rep/summary.csv")).unwrap();
+    let median_column = summary.lines().next().unwrap().split(',').position(|c| c == "median_m").unwrap();
     let median = |method: &str, group: &str| -> f64 {
         summary
             .lines()
             .find(|l| l.starts_with(&format!("{method},{group},1.000,")))
-            .and_then(|l| l.split(',').nth(5))
+            .and_then(|l| l.split(',').nth(median_column))
             .and_then(|v| v.parse().ok())
             .unwrap_or_else(|| panic!("no 1 s row for {method}/{group}:\n{summary}"))
     };

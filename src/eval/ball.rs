@@ -7,8 +7,8 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use super::plot::{band_plot, line_plot, Band, Series};
-use super::stats::quantile;
+use super::plot::{band_panels, line_plot, Band, Series};
+use super::stats::quantile_counting_failures;
 use crate::data::ball_io::{Recording, FRAME_RATE};
 use crate::data::collect_ball::{collect_ball, BallCollectSettings};
 use crate::envs::ball::Orientation;
@@ -89,7 +89,12 @@ pub struct ErrorSummary {
     pub method: String,
     pub group: String,
     pub horizon_s: f64,
+    /// Trajectories scored, failures included.
     pub count: usize,
+    /// Trajectories the method could not predict; they count as infinitely wrong in the quantiles.
+    pub failed: usize,
+    /// Shots too short for this horizon (left out).
+    pub too_short: usize,
     pub q10: f64,
     pub median: f64,
     pub q90: f64,
@@ -215,8 +220,15 @@ pub fn evaluate(
                     return Err(Error::Cancelled);
                 }
                 let mut errs = Vec::new();
+                let mut too_short = 0;
                 for rec in recs {
                     let Some(cut) = protocol_cut(rec, h) else { continue };
+                    // A shot shorter than the horizon plus ten measurements is predicted over less than the
+                    // horizon: filed here it would flatter the long horizons, so it is left out and counted.
+                    if rec.frames.last().is_some_and(|&last| last - cut < h) {
+                        too_short += 1;
+                        continue;
+                    }
                     let err = method.predictor.predict(rec, cut, h as usize).and_then(|p| prediction_error(&p, rec));
                     // A method that cannot predict a trajectory scores as infinitely wrong, not as absent.
                     let err = err.unwrap_or(f64::INFINITY);
@@ -229,12 +241,14 @@ pub fn evaluate(
                     ]);
                     errs.push(err);
                 }
-                let q = |p| quantile(&errs, p).unwrap_or(f64::NAN);
+                let q = |p| quantile_counting_failures(&errs, p).unwrap_or(f64::NAN);
                 rows.push(ErrorSummary {
                     method: method.name.clone(),
                     group: group.clone(),
                     horizon_s: h as f64 / FRAME_RATE,
                     count: errs.len(),
+                    failed: errs.iter().filter(|e| e.is_infinite()).count(),
+                    too_short,
                     q10: q(0.1),
                     median: q(0.5),
                     q90: q(0.9),
@@ -253,6 +267,8 @@ pub fn evaluate(
                 r.group.clone(),
                 format!("{:.3}", r.horizon_s),
                 r.count.to_string(),
+                r.failed.to_string(),
+                r.too_short.to_string(),
                 format!("{:.4}", r.q10),
                 format!("{:.4}", r.median),
                 format!("{:.4}", r.q90),
@@ -261,27 +277,33 @@ pub fn evaluate(
         .collect();
     write_csv(
         &run.file("summary.csv"),
-        &["method", "group", "horizon_s", "trajectories", "q10_m", "median_m", "q90_m"],
+        &["method", "group", "horizon_s", "trajectories", "failed", "too_short", "q10_m", "median_m", "q90_m"],
         &summary_rows,
     )?;
-    let bands: Vec<Band> = methods
+    // One panel per launcher pose, in centimetres like the tables; a method keeps its colour in every panel.
+    let panels: Vec<(String, Vec<Band>)> = tests
         .iter()
-        .flat_map(|m| tests.iter().map(move |(g, _)| (m.name.clone(), g.clone())))
-        .map(|(m, g)| Band {
-            name: format!("{m} ({g})"),
-            points: rows
+        .map(|(group, _)| {
+            let bands = methods
                 .iter()
-                .filter(|r| r.method == m && r.group == g)
-                .map(|r| (r.horizon_s, r.q10, r.median, r.q90.min(2.0)))
-                .collect(),
+                .map(|m| Band {
+                    name: m.name.clone(),
+                    points: rows
+                        .iter()
+                        .filter(|r| r.method == m.name && &r.group == group)
+                        .map(|r| (r.horizon_s, 100.0 * r.q10, 100.0 * r.median, 100.0 * r.q90.min(2.0)))
+                        .collect(),
+                })
+                .collect();
+            (group.clone(), bands)
         })
         .collect();
-    band_plot(
+    band_panels(
         &run.file("error_vs_horizon.png"),
-        "Prediction error vs horizon (median, 10-90 %)",
+        "Prediction error vs horizon per launcher pose (median, 10-90 %)",
         "horizon [s]",
-        "error [m]",
-        &bands,
+        "error [cm]",
+        &panels,
     )?;
     trajectory_plot(&run.file("trajectories.png"), &methods, &tests)?;
     let md = report_markdown(settings, &methods, &rows);
@@ -294,18 +316,30 @@ pub fn evaluate(
 /// Side view (y, z) of a few test shots: measurements, the filtered part and the 1 s prediction of the
 /// first EKF method; the side view shows the bounce, where prediction is hardest.
 fn trajectory_plot(path: &Path, methods: &[Method], tests: &[TestSet]) -> Result<()> {
-    let Some(Method { predictor: Predictor::Ekf { model, spin_net }, name }) = methods.first() else { return Ok(()) };
+    let series = trajectory_series(methods, tests);
+    if series.is_empty() {
+        return Ok(());
+    }
+    line_plot(path, "Test shots from the side", "y [m]", "z [m]", &series)
+}
+
+/// The (y, z) series of `trajectory_plot`; every series in the side view's coordinates.
+fn trajectory_series(methods: &[Method], tests: &[TestSet]) -> Vec<Series> {
+    let Some(Method { predictor: Predictor::Ekf { model, spin_net }, name }) = methods.first() else {
+        return Vec::new();
+    };
+    let side = |p: &[f64]| (p[1], p[2]);
     let mut series = Vec::new();
     for (group, rec) in tests.iter().flat_map(|(g, r)| r.iter().step_by(37).take(2).map(move |r| (g, r))) {
         let Some(cut) = protocol_cut(rec, 180) else { continue };
         series.push(Series {
             name: format!("{group} #{} measured", rec.id),
-            points: rec.positions.iter().flatten().map(|p| (p[1], p[2])).collect(),
+            points: rec.positions.iter().flatten().map(|p| side(p)).collect(),
         });
         if let Ok(track) = filter_recording(model, rec, Some(cut), &spin_prior(spin_net, rec)) {
             series.push(Series {
                 name: format!("{group} #{} filtered", rec.id),
-                points: track.beliefs.iter().map(|b| (b.mean[1], b.mean[2])).collect(),
+                points: track.beliefs.iter().map(|b| side(b.mean.as_slice())).collect(),
             });
             if let Some(b) = track.beliefs.last() {
                 let pred = predict_ahead(model, b, *track.frames.last().unwrap_or(&cut), 180);
@@ -314,13 +348,13 @@ fn trajectory_plot(path: &Path, methods: &[Method], tests: &[TestSet]) -> Result
                     points: pred
                         .iter()
                         .filter(|p| p.frame <= *rec.frames.last().unwrap_or(&0))
-                        .map(|p| (p.position[0], p.position[1]))
+                        .map(|p| side(&p.position))
                         .collect(),
                 });
             }
         }
     }
-    line_plot(path, "Test shots from the side", "y [m]", "z [m]", &series)
+    series
 }
 
 fn format_c(c: &[[f64; 6]; 6]) -> String {
@@ -337,18 +371,30 @@ fn report_markdown(settings: &BallEvalSettings, methods: &[Method], rows: &[Erro
          Protocol: filter until the horizon before the end (at least ten measurements), predict the rest; error = largest distance over the\n\
          last five prediction–measurement pairs. The ridge baseline maps the last 8 positions (relative to the newest) to displacements\n\
          at every future frame; it is transparent, fast and strong on ballistic flight, and has no model of the bounce.\n\
+         Its error is not monotone in the horizon (largest near 0.4-0.5 s, smaller at 1 s), and this is the protocol meeting a\n\
+         linear map, not a defect: the error is taken at the end of each shot, so the horizon sets where the cut falls. At 1 s\n\
+         the cut is just after launch, where every shot's window looks alike and its remaining path (bounce included) is close\n\
+         to the average one the ridge learns; at 0.4-0.5 s the cut falls around the bounce, where a window of relative\n\
+         positions cannot tell whether the kink is still ahead, and a linear map averages both cases. Giving it the absolute\n\
+         position as well lowers the 0.5 s median on default-pose shots (33 → 21 cm in `eval quick`'s setting) but keeps the\n\
+         peak and worsens unseen poses, whose positions lie outside the training shots.\n\
          A model named `oracle` runs the thesis' Table C.1 parameters, which are the constants the simulator generates these shots\n\
-         with: it bounds what a perfectly learned EKF could reach here and is not a competitor.\n\n\
-         | method | group | horizon [s] | n | 10 % [cm] | median [cm] | 90 % [cm] |\n|---|---|---|---|---|---|---|\n",
+         with: it bounds what a perfectly learned EKF could reach here and is not a competitor.\n\
+         `n` counts the shots scored at a horizon; a prediction that fails (`failed`) ranks as infinitely wrong in the quantiles\n\
+         (∞ when it reaches one). Shots shorter than the horizon plus ten measurements are left out (`short`), since their\n\
+         prediction would span less than the horizon.\n\n\
+         | method | group | horizon [s] | n | failed | short | 10 % [cm] | median [cm] | 90 % [cm] |\n|---|---|---|---|---|---|---|---|---|\n",
         settings.train_shots, settings.augment_rotations, settings.test_shots_default, settings.test_shots_unseen
     );
     for r in rows.iter().filter(|r| (r.horizon_s * 10.0).round() as i64 % 5 == 0) {
         md.push_str(&format!(
-            "| {} | {} | {:.1} | {} | {:.1} | {:.1} | {:.1} |\n",
+            "| {} | {} | {:.1} | {} | {} | {} | {:.1} | {:.1} | {:.1} |\n",
             r.method,
             r.group,
             r.horizon_s,
             r.count,
+            r.failed,
+            r.too_short,
             100.0 * r.q10,
             100.0 * r.median,
             100.0 * r.q90
@@ -365,4 +411,44 @@ fn report_markdown(settings: &BallEvalSettings, methods: &[Method], rows: &[Erro
         format_c(&BallModelParams::thesis_learned().c)
     ));
     md
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::run::monitor::NullMonitor;
+
+    /// The side view's predicted points stay where the shot was measured (the plot once drew (x, y) on
+    /// the (y, z) axes: predictions seemed to climb to 2.5 m while the CSV never passed 0.35 m).
+    #[test]
+    fn side_view_series_lie_in_the_measured_envelope() {
+        let settings = BallEvalSettings {
+            train_shots: 1,
+            augment_rotations: 0,
+            test_shots_default: 2,
+            test_shots_unseen: 1,
+            ..Default::default()
+        };
+        let (_, tests) = datasets(&settings, 3, &NullMonitor).unwrap();
+        let model = BallModel::new(BallModelParams::thesis_learned()).unwrap();
+        let methods = [Method { name: "oracle".into(), predictor: Predictor::Ekf { model, spin_net: None } }];
+        let series = trajectory_series(&methods, &tests);
+        assert!(series.iter().any(|s| s.name.contains("predicted")), "no prediction drawn");
+        for group in series.chunks(3) {
+            let (ys, zs): (Vec<f64>, Vec<f64>) = group[0].points.iter().copied().unzip();
+            let span = |v: &[f64]| {
+                (v.iter().copied().fold(f64::INFINITY, f64::min), v.iter().copied().fold(f64::NEG_INFINITY, f64::max))
+            };
+            let ((y0, y1), (z0, z1)) = (span(&ys), span(&zs));
+            for s in group {
+                for &(y, z) in &s.points {
+                    assert!(
+                        y > y0 - 0.3 && y < y1 + 0.3 && z > z0 - 0.3 && z < z1 + 0.3,
+                        "{}: ({y}, {z}) outside y {y0}..{y1}, z {z0}..{z1}",
+                        s.name
+                    );
+                }
+            }
+        }
+    }
 }

@@ -20,6 +20,36 @@ fn register_font() {
     });
 }
 
+/// Line colours: matplotlib's tab10, then the darker tab20b/tab20c hues, all readable on white. Plots
+/// with more series than this reuse colours (and say so by dropping the legend).
+const PALETTE: [(u8, u8, u8); 20] = [
+    (31, 119, 180),
+    (255, 127, 14),
+    (44, 160, 44),
+    (214, 39, 40),
+    (148, 103, 189),
+    (140, 86, 75),
+    (227, 119, 194),
+    (127, 127, 127),
+    (188, 189, 34),
+    (23, 190, 207),
+    (57, 59, 121),
+    (99, 121, 57),
+    (140, 109, 49),
+    (132, 60, 57),
+    (123, 65, 115),
+    (49, 130, 189),
+    (230, 85, 13),
+    (49, 163, 84),
+    (117, 107, 177),
+    (99, 99, 99),
+];
+
+pub fn series_color(i: usize) -> RGBAColor {
+    let (r, g, b) = PALETTE[i % PALETTE.len()];
+    RGBColor(r, g, b).to_rgba()
+}
+
 /// A named series of (x, y) points.
 pub struct Series {
     pub name: String,
@@ -103,7 +133,7 @@ pub fn line_plot_in(
         let root = BitMapBackend::new(tmp, SIZE).into_drawing_area();
         let mut chart = xy_chart(&root, path, title, (x_label, y_label), x0..x1, y0..y1)?;
         for (i, s) in series.iter().enumerate() {
-            let color = Palette99::pick(i).to_rgba();
+            let color = series_color(i);
             // A non-finite y breaks the line, so wrapped angles do not draw vertical jumps.
             for (j, segment) in s.points.split(|p| !p.1.is_finite()).filter(|seg| !seg.is_empty()).enumerate() {
                 // A lone point has no line to show it: mark it.
@@ -121,7 +151,7 @@ pub fn line_plot_in(
                 }
             }
         }
-        if series.len() <= 12 {
+        if series.len() <= PALETTE.len() {
             chart
                 .configure_series_labels()
                 .background_style(WHITE.mix(0.8))
@@ -148,7 +178,7 @@ pub fn band_plot(path: &Path, title: &str, x_label: &str, y_label: &str, bands: 
         let root = BitMapBackend::new(tmp, SIZE).into_drawing_area();
         let mut chart = xy_chart(&root, path, title, (x_label, y_label), x0..x1, y0.min(0.0)..y1)?;
         for (i, band) in bands.iter().enumerate() {
-            let color = Palette99::pick(i).to_rgba();
+            let color = series_color(i);
             let mut outline: Vec<(f64, f64)> = band.points.iter().map(|p| (p.0, p.3)).collect();
             outline.extend(band.points.iter().rev().map(|p| (p.0, p.1)));
             chart
@@ -167,6 +197,63 @@ pub fn band_plot(path: &Path, title: &str, x_label: &str, y_label: &str, bands: 
             .border_style(BLACK)
             .draw()
             .map_err(|e| plot_err(path, e))?;
+        root.present().map_err(|e| plot_err(path, e))?;
+        Ok(())
+    })
+}
+
+/// One band chart per panel on a grid, with one y range for all so the panels compare at a glance; band k
+/// has the same colour in every panel, so one legend (in the first panel) serves all.
+pub fn band_panels(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    panels: &[(String, Vec<Band>)],
+) -> Result<()> {
+    let all = || panels.iter().flat_map(|(_, bands)| bands.iter().flat_map(|b| b.points.iter()));
+    let (x0, x1) = bounds(all().map(|p| p.0));
+    let (_, y1) = bounds(all().flat_map(|p| [p.1, p.3]));
+    let columns = panels.len().clamp(1, 3);
+    let rows = panels.len().div_ceil(columns).max(1);
+    let size = (420 * columns as u32, 60 + 340 * rows as u32);
+    render_atomic(path, |tmp| {
+        let root = BitMapBackend::new(tmp, size).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| plot_err(path, e))?;
+        let root = root.titled(title, ("sans-serif", 24)).map_err(|e| plot_err(path, e))?;
+        for (k, (area, (name, bands))) in root.split_evenly((rows, columns)).iter().zip(panels).enumerate() {
+            let mut chart = ChartBuilder::on(area)
+                .caption(name, ("sans-serif", 18))
+                .margin(8)
+                .x_label_area_size(36)
+                .y_label_area_size(52)
+                .build_cartesian_2d(x0..x1, 0.0..y1)
+                .map_err(|e| plot_err(path, e))?;
+            chart.configure_mesh().x_desc(x_label).y_desc(y_label).draw().map_err(|e| plot_err(path, e))?;
+            for (i, band) in bands.iter().enumerate() {
+                let color = series_color(i);
+                let mut outline: Vec<(f64, f64)> = band.points.iter().map(|p| (p.0, p.3)).collect();
+                outline.extend(band.points.iter().rev().map(|p| (p.0, p.1)));
+                chart
+                    .draw_series(std::iter::once(Polygon::new(outline, color.mix(0.15))))
+                    .map_err(|e| plot_err(path, e))?;
+                chart
+                    .draw_series(LineSeries::new(band.points.iter().map(|p| (p.0, p.2)), color.stroke_width(2)))
+                    .map_err(|e| plot_err(path, e))?
+                    .label(band.name.clone())
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2)));
+            }
+            if k == 0 {
+                chart
+                    .configure_series_labels()
+                    .position(SeriesLabelPosition::UpperLeft)
+                    .background_style(WHITE.mix(0.8))
+                    .border_style(BLACK)
+                    .label_font(("sans-serif", 13))
+                    .draw()
+                    .map_err(|e| plot_err(path, e))?;
+            }
+        }
         root.present().map_err(|e| plot_err(path, e))?;
         Ok(())
     })

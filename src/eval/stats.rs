@@ -16,6 +16,23 @@ pub fn quantile(values: &[f64], q: f64) -> Option<f64> {
     Some(v[lo] + (v[hi] - v[lo]) * (pos - lo as f64))
 }
 
+/// Quantile of errors where a failure counts as +∞: failures take the top ranks, so a method that fails
+/// on a third of the trajectories has an infinite 90 % quantile rather than a flattering finite one.
+/// NaN values are not errors and are ignored; `None` when nothing is left.
+pub fn quantile_counting_failures(values: &[f64], q: f64) -> Option<f64> {
+    let mut v: Vec<f64> = values.iter().copied().filter(|x| !x.is_nan()).collect();
+    if v.is_empty() {
+        return None;
+    }
+    v.sort_by(f64::total_cmp);
+    let pos = q.clamp(0.0, 1.0) * (v.len() - 1) as f64;
+    let (lo, hi) = (pos.floor() as usize, pos.ceil() as usize);
+    let frac = pos - lo as f64;
+    // Interpolating towards an infinite neighbour is infinite only if the neighbour carries weight (and
+    // ∞ − ∞ must not turn two failures into NaN).
+    Some(if frac == 0.0 || v[lo].is_infinite() { v[lo] } else { v[lo] + (v[hi] - v[lo]) * frac })
+}
+
 pub fn mean(values: &[f64]) -> Option<f64> {
     (!values.is_empty()).then(|| values.iter().sum::<f64>() / values.len() as f64)
 }
@@ -180,6 +197,18 @@ fn signed_rank_sum_counts(n: usize) -> Vec<u64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn failures_take_the_top_ranks_of_the_quantiles() {
+        let errors = [0.1, 0.2, f64::INFINITY, 0.3, f64::INFINITY];
+        assert_eq!(quantile_counting_failures(&errors, 0.5), Some(0.3));
+        assert_eq!(quantile_counting_failures(&errors, 0.9), Some(f64::INFINITY));
+        assert_eq!(quantile_counting_failures(&errors, 0.0), Some(0.1));
+        // The finite-only quantile would have said 0.2 for the median.
+        assert_eq!(quantile(&errors, 0.5), Some(0.2));
+        assert_eq!(quantile_counting_failures(&[f64::NAN], 0.5), None);
+        assert_eq!(quantile_counting_failures(&[1.0, f64::INFINITY, f64::INFINITY], 0.9), Some(f64::INFINITY));
+    }
 
     #[test]
     fn quantiles_interpolate_like_numpy() {
