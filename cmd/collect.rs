@@ -64,9 +64,7 @@ episode from a uniformly scrambled board and a reset manipulator. --actions: one
 angles in rad (|wrist| <= 160 deg) and their velocities; default: a reset drawn from --seed).
 Ball shots: launcher settings drawn as in thesis 6.5.1, 180 Hz camera with ~1 mm noise and dropouts.")]
 pub struct CollectArgs {
-    /// Environment: pendulum[:light|heavy|mass=<m>|inverted|quadrant], toy:inner|outer, mountaincar, lightsout,
-    /// tileswap, <game>:cursor|reacher (e.g. lightsout:cursor, tileswap:reacher), ball.
-    #[arg(long)]
+    #[arg(long, help = concat!("Environment: ", mbrl::known_envs!()))]
     env: String,
     /// Number of rollouts, each in its own instance of a parametrized env.
     #[arg(long, default_value_t = 100)]

@@ -46,10 +46,8 @@ enum Protocol {
         out: PathBuf,
     },
     /// Summarise a dataset: rollouts, returns, state ranges, plots.
-    #[command(after_help = "Example:\n  mbrl eval dataset --input datasets/pendulum-random.mcap
-  mbrl eval boards
-  mbrl eval ball --model thesis --model initial
-  mbrl eval embodied --game lightsout --embodiment cursor --max-depth 5 --boards 200 --out reports/dataset")]
+    #[command(after_help = "Examples:\n  mbrl eval dataset --input datasets/pendulum-random.mcap\n  \
+                            mbrl eval dataset --input datasets/pendulum-heavy-random.mcap --out reports/heavy-data")]
     Dataset {
         /// Dataset file written by `mbrl collect` or `mbrl plan`.
         #[arg(long)]
@@ -182,8 +180,7 @@ struct SwingupArgs {
     /// Number of episodes (each with its own start state).
     #[arg(long, default_value_t = 10)]
     episodes: usize,
-    /// Environment variant: pendulum[:light|heavy|mass=<m>|inverted|quadrant].
-    #[arg(long, default_value = "pendulum")]
+    #[arg(long, default_value = "pendulum", help = concat!("Environment variant: ", mbrl::pendulum_envs!()))]
     env: String,
     /// Steps per episode.
     #[arg(long, default_value_t = 150)]

@@ -32,8 +32,7 @@ std is ≤ 0.01; `--iters 30 --no-warm-start` is the authors' planner.
 The pendulum starts hanging (θ ~ U[π-0.05, π+0.05], θ̇ ~ U[-0.05, 0.05]); success means each of the
 last 25 rewards is above -1 (thesis 3.5.2).")]
 pub struct PlanArgs {
-    /// Environment: pendulum[:light|heavy|mass=<m>|inverted|quadrant].
-    #[arg(long)]
+    #[arg(long, help = concat!("Environment: ", mbrl::pendulum_envs!()))]
     env: String,
     #[command(flatten)]
     model: ModelArgs,

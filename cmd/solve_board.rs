@@ -184,7 +184,8 @@ fn solve_learned<G: DenseIndex>(
     })?;
     say!("board {} ({}):\n{}", game.canonical_string(board), loaded.env.name(), game.render(board));
     for (i, plan) in outcome.plans.iter().enumerate() {
-        say!("plan {} ({} skills): {:?}", i + 1, plan.len(), plan);
+        let skills: Vec<String> = plan.iter().map(|k| k.to_string()).collect();
+        say!("plan {} ({} skills): {}", i + 1, plan.len(), skills.join(", "));
     }
     let moves: Vec<String> = outcome
         .executed
@@ -246,8 +247,11 @@ fn solve<G: DenseIndex>(global: &GlobalArgs, args: &SolveBoardArgs, game: G) -> 
     say!("plan ({} moves): {}", plan.len(), plan.iter().map(|&m| game.move_name(m)).collect::<Vec<_>>().join(", "));
     let s = result.stats;
     say!(
-        "search: {:?}, {} states expanded, {} generated, {} stored, {:.1} MiB",
-        args.search,
+        "search: {}, {} states expanded, {} generated, {} stored, {:.1} MiB",
+        match args.search {
+            SearchChoice::Bidirectional => "bidirectional BFS",
+            SearchChoice::Bfs => "one-sided BFS",
+        },
         s.expanded,
         s.generated,
         s.stored,
@@ -271,7 +275,10 @@ fn solve<G: DenseIndex>(global: &GlobalArgs, args: &SolveBoardArgs, game: G) -> 
                 if run.solved { "yes" } else { "no" }
             );
             if !run.solved {
-                bail!("the {:?} controller did not reach the goal board", args.embodiment.unwrap());
+                bail!(
+                    "the {} controller did not reach the goal board",
+                    embodiment.map_or("scripted", Embodiment::name)
+                );
             }
         }
     }

@@ -507,13 +507,13 @@ fn print_seads_report(report: &seads::TrainReport, out: &Path) -> anyhow::Result
     let run = &report.run;
     let c = &run.config;
     say!(
-        "trained SEADS on {}: {} skills, {} epochs, {} env steps (budget {}), SAC {:?}, forward model {} units",
+        "trained SEADS on {}: {} skills, {} epochs, {} env steps (budget {}), SAC hidden layers {}, forward model {} units",
         run.env,
         c.skills,
         report.outcome.steps,
         report.env_steps,
         c.env_steps,
-        c.sac_hidden,
+        c.sac_hidden.iter().map(usize::to_string).collect::<Vec<_>>().join(" × "),
         c.model_hidden
     );
     let last = &report.last;

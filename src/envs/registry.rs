@@ -11,9 +11,28 @@ use super::Env;
 use crate::error::{Error, Result};
 use crate::util::seeding::rng_for;
 
-pub const KNOWN_ENVS: &str =
-    "pendulum[:light|heavy|mass=<m>|inverted|quadrant], toy:inner|outer, mountaincar, lightsout[:<n>x<n>], tileswap, \
-     <game>:cursor|reacher (a board game played by a manipulator), ball";
+/// The pendulum family as a flag's help text names it; a macro so `concat!` can build help strings from it.
+#[macro_export]
+macro_rules! pendulum_envs {
+    () => {
+        "pendulum[:light|heavy|mass=<m>|inverted|quadrant]"
+    };
+}
+
+/// Every env name `parse_env` accepts, for error messages and every subcommand's help (one list, so they
+/// cannot drift apart).
+#[macro_export]
+macro_rules! known_envs {
+    () => {
+        concat!(
+            $crate::pendulum_envs!(),
+            ", toy:inner|outer, mountaincar, lightsout[:<n>x<n>], tileswap, <game>:cursor|reacher (a board game \
+             played by a manipulator, e.g. lightsout:cursor), ball"
+        )
+    };
+}
+
+pub const KNOWN_ENVS: &str = known_envs!();
 
 /// The random stream, under an instance seed, that draws an instance's hidden parameters. Fixed forever:
 /// changing it would change which instance every recorded `--instance-seed` names.

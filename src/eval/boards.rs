@@ -185,12 +185,12 @@ pub fn embodied_report<G: DenseIndex>(
     )?;
     let (total, solved) = rows.iter().fold((0, 0), |(t, s), r| (t + r.boards, s + r.solved));
     let mut md = format!(
-        "# {} played by the {:?} scripted controller\n\n\
+        "# {} played by the {} scripted controller\n\n\
          Boards of each depth drawn from the {} split; plans by bidirectional BFS with the true rules, executed\n\
          move by move (skill step limit per move). Overall: {solved}/{total} solved ({:.2} %).\n\n\
          | depth | boards | solved | success rate | mean control steps |\n|---|---|---|---|---|\n",
         game.name(),
-        settings.embodiment,
+        settings.embodiment.name(),
         settings.split.as_str(),
         100.0 * solved as f64 / total.max(1) as f64
     );

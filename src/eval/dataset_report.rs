@@ -4,7 +4,7 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use super::plot::{histogram, line_plot, Series};
+use super::plot::{histogram, line_panels, Series};
 use super::stats::{mean, quantile};
 use crate::data::{read_dataset, Rollout};
 use crate::error::{Error, Result};
@@ -13,7 +13,10 @@ use crate::util::atomic::write_text;
 use crate::util::table::write_csv;
 
 /// Rollouts drawn in the state plot; more would be unreadable.
-const PLOTTED_ROLLOUTS: usize = 20;
+/// Rollouts drawn in states.png: one palette colour each, none reused.
+const PLOTTED_ROLLOUTS: usize = 10;
+/// State dimensions drawn (an embodied board game has dozens of board bits; the first are the manipulator's).
+const PLOTTED_DIMENSIONS: usize = 6;
 
 #[derive(Clone, Debug, Serialize)]
 pub struct DimensionStats {
@@ -68,17 +71,7 @@ pub fn report(input: &Path, provenance: &Provenance, out_dir: &Path) -> Result<D
         .collect();
     write_csv(&run.file("rollouts.csv"), &["rollout", "steps", "return"], &rows)?;
     histogram(&run.file("returns.png"), "Rollout returns", "return", &returns, 20)?;
-    if let Some(first) = data.meta.state_names.first() {
-        let series: Vec<Series> = grouped
-            .iter()
-            .take(PLOTTED_ROLLOUTS)
-            .map(|(id, r)| Series {
-                name: format!("rollout {id}"),
-                points: r.states.iter().enumerate().map(|(t, s)| (t as f64 * data.meta.dt, s[0])).collect(),
-            })
-            .collect();
-        line_plot(&run.file("states.png"), &format!("{first} over time"), "time [s]", first, &series)?;
-    }
+    state_panels(&run.file("states.png"), &data.meta, &grouped)?;
     let summary = DatasetSummary {
         env: data.meta.env.clone(),
         rollouts: grouped.len(),
@@ -90,6 +83,50 @@ pub fn report(input: &Path, provenance: &Provenance, out_dir: &Path) -> Result<D
     let path = run.file("report.md");
     write_text(&path, &md)?;
     Ok(summary)
+}
+
+/// One panel per state dimension over time, angles wrapped to [−π, π) with the line broken at each wrap.
+fn state_panels(path: &Path, meta: &crate::data::DatasetMeta, grouped: &[(u32, Rollout)]) -> Result<()> {
+    let angular =
+        crate::envs::parse_env(&meta.env).and_then(|env| env.build()).map(|env| env.spec().angular).unwrap_or_default();
+    let dims = meta.state_names.len().min(PLOTTED_DIMENSIONS);
+    let panels: Vec<(String, Vec<Series>)> = (0..dims)
+        .map(|d| {
+            let is_angle = angular.get(d).copied().unwrap_or(false);
+            let series = grouped
+                .iter()
+                .take(PLOTTED_ROLLOUTS)
+                .map(|(id, r)| Series { name: format!("rollout {id}"), points: state_trace(r, d, meta.dt, is_angle) })
+                .collect();
+            let label =
+                if is_angle { format!("{} [rad, wrapped]", meta.state_names[d]) } else { meta.state_names[d].clone() };
+            (label, series)
+        })
+        .collect();
+    let shown = grouped.len().min(PLOTTED_ROLLOUTS);
+    let mut title = format!("States over time ({shown} of {} rollouts", grouped.len());
+    if dims < meta.state_names.len() {
+        title += &format!(", first {dims} of {} dimensions", meta.state_names.len());
+    }
+    title.push(')');
+    line_panels(path, &title, "time [s]", &panels)
+}
+
+/// (t, x_d) of a rollout; an angle is wrapped and a NaN breaks the line where it jumps across ±π.
+fn state_trace(rollout: &Rollout, d: usize, dt: f64, is_angle: bool) -> Vec<(f64, f64)> {
+    let wrap = |x: f64| (x + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+    let mut points = Vec::with_capacity(rollout.states.len());
+    let mut previous: Option<f64> = None;
+    for (t, state) in rollout.states.iter().enumerate() {
+        let Some(&raw) = state.get(d) else { continue };
+        let value = if is_angle { wrap(raw) } else { raw };
+        if is_angle && previous.is_some_and(|p| (value - p).abs() > std::f64::consts::PI) {
+            points.push((t as f64 * dt, f64::NAN));
+        }
+        points.push((t as f64 * dt, value));
+        previous = Some(value);
+    }
+    points
 }
 
 fn markdown(input: &Path, meta: &crate::data::DatasetMeta, s: &DatasetSummary, returns: &[f64]) -> String {

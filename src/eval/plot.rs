@@ -144,7 +144,9 @@ pub fn line_plot_in(
                 } else {
                     chart.draw_series(LineSeries::new(segment.iter().copied(), color)).map_err(|e| plot_err(path, e))?
                 };
-                if j == 0 {
+                if j == 0 && s.points.len() == 1 {
+                    drawn.label(s.name.clone()).legend(move |(x, y)| Circle::new((x + 8, y), 4, color.filled()));
+                } else if j == 0 {
                     drawn
                         .label(s.name.clone())
                         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], color));
@@ -158,6 +160,61 @@ pub fn line_plot_in(
                 .border_style(BLACK)
                 .draw()
                 .map_err(|e| plot_err(path, e))?;
+        }
+        root.present().map_err(|e| plot_err(path, e))?;
+        Ok(())
+    })
+}
+
+/// Line charts stacked on one x axis, each with its own y range and label (one per state dimension): the
+/// series keep their colour across panels, and the first panel carries the legend when it stays readable.
+pub fn line_panels(path: &Path, title: &str, x_label: &str, panels: &[(String, Vec<Series>)]) -> Result<()> {
+    let (x0, x1) = bounds(panels.iter().flat_map(|(_, s)| s.iter().flat_map(|s| s.points.iter().map(|p| p.0))));
+    let rows = panels.len().max(1);
+    let size = (900, 50 + 230 * rows as u32);
+    render_atomic(path, |tmp| {
+        let root = BitMapBackend::new(tmp, size).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| plot_err(path, e))?;
+        let root = root.titled(title, ("sans-serif", 22)).map_err(|e| plot_err(path, e))?;
+        for (k, (area, (y_label, series))) in root.split_evenly((rows, 1)).iter().zip(panels).enumerate() {
+            let (y0, y1) = bounds(series.iter().flat_map(|s| s.points.iter().map(|p| p.1)));
+            let mut chart = ChartBuilder::on(area)
+                .margin(8)
+                .x_label_area_size(if k + 1 == rows { 36 } else { 8 })
+                .y_label_area_size(64)
+                .build_cartesian_2d(x0..x1, y0..y1)
+                .map_err(|e| plot_err(path, e))?;
+            let mut mesh = chart.configure_mesh();
+            mesh.y_desc(y_label.as_str());
+            if k + 1 == rows {
+                mesh.x_desc(x_label);
+            } else {
+                mesh.x_labels(0);
+            }
+            mesh.draw().map_err(|e| plot_err(path, e))?;
+            for (i, s) in series.iter().enumerate() {
+                let color = series_color(i);
+                for (j, segment) in s.points.split(|p| !p.1.is_finite()).filter(|seg| !seg.is_empty()).enumerate() {
+                    let drawn = chart
+                        .draw_series(LineSeries::new(segment.iter().copied(), color.stroke_width(2)))
+                        .map_err(|e| plot_err(path, e))?;
+                    if j == 0 && k == 0 {
+                        drawn
+                            .label(s.name.clone())
+                            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2)));
+                    }
+                }
+            }
+            if k == 0 && series.len() <= 10 {
+                chart
+                    .configure_series_labels()
+                    .position(SeriesLabelPosition::UpperRight)
+                    .background_style(WHITE.mix(0.8))
+                    .border_style(BLACK)
+                    .label_font(("sans-serif", 12))
+                    .draw()
+                    .map_err(|e| plot_err(path, e))?;
+            }
         }
         root.present().map_err(|e| plot_err(path, e))?;
         Ok(())

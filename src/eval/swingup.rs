@@ -306,7 +306,7 @@ fn report_markdown(
     let mut md = format!(
         "# Pendulum swing-up: {model} + CEM\n\n\
          Environment `{}`, start θ ∼ U[π−0.05, π+0.05], θ̇ ∼ U[−0.05, 0.05], {} steps.\n\
-         CEM: horizon {}, {} candidates, {} elites, {} iterations, noise {:?}, warm start {}.\n\
+         CEM: horizon {}, {} candidates, {} elites, {} iterations, {} noise, warm start {}.\n\
          Seed {}, command `{}`.\n\n\
          Success = each of the last {SUCCESS_WINDOW} rewards > {SUCCESS_MIN_REWARD} (thesis 3.5.2).\n\n\
          | episodes | successes | mean return | median return | 10 % | 90 % |\n|---|---|---|---|---|---|\n\
@@ -317,7 +317,7 @@ fn report_markdown(
         c.candidates,
         c.elites,
         c.iterations,
-        c.noise,
+        c.noise.describe(),
         c.warm_start,
         provenance.seed,
         provenance.command_line,

@@ -26,6 +26,16 @@ pub enum NoiseKind {
     },
 }
 
+impl NoiseKind {
+    /// As reports name it: `white`, `colored (β = 2)`.
+    pub fn describe(&self) -> String {
+        match self {
+            NoiseKind::White => "white".to_string(),
+            NoiseKind::Colored { beta } => format!("colored (β = {beta})"),
+        }
+    }
+}
+
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CemConfig {
     pub horizon: usize,
