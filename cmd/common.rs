@@ -51,12 +51,25 @@ impl GlobalArgs {
     }
 }
 
+/// The live view draws on stdout and reads keys from stdin or, when that is redirected, the controlling
+/// terminal.
+fn has_terminal() -> bool {
+    std::io::stdout().is_terminal()
+        && (std::io::stdin().is_terminal() || std::fs::OpenOptions::new().read(true).open("/dev/tty").is_ok())
+}
+
 /// More worker threads than this only cost memory (a stack each) on any machine mbrl runs on.
 const MAX_THREADS: usize = 1024;
 
 pub fn init_threads(global: &GlobalArgs) -> anyhow::Result<()> {
     if global.threads > MAX_THREADS {
         anyhow::bail!("--threads {}: at most {MAX_THREADS} worker threads (0 = one per core)", global.threads);
+    }
+    if global.tui && !global.quiet && !global.no_tui && !has_terminal() {
+        anyhow::bail!(
+            "--tui needs a terminal, and stdout is a pipe or file (or there is no controlling terminal); drop --tui, \
+             or give --no-tui for progress lines on stderr"
+        );
     }
     mbrl::util::budget::set_limit_gib(global.max_memory_gib);
     rayon::ThreadPoolBuilder::new()

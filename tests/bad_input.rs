@@ -211,3 +211,15 @@ fn gym_ids_map_to_the_same_dynamics_or_name_the_mbrl_env() {
     let data = mbrl::data::dataset::read_dataset(&d.join("p.mcap")).unwrap();
     assert_eq!(data.meta.env, "pendulum");
 }
+
+#[test]
+fn tui_without_a_terminal_is_one_line_and_no_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = mbrl(dir.path())
+        .args(["plan", "--env", "pendulum", "--model", "true", "--tui", "--out", "p.mcap"])
+        .output()
+        .unwrap();
+    assert_one_line_error(&out, &["--tui", "terminal", "--no-tui"]);
+    assert!(!stderr_of(&out).contains('\u{1b}') && out.stdout.is_empty(), "terminal codes written: {out:?}");
+    assert!(files_in(dir.path()).is_empty());
+}
