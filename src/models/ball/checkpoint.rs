@@ -25,9 +25,10 @@ pub struct LoadedBallModel {
 
 impl LoadedBallModel {
     /// The spin prior for a recording: from its launcher settings when both the network and the settings
-    /// are there, the broad prior otherwise.
+    /// are there (the frame's yaw read off the first two measurements, thesis 6.4.3), the broad prior
+    /// otherwise.
     pub fn prior(&self, recording: &Recording) -> SpinPrior {
-        match (&self.spin_net, recording.info.side_info) {
+        match (&self.spin_net, super::learn::observed_side_info(recording)) {
             (Some(net), Some(side_info)) => net.prior(&side_info),
             _ => SpinPrior::Uninformed,
         }

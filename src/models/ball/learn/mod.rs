@@ -40,7 +40,7 @@ pub use filter::{chunk_loss, log_likelihoods};
 pub use params::BallParamsModule;
 pub use positive::{inverse_softplus, softplus};
 pub use reference::{chunk_nll, reference_loss};
-pub use rotation::launch_rotation;
+pub use rotation::{launch_rotation, observed_side_info};
 pub use spin_net::{SpinNet, SpinNetWeights};
 pub use train::{train, TrainOutcome, TrainSettings};
 pub use trainer::BallEkfTrainer;
