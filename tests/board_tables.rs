@@ -5,14 +5,7 @@ use mbrl::envs::boards::{split_of, LightsOut, Split, TileSwap};
 
 // BoardGame brings canonical_string into scope.
 
-const LIGHTSOUT_TABLE_7_1: [u64; 16] =
-    [1, 25, 300, 2300, 12650, 53130, 176176, 467104, 982335, 1596279, 1935294, 1684446, 1004934, 383670, 82614, 7350];
-const TILESWAP_TABLE_7_1: [u64; 17] =
-    [1, 12, 88, 470, 1978, 6658, 18081, 38936, 65246, 83000, 76688, 48316, 18975, 4024, 382, 24, 1];
-
-/// (train, test) for depths 1-5.
-const LIGHTSOUT_TABLE_7_2: [(u64, u64); 5] = [(7, 18), (99, 201), (785, 1515), (4200, 8450), (17849, 35281)];
-const TILESWAP_TABLE_7_2: [(u64, u64); 5] = [(7, 5), (31, 57), (179, 291), (683, 1295), (2237, 4421)];
+use mbrl::eval::boards::{LIGHTSOUT_TABLE_7_1, LIGHTSOUT_TABLE_7_2, TILESWAP_TABLE_7_1, TILESWAP_TABLE_7_2};
 
 fn split_counts<G: DenseIndex>(game: &G, table: &DepthTable, depth: u8) -> (u64, u64) {
     let mut counts = (0, 0);

@@ -6,6 +6,7 @@ use std::path::Path;
 use rand::seq::IndexedRandom;
 use serde::Serialize;
 
+use super::plot::{line_panels, Panel, Series};
 use crate::envs::boards::depth::{DenseIndex, DepthTable};
 use crate::envs::boards::sets::boards_at;
 use crate::envs::boards::{split_of, LightsOut, Split, TileSwap};
@@ -19,11 +20,14 @@ use crate::util::atomic::write_text;
 use crate::util::seeding::rng_for;
 use crate::util::table::write_csv;
 
-/// Thesis Table 7.1, for the comparison column of the report (depths 0..).
-const THESIS_LIGHTSOUT: [u64; 16] =
+/// Thesis Table 7.1: boards per solution depth (depths 0..).
+pub const LIGHTSOUT_TABLE_7_1: [u64; 16] =
     [1, 25, 300, 2300, 12650, 53130, 176176, 467104, 982335, 1596279, 1935294, 1684446, 1004934, 383670, 82614, 7350];
-const THESIS_TILESWAP: [u64; 17] =
+pub const TILESWAP_TABLE_7_1: [u64; 17] =
     [1, 12, 88, 470, 1978, 6658, 18081, 38936, 65246, 83000, 76688, 48316, 18975, 4024, 382, 24, 1];
+/// Thesis Table 7.2: (train, test) boards at depths 1-5.
+pub const LIGHTSOUT_TABLE_7_2: [(u64, u64); 5] = [(7, 18), (99, 201), (785, 1515), (4200, 8450), (17849, 35281)];
+pub const TILESWAP_TABLE_7_2: [(u64, u64); 5] = [(7, 5), (31, 57), (179, 291), (683, 1295), (2237, 4421)];
 
 #[derive(Clone, Debug, Serialize, PartialEq)]
 pub struct DepthRow {
@@ -32,10 +36,18 @@ pub struct DepthRow {
     pub boards: u64,
     pub train: u64,
     pub test: u64,
+    /// Table 7.1's count at this depth.
     pub thesis: Option<u64>,
+    /// Table 7.2's (train, test) at this depth (depths 1-5).
+    pub thesis_split: Option<(u64, u64)>,
 }
 
-fn depth_rows<G: DenseIndex>(game: &G, thesis: &[u64], monitor: &dyn Monitor) -> Result<Vec<DepthRow>> {
+fn depth_rows<G: DenseIndex>(
+    game: &G,
+    thesis: &[u64],
+    thesis_split: &[(u64, u64)],
+    monitor: &dyn Monitor,
+) -> Result<Vec<DepthRow>> {
     monitor.message(&format!("building the depth table of {}", game.name()));
     let table = DepthTable::build(game)?;
     let counts = table.counts();
@@ -48,7 +60,15 @@ fn depth_rows<G: DenseIndex>(game: &G, thesis: &[u64], monitor: &dyn Monitor) ->
                 Split::Test => test += 1,
             }
         }
-        rows.push(DepthRow { game: game.name(), depth, boards, train, test, thesis: thesis.get(depth).copied() });
+        rows.push(DepthRow {
+            game: game.name(),
+            depth,
+            boards,
+            train,
+            test,
+            thesis: thesis.get(depth).copied(),
+            thesis_split: depth.checked_sub(1).and_then(|d| thesis_split.get(d)).copied(),
+        });
         monitor.progress(&format!("{} depths", game.name()), depth as u64 + 1, counts.len() as u64);
     }
     Ok(rows)
@@ -60,12 +80,14 @@ pub fn depth_report(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monit
     run.write_config(&serde_json::json!({"job": "eval boards", "provenance": provenance}))?;
     let metrics = run.metrics()?;
     let monitor = Tee { first: monitor, second: &metrics };
-    let mut rows = depth_rows(&LightsOut::new(5)?, &THESIS_LIGHTSOUT, &monitor)?;
-    rows.extend(depth_rows(&TileSwap::new(), &THESIS_TILESWAP, &monitor)?);
+    let mut rows = depth_rows(&LightsOut::new(5)?, &LIGHTSOUT_TABLE_7_1, &LIGHTSOUT_TABLE_7_2, &monitor)?;
+    rows.extend(depth_rows(&TileSwap::new(), &TILESWAP_TABLE_7_1, &TILESWAP_TABLE_7_2, &monitor)?);
     let csv_rows: Vec<Vec<String>> = rows
         .iter()
         .map(|r| {
             let thesis = r.thesis.map(|t| t.to_string()).unwrap_or_default();
+            let (thesis_train, thesis_test) =
+                r.thesis_split.map(|(a, b)| (a.to_string(), b.to_string())).unwrap_or_default();
             vec![
                 r.game.clone(),
                 r.depth.to_string(),
@@ -73,26 +95,48 @@ pub fn depth_report(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monit
                 r.train.to_string(),
                 r.test.to_string(),
                 thesis,
+                thesis_train,
+                thesis_test,
             ]
         })
         .collect();
     write_csv(
         &run.file("depth_table.csv"),
-        &["game", "depth", "boards", "train", "test", "thesis_table_7_1"],
+        &[
+            "game",
+            "depth",
+            "boards",
+            "train",
+            "test",
+            "thesis_table_7_1",
+            "thesis_table_7_2_train",
+            "thesis_table_7_2_test",
+        ],
         &csv_rows,
     )?;
     let mut md = String::from(
         "# Board games: solution depths and splits\n\n\
-         Boards per optimal solution depth by reverse breadth-first search from the solved board, and the\n\
-         train/test split by CRC32 of the canonical board string mod 3 (appendix D.1.4). `thesis` is Table 7.1.\n\n\
-         | game | depth | boards | train | test | thesis |\n|---|---|---|---|---|---|\n",
+         Boards per optimal solution depth (LightsOut: every press set enumerated; TileSwap: breadth-first search\n\
+         from the solved board), and the train/test split by CRC32 of the canonical board string mod 3 (appendix\n\
+         D.1.4). `7.1` is the thesis' Table 7.1 (boards per depth), `7.2 train`/`7.2 test` its Table 7.2 (depths 1-5).\n\n\
+         | game | depth | boards | train | test | 7.1 | 7.2 train | 7.2 test |\n|---|---|---|---|---|---|---|---|\n",
     );
+    let dash = || "–".to_string();
     for r in &rows {
-        let thesis = r.thesis.map(|t| t.to_string()).unwrap_or_else(|| "–".into());
-        md.push_str(&format!("| {} | {} | {} | {} | {} | {} |\n", r.game, r.depth, r.boards, r.train, r.test, thesis));
+        let thesis = r.thesis.map(|t| t.to_string()).unwrap_or_else(dash);
+        let (a, b) = r.thesis_split.map(|(a, b)| (a.to_string(), b.to_string())).unwrap_or_else(|| (dash(), dash()));
+        md.push_str(&format!(
+            "| {} | {} | {} | {} | {} | {thesis} | {a} | {b} |\n",
+            r.game, r.depth, r.boards, r.train, r.test
+        ));
     }
     let mismatches = rows.iter().filter(|r| r.thesis.is_some_and(|t| t != r.boards)).count();
-    md.push_str(&format!("\nRows differing from Table 7.1: {mismatches}.\n"));
+    let split_mismatches = rows.iter().filter(|r| r.thesis_split.is_some_and(|t| t != (r.train, r.test))).count();
+    md.push_str(&format!(
+        "\nRows differing from Table 7.1: {mismatches}. Rows differing from Table 7.2: {split_mismatches}.\n\n\
+         ![boards per depth](depths.png)\n"
+    ));
+    depth_plot(&run.file("depths.png"), &rows)?;
     let path = run.file("report.md");
     write_text(&path, &md)?;
     // Only the run's own file is told it finished: the caller's view may have more jobs to show.
@@ -204,9 +248,56 @@ pub fn embodied_report<G: DenseIndex>(
             r.mean_control_steps
         ));
     }
+    md.push_str("\n![success and control steps per depth](embodied.png)\n");
+    embodied_plot(&run.file("embodied.png"), &game.name(), settings.embodiment.name(), &rows)?;
     let path = run.file("report.md");
     write_text(&path, &md)?;
     // Only the run's own file is told it finished: the caller's view may have more jobs to show.
     metrics.emit(&Event::Finished { ok: true });
     Ok(rows)
+}
+
+/// Boards per depth on a log scale, all and per split, one panel per game.
+fn depth_plot(path: &Path, rows: &[DepthRow]) -> Result<()> {
+    let mut games: Vec<String> = rows.iter().map(|r| r.game.clone()).collect();
+    games.dedup();
+    let panels: Vec<Panel> = games
+        .iter()
+        .map(|game| {
+            let of = |name: &str, count: &dyn Fn(&DepthRow) -> u64| Series {
+                name: name.to_string(),
+                points: rows
+                    .iter()
+                    .filter(|r| &r.game == game)
+                    .map(|r| (r.depth as f64, if count(r) > 0 { (count(r) as f64).log10() } else { f64::NAN }))
+                    .collect(),
+            };
+            let series =
+                vec![of("all boards", &|r| r.boards), of("train split", &|r| r.train), of("test split", &|r| r.test)];
+            Panel { y_label: format!("{game}: log10 boards"), series, y_range: None }
+        })
+        .collect();
+    line_panels(path, "Boards per optimal solution depth (Tables 7.1, 7.2)", "depth [moves]", &panels)
+}
+
+/// Success rate and mean control steps against the plan depth.
+fn embodied_plot(path: &Path, game: &str, embodiment: &str, rows: &[EmbodiedRow]) -> Result<()> {
+    let points = |f: &dyn Fn(&EmbodiedRow) -> f64| rows.iter().map(|r| (r.depth as f64, f(r))).collect::<Vec<_>>();
+    let most_steps = rows.iter().map(|r| r.mean_control_steps).fold(0.0, f64::max);
+    let panels = vec![
+        Panel {
+            y_label: "success rate [%]".into(),
+            series: vec![Series {
+                name: "solved".into(),
+                points: points(&|r| 100.0 * r.solved as f64 / r.boards.max(1) as f64),
+            }],
+            y_range: Some((0.0, 105.0)),
+        },
+        Panel {
+            y_label: "mean control steps".into(),
+            series: vec![Series { name: "control steps".into(), points: points(&|r| r.mean_control_steps) }],
+            y_range: Some((0.0, 1.1 * most_steps.max(1.0))),
+        },
+    ];
+    line_panels(path, &format!("{game} played by the {embodiment}"), "depth [moves]", &panels)
 }

@@ -4,7 +4,7 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use super::plot::{histogram, line_panels, Series};
+use super::plot::{histogram, line_panels, Panel, Series};
 use super::stats::{mean, quantile};
 use crate::data::{read_dataset, Rollout};
 use crate::error::{Error, Result};
@@ -90,7 +90,7 @@ fn state_panels(path: &Path, meta: &crate::data::DatasetMeta, grouped: &[(u32, R
     let angular =
         crate::envs::parse_env(&meta.env).and_then(|env| env.build()).map(|env| env.spec().angular).unwrap_or_default();
     let dims = meta.state_names.len().min(PLOTTED_DIMENSIONS);
-    let panels: Vec<(String, Vec<Series>)> = (0..dims)
+    let panels: Vec<Panel> = (0..dims)
         .map(|d| {
             let is_angle = angular.get(d).copied().unwrap_or(false);
             let series = grouped
@@ -100,7 +100,7 @@ fn state_panels(path: &Path, meta: &crate::data::DatasetMeta, grouped: &[(u32, R
                 .collect();
             let label =
                 if is_angle { format!("{} [rad, wrapped]", meta.state_names[d]) } else { meta.state_names[d].clone() };
-            (label, series)
+            Panel { y_label: label, series, y_range: None }
         })
         .collect();
     let shown = grouped.len().min(PLOTTED_ROLLOUTS);

@@ -166,18 +166,27 @@ pub fn line_plot_in(
     })
 }
 
+/// One panel of `line_panels`: its y label, series and, for rates and counts, a fixed y range.
+pub struct Panel {
+    pub y_label: String,
+    pub series: Vec<Series>,
+    pub y_range: Option<(f64, f64)>,
+}
+
 /// Line charts stacked on one x axis, each with its own y range and label (one per state dimension): the
 /// series keep their colour across panels, and the first panel carries the legend when it stays readable.
-pub fn line_panels(path: &Path, title: &str, x_label: &str, panels: &[(String, Vec<Series>)]) -> Result<()> {
-    let (x0, x1) = bounds(panels.iter().flat_map(|(_, s)| s.iter().flat_map(|s| s.points.iter().map(|p| p.0))));
+pub fn line_panels(path: &Path, title: &str, x_label: &str, panels: &[Panel]) -> Result<()> {
+    let (x0, x1) = bounds(panels.iter().flat_map(|p| p.series.iter().flat_map(|s| s.points.iter().map(|p| p.0))));
     let rows = panels.len().max(1);
     let size = (900, 50 + 230 * rows as u32);
     render_atomic(path, |tmp| {
         let root = BitMapBackend::new(tmp, size).into_drawing_area();
         root.fill(&WHITE).map_err(|e| plot_err(path, e))?;
         let root = root.titled(title, ("sans-serif", 22)).map_err(|e| plot_err(path, e))?;
-        for (k, (area, (y_label, series))) in root.split_evenly((rows, 1)).iter().zip(panels).enumerate() {
-            let (y0, y1) = bounds(series.iter().flat_map(|s| s.points.iter().map(|p| p.1)));
+        for (k, (area, panel)) in root.split_evenly((rows, 1)).iter().zip(panels).enumerate() {
+            let (y_label, series) = (&panel.y_label, &panel.series);
+            let (y0, y1) =
+                panel.y_range.unwrap_or_else(|| bounds(series.iter().flat_map(|s| s.points.iter().map(|p| p.1))));
             let mut chart = ChartBuilder::on(area)
                 .margin(8)
                 .x_label_area_size(if k + 1 == rows { 36 } else { 8 })
@@ -205,7 +214,7 @@ pub fn line_panels(path: &Path, title: &str, x_label: &str, panels: &[(String, V
                     }
                 }
             }
-            if k == 0 && series.len() <= 10 {
+            if k == 0 && (2..=10).contains(&series.len()) {
                 chart
                     .configure_series_labels()
                     .position(SeriesLabelPosition::UpperRight)
