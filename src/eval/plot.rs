@@ -215,14 +215,7 @@ pub fn line_panels(path: &Path, title: &str, x_label: &str, panels: &[Panel]) ->
                 }
             }
             if k == 0 && (2..=10).contains(&series.len()) {
-                chart
-                    .configure_series_labels()
-                    .position(SeriesLabelPosition::UpperRight)
-                    .background_style(WHITE.mix(0.8))
-                    .border_style(BLACK)
-                    .label_font(("sans-serif", 12))
-                    .draw()
-                    .map_err(|e| plot_err(path, e))?;
+                draw_legend(&mut chart, path, SeriesLabelPosition::UpperRight, 12)?;
             }
         }
         root.present().map_err(|e| plot_err(path, e))?;
@@ -244,25 +237,9 @@ pub fn band_plot(path: &Path, title: &str, x_label: &str, y_label: &str, bands: 
         let root = BitMapBackend::new(tmp, SIZE).into_drawing_area();
         let mut chart = xy_chart(&root, path, title, (x_label, y_label), x0..x1, y0.min(0.0)..y1)?;
         for (i, band) in bands.iter().enumerate() {
-            let color = series_color(i);
-            let mut outline: Vec<(f64, f64)> = band.points.iter().map(|p| (p.0, p.3)).collect();
-            outline.extend(band.points.iter().rev().map(|p| (p.0, p.1)));
-            chart
-                .draw_series(std::iter::once(Polygon::new(outline, color.mix(0.15))))
-                .map_err(|e| plot_err(path, e))?;
-            chart
-                .draw_series(LineSeries::new(band.points.iter().map(|p| (p.0, p.2)), color.stroke_width(2)))
-                .map_err(|e| plot_err(path, e))?
-                .label(band.name.clone())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2)));
+            draw_band(&mut chart, path, band, series_color(i))?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .draw()
-            .map_err(|e| plot_err(path, e))?;
+        draw_legend(&mut chart, path, SeriesLabelPosition::UpperLeft, 15)?;
         root.present().map_err(|e| plot_err(path, e))?;
         Ok(())
     })
@@ -297,32 +274,45 @@ pub fn band_panels(
                 .map_err(|e| plot_err(path, e))?;
             chart.configure_mesh().x_desc(x_label).y_desc(y_label).draw().map_err(|e| plot_err(path, e))?;
             for (i, band) in bands.iter().enumerate() {
-                let color = series_color(i);
-                let mut outline: Vec<(f64, f64)> = band.points.iter().map(|p| (p.0, p.3)).collect();
-                outline.extend(band.points.iter().rev().map(|p| (p.0, p.1)));
-                chart
-                    .draw_series(std::iter::once(Polygon::new(outline, color.mix(0.15))))
-                    .map_err(|e| plot_err(path, e))?;
-                chart
-                    .draw_series(LineSeries::new(band.points.iter().map(|p| (p.0, p.2)), color.stroke_width(2)))
-                    .map_err(|e| plot_err(path, e))?
-                    .label(band.name.clone())
-                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2)));
+                draw_band(&mut chart, path, band, series_color(i))?;
             }
             if k == 0 {
-                chart
-                    .configure_series_labels()
-                    .position(SeriesLabelPosition::UpperLeft)
-                    .background_style(WHITE.mix(0.8))
-                    .border_style(BLACK)
-                    .label_font(("sans-serif", 13))
-                    .draw()
-                    .map_err(|e| plot_err(path, e))?;
+                draw_legend(&mut chart, path, SeriesLabelPosition::UpperLeft, 13)?;
             }
         }
         root.present().map_err(|e| plot_err(path, e))?;
         Ok(())
     })
+}
+
+/// A band's shaded 10-90 % area and its median line, labelled for the legend.
+fn draw_band(chart: &mut XyChart<'_, '_>, path: &Path, band: &Band, color: RGBAColor) -> Result<()> {
+    let mut outline: Vec<(f64, f64)> = band.points.iter().map(|p| (p.0, p.3)).collect();
+    outline.extend(band.points.iter().rev().map(|p| (p.0, p.1)));
+    chart.draw_series(std::iter::once(Polygon::new(outline, color.mix(0.15)))).map_err(|e| plot_err(path, e))?;
+    chart
+        .draw_series(LineSeries::new(band.points.iter().map(|p| (p.0, p.2)), color.stroke_width(2)))
+        .map_err(|e| plot_err(path, e))?
+        .label(band.name.clone())
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2)));
+    Ok(())
+}
+
+/// The boxed legend of the labelled series drawn so far.
+fn draw_legend<'a, 'b: 'a>(
+    chart: &mut XyChart<'a, 'b>,
+    path: &Path,
+    position: SeriesLabelPosition,
+    font_size: u32,
+) -> Result<()> {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .label_font(("sans-serif", font_size))
+        .draw()
+        .map_err(|e| plot_err(path, e))
 }
 
 /// The five figures a box of a box plot draws, matplotlib's convention (thesis Fig. 7.9): quartiles by
