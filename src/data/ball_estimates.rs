@@ -6,13 +6,16 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use super::mcap_io::{check_version, metadata_field, read_messages, write_messages, Layout};
+use super::mcap_io::{check_version, message_clock, metadata_field, read_messages, write_messages_with, Layout};
+use super::scene::{scene_channel, ScenePoint, ESTIMATED};
 use crate::error::{Error, Result};
 use crate::util::table::write_csv;
 
 pub const STATE_NAMES: [&str; 11] = ["px", "py", "pz", "vx", "vy", "vz", "wx", "wy", "wz", "a_d", "a_m"];
 pub const METADATA_NAME: &str = "mbrl.ball_estimates";
 pub const TOPIC: &str = "/ball/estimates";
+/// The filter means as `foxglove.SceneUpdate`, for Foxglove's 3D panel.
+pub const SCENE_TOPIC: &str = "/ball/estimates/scene";
 const FORMAT_VERSION: u32 = 1;
 const SCHEMA: &str = r#"{
   "$schema": "https://json-schema.org/draft/2020-12/schema",
@@ -81,7 +84,18 @@ pub fn write_estimates_mcap(path: &Path, model: &str, command_line: &str, estima
         ("command_line".to_string(), command_line.to_string()),
         ("mbrl_version".to_string(), crate::VERSION.to_string()),
     ]);
-    write_messages(path, &layout, metadata, estimates)
+    let points: Vec<ScenePoint> = estimates
+        .iter()
+        .enumerate()
+        .map(|(sequence, e)| ScenePoint {
+            clock_ns: message_clock(&layout, sequence),
+            trajectory: e.trajectory,
+            frame: e.frame,
+            position: Some([e.mean[0], e.mean[1], e.mean[2]]),
+        })
+        .collect();
+    let scene = scene_channel(SCENE_TOPIC, &points, ESTIMATED);
+    write_messages_with(path, &layout, metadata, estimates, Some(&scene))
 }
 
 /// An estimates file as `filter --out F.mcap` writes it.

@@ -5,12 +5,17 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use super::mcap_io::{check_version, metadata_field, metadata_seed, read_messages, write_messages, Layout};
+use super::mcap_io::{
+    check_version, message_clock, metadata_field, metadata_seed, read_messages, write_messages_with, Layout,
+};
+use super::scene::{scene_channel, ScenePoint, MEASURED};
 use crate::error::{Error, Result};
 
 pub const BALL_FORMAT_VERSION: u32 = 1;
 pub const METADATA_NAME: &str = "mbrl.balls";
 pub const TOPIC: &str = "/ball/frames";
+/// The measured positions as `foxglove.SceneUpdate`, for Foxglove's 3D panel.
+pub const SCENE_TOPIC: &str = "/ball/scene";
 /// Camera frame rate of the recordings (thesis 6.5.1), the same the simulator's camera uses.
 pub use crate::envs::ball::camera::FRAME_RATE;
 /// The longest stretch of lost frames inside one trajectory: 10 s at 180 Hz, several times a table-tennis
@@ -146,7 +151,18 @@ pub fn write_ball_dataset(path: &Path, data: &BallDataset) -> Result<()> {
             })
         })
         .collect();
-    write_messages(path, &LAYOUT, metadata, &frames)
+    let points: Vec<ScenePoint> = frames
+        .iter()
+        .enumerate()
+        .map(|(sequence, f)| ScenePoint {
+            clock_ns: message_clock(&LAYOUT, sequence),
+            trajectory: f.trajectory,
+            frame: f.frame,
+            position: f.position,
+        })
+        .collect();
+    let scene = scene_channel(SCENE_TOPIC, &points, MEASURED);
+    write_messages_with(path, &LAYOUT, metadata, &frames, Some(&scene))
 }
 
 pub fn read_ball_dataset(path: &Path) -> Result<BallDataset> {

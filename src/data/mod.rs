@@ -16,6 +16,7 @@ pub mod frames;
 pub mod frames_png;
 pub mod mcap_io;
 pub mod rollout;
+pub mod scene;
 pub mod schema;
 
 pub use dataset::{instance_pairs, read_dataset, write_dataset, Dataset, DatasetLayout, DatasetMeta, FORMAT_VERSION};
