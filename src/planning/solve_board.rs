@@ -73,7 +73,9 @@ pub fn plan_board<G: BoardGame>(
     let on_layer = |s: &SearchStats| {
         monitor.scalar("bfs/stored", s.depth as u64, s.stored as f64);
         monitor.scalar("bfs/expanded", s.depth as u64, s.expanded as f64);
-        monitor.progress("search depth", s.depth as u64, limits.max_depth as u64);
+        // The depth counter stalls on the deep layers where the work is; stored states against the
+        // --max-nodes budget move with the work and show how near the search is to giving up.
+        monitor.progress("search: states stored of --max-nodes", s.stored, limits.max_nodes as u64);
         monitor.emit(&Event::text("search", stats_text(s)));
     };
     let result = match search {

@@ -54,15 +54,17 @@ pub(crate) fn bounds(values: impl Iterator<Item = f64>, margin: f64) -> [f64; 2]
     if lo > hi {
         return [0.0, 1.0];
     }
+    // Counts, rates and other values that never go negative keep the axis at zero or above.
+    let floor = if lo >= 0.0 { 0.0 } else { f64::NEG_INFINITY };
     let span = hi - lo;
     if span == 0.0 {
         let pad = if lo == 0.0 { 1.0 } else { lo.abs() * Y_MARGIN };
-        return [lo - pad, hi + pad];
+        return [(lo - pad).max(floor), hi + pad];
     }
     if !span.is_finite() {
         return [lo, hi];
     }
-    [lo - span * margin, hi + span * margin]
+    [(lo - span * margin).max(floor), hi + span * margin]
 }
 
 fn step_labels([lo, hi]: [f64; 2]) -> Vec<String> {
@@ -123,7 +125,7 @@ mod tests {
 
     #[test]
     fn bounds_of_constant_series_are_widened() {
-        assert_eq!(bounds([0.0, 0.0].into_iter(), Y_MARGIN), [-1.0, 1.0]);
+        assert_eq!(bounds([0.0, 0.0].into_iter(), Y_MARGIN), [0.0, 1.0]);
         let [lo, hi] = bounds([4.0].into_iter(), 0.0);
         assert!(lo < 4.0 && hi > 4.0);
         let [lo, hi] = bounds([-2e-6, -2e-6].into_iter(), Y_MARGIN);
@@ -133,8 +135,18 @@ mod tests {
     #[test]
     fn bounds_add_margin_and_skip_non_finite() {
         let [lo, hi] = bounds([0.0, f64::NAN, 10.0, f64::NEG_INFINITY].into_iter(), 0.1);
-        assert_eq!([lo, hi], [-1.0, 11.0]);
+        assert_eq!([lo, hi], [0.0, 11.0]);
         assert_eq!(bounds([3.0, 7.0].into_iter(), 0.0), [3.0, 7.0]);
+        assert_eq!(bounds([-1.0, 9.0].into_iter(), 0.1), [-2.0, 10.0]);
+    }
+
+    /// A count (states stored by a search) never gets a negative axis from the margin.
+    #[test]
+    fn values_that_never_go_negative_keep_the_axis_at_zero() {
+        let [lo, hi] = bounds([1.0, 25.0, 30552.0].into_iter(), Y_MARGIN);
+        assert_eq!(lo, 0.0);
+        assert!(hi > 30552.0);
+        assert!(value_labels([lo, hi]).iter().all(|l| !l.starts_with('-')));
     }
 
     #[test]
