@@ -6,7 +6,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use super::mcap_io::{check_version, message_clock, metadata_field, read_messages, write_messages_with, Layout};
+use super::mcap_io::{check_version, metadata_field, read_messages, write_messages_with, Layout};
 use super::scene::{scene_channel, ScenePoint, ESTIMATED};
 use crate::error::{Error, Result};
 use crate::util::table::write_csv;
@@ -84,17 +84,12 @@ pub fn write_estimates_mcap(path: &Path, model: &str, command_line: &str, estima
         ("command_line".to_string(), command_line.to_string()),
         ("mbrl_version".to_string(), crate::VERSION.to_string()),
     ]);
-    let points: Vec<ScenePoint> = estimates
-        .iter()
-        .enumerate()
-        .map(|(sequence, e)| ScenePoint {
-            clock_ns: message_clock(&layout, sequence),
-            trajectory: e.trajectory,
-            frame: e.frame,
-            position: Some([e.mean[0], e.mean[1], e.mean[2]]),
-        })
-        .collect();
-    let scene = scene_channel(SCENE_TOPIC, &points, ESTIMATED);
+    let points = estimates.iter().map(|e| ScenePoint {
+        trajectory: e.trajectory,
+        frame: e.frame,
+        position: Some([e.mean[0], e.mean[1], e.mean[2]]),
+    });
+    let scene = scene_channel(SCENE_TOPIC, &layout, points, ESTIMATED);
     write_messages_with(path, &layout, metadata, estimates, Some(&scene))
 }
 

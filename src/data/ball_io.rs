@@ -5,9 +5,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use super::mcap_io::{
-    check_version, message_clock, metadata_field, metadata_seed, read_messages, write_messages_with, Layout,
-};
+use super::mcap_io::{check_version, metadata_field, metadata_seed, read_messages, write_messages_with, Layout};
 use super::scene::{scene_channel, ScenePoint, MEASURED};
 use crate::error::{Error, Result};
 
@@ -151,17 +149,8 @@ pub fn write_ball_dataset(path: &Path, data: &BallDataset) -> Result<()> {
             })
         })
         .collect();
-    let points: Vec<ScenePoint> = frames
-        .iter()
-        .enumerate()
-        .map(|(sequence, f)| ScenePoint {
-            clock_ns: message_clock(&LAYOUT, sequence),
-            trajectory: f.trajectory,
-            frame: f.frame,
-            position: f.position,
-        })
-        .collect();
-    let scene = scene_channel(SCENE_TOPIC, &points, MEASURED);
+    let points = frames.iter().map(|f| ScenePoint { trajectory: f.trajectory, frame: f.frame, position: f.position });
+    let scene = scene_channel(SCENE_TOPIC, &LAYOUT, points, MEASURED);
     write_messages_with(path, &LAYOUT, metadata, &frames, Some(&scene))
 }
 

@@ -98,6 +98,18 @@ enum Values {
     Text(Vec<String>),
 }
 
+impl Values {
+    fn len(&self) -> usize {
+        match self {
+            Values::F64(v) => v.len(),
+            Values::I64(v) => v.len(),
+            Values::U8(v) => v.len(),
+            Values::Bool(v) => v.len(),
+            Values::Text(v) => v.len(),
+        }
+    }
+}
+
 /// One named array. `csv_columns` names the CSV columns of a per-step array (its trailing dimensions
 /// flattened row-major); `None` keeps it out of the table (images, covariances, per-recording arrays).
 struct Array {
@@ -108,25 +120,25 @@ struct Array {
 }
 
 impl Array {
-    fn per_step(name: &'static str, rows: usize, values: Values, columns: Vec<String>) -> Self {
-        let width = columns.len();
-        Array {
-            name,
-            shape: if width == 1 && !is_matrix(name) { vec![rows] } else { vec![rows, width] },
-            values,
-            csv_columns: Some(columns),
-        }
+    /// One value per row; the CSV column has the array's name.
+    fn column(name: &'static str, values: Values) -> Self {
+        Self::column_named(name, name, values)
+    }
+
+    /// One value per row under another CSV header (the board's text is `board` in the table).
+    fn column_named(name: &'static str, header: &str, values: Values) -> Self {
+        Array { name, shape: vec![values.len()], values, csv_columns: Some(vec![header.to_string()]) }
+    }
+
+    /// `columns.len()` values per row, row-major, each a CSV column. Stays two-dimensional with one column, so
+    /// a shape does not depend on the data (an env with one action still gives `action` as (N, 1)).
+    fn matrix(name: &'static str, rows: usize, values: Values, columns: Vec<String>) -> Self {
+        Array { name, shape: vec![rows, columns.len()], values, csv_columns: Some(columns) }
     }
 
     fn npz_only(name: &'static str, shape: Vec<usize>, values: Values) -> Self {
         Array { name, shape, values, csv_columns: None }
     }
-}
-
-/// Arrays that stay two-dimensional even when they have one column, so their shape does not depend on the
-/// data (an env with one action still gives `action` as (N, 1)).
-fn is_matrix(name: &str) -> bool {
-    matches!(name, "state" | "next_state" | "action" | "obs" | "next_obs" | "board" | "symbolic")
 }
 
 /// A data file in array form: what both formats write.
@@ -168,13 +180,7 @@ pub fn load(path: &Path) -> Result<Exported> {
 
 /// Rows of uneven width (a reader that let them through) would make a ragged array: refused by name.
 fn check_shape(path: &Path, rows: usize, array: &Array) -> Result<()> {
-    let len = match &array.values {
-        Values::F64(v) => v.len(),
-        Values::I64(v) => v.len(),
-        Values::U8(v) => v.len(),
-        Values::Bool(v) => v.len(),
-        Values::Text(v) => v.len(),
-    };
+    let len = array.values.len();
     let expected: usize = array.shape.iter().product();
     let table_ok = array.csv_columns.as_ref().is_none_or(|c| c.len() * rows == len);
     if len != expected || !table_ok {
@@ -203,17 +209,12 @@ fn rollout_arrays(path: &Path) -> Result<Exported> {
         steps.iter().flat_map(|s| get(s).iter().copied()).collect()
     };
     let mut arrays = vec![
-        Array::per_step(
-            "rollout",
-            rows,
-            Values::I64(steps.iter().map(|s| s.rollout as i64).collect()),
-            vec!["rollout".into()],
-        ),
-        Array::per_step("t", rows, Values::I64(steps.iter().map(|s| s.t as i64).collect()), vec!["t".into()]),
-        Array::per_step("state", rows, Values::F64(flat(&|s| &s.state)), names.clone()),
-        Array::per_step("action", rows, Values::F64(flat(&|s| &s.action)), numbered("action", data.meta.action_dim)),
-        Array::per_step("reward", rows, Values::F64(steps.iter().map(|s| s.reward).collect()), vec!["reward".into()]),
-        Array::per_step("next_state", rows, Values::F64(flat(&|s| &s.next_state)), prefixed("next_", names)),
+        Array::column("rollout", Values::I64(steps.iter().map(|s| s.rollout as i64).collect())),
+        Array::column("t", Values::I64(steps.iter().map(|s| s.t as i64).collect())),
+        Array::matrix("state", rows, Values::F64(flat(&|s| &s.state)), names.clone()),
+        Array::matrix("action", rows, Values::F64(flat(&|s| &s.action)), numbered("action", data.meta.action_dim)),
+        Array::column("reward", Values::F64(steps.iter().map(|s| s.reward).collect())),
+        Array::matrix("next_state", rows, Values::F64(flat(&|s| &s.next_state)), prefixed("next_", names)),
     ];
     // Observations exist only for envs whose observation differs from the state; they are exported when
     // every step has them with one width.
@@ -227,8 +228,8 @@ fn rollout_arrays(path: &Path) -> Result<Exported> {
                 steps.iter().flat_map(|s| s.obs.as_deref().unwrap_or_default().iter().copied()).collect();
             let next: Vec<f64> =
                 steps.iter().flat_map(|s| s.next_obs.as_deref().unwrap_or_default().iter().copied()).collect();
-            arrays.push(Array::per_step("obs", rows, Values::F64(obs), numbered("obs", width)));
-            arrays.push(Array::per_step("next_obs", rows, Values::F64(next), numbered("next_obs", width)));
+            arrays.push(Array::matrix("obs", rows, Values::F64(obs), numbered("obs", width)));
+            arrays.push(Array::matrix("next_obs", rows, Values::F64(next), numbered("next_obs", width)));
         }
     }
     if let Some(info) = &data.meta.frames {
@@ -277,26 +278,11 @@ fn board_arrays(path: &Path) -> Result<Exported> {
     let width = width.unwrap_or(0);
     let symbolic_width = symbolic_width.unwrap_or(0);
     let arrays = vec![
-        Array::per_step(
-            "board_text",
-            rows,
-            Values::Text(set.boards.iter().map(|b| b.board.clone()).collect()),
-            vec!["board".into()],
-        ),
-        Array::per_step("board", rows, Values::I64(fields), numbered("field", width)),
-        Array::per_step(
-            "depth",
-            rows,
-            Values::I64(set.boards.iter().map(|b| b.depth as i64).collect()),
-            vec!["depth".into()],
-        ),
-        Array::per_step(
-            "test_split",
-            rows,
-            Values::Bool(set.boards.iter().map(|b| b.split == Split::Test).collect()),
-            vec!["test_split".into()],
-        ),
-        Array::per_step(
+        Array::column_named("board_text", "board", Values::Text(set.boards.iter().map(|b| b.board.clone()).collect())),
+        Array::matrix("board", rows, Values::I64(fields), numbered("field", width)),
+        Array::column("depth", Values::I64(set.boards.iter().map(|b| b.depth as i64).collect())),
+        Array::column("test_split", Values::Bool(set.boards.iter().map(|b| b.split == Split::Test).collect())),
+        Array::matrix(
             "symbolic",
             rows,
             Values::U8(set.boards.iter().flat_map(|b| b.symbolic.iter().copied()).collect()),
@@ -320,21 +306,16 @@ fn ball_arrays(path: &Path) -> Result<Exported> {
         recordings.iter().flat_map(|r| r.positions.iter().flat_map(|p| p.unwrap_or([f64::NAN; 3]))).collect();
     let measured: Vec<bool> = recordings.iter().flat_map(|r| r.positions.iter().map(Option::is_some)).collect();
     let mut arrays = vec![
-        Array::per_step("trajectory", rows, Values::I64(per_frame(&|r, _| r.id as i64)), vec!["trajectory".into()]),
-        Array::per_step("frame", rows, Values::I64(per_frame(&|r, i| r.frames[i] as i64)), vec!["frame".into()]),
-        Array::per_step("t", rows, Values::F64(recordings.iter().flat_map(|r| r.times()).collect()), vec!["t".into()]),
-        Array::per_step("position", rows, Values::F64(positions), ["x", "y", "z"].map(String::from).to_vec()),
-        Array::per_step("measured", rows, Values::Bool(measured), vec!["measured".into()]),
+        Array::column("trajectory", Values::I64(per_frame(&|r, _| r.id as i64))),
+        Array::column("frame", Values::I64(per_frame(&|r, i| r.frames[i] as i64))),
+        Array::column("t", Values::F64(recordings.iter().flat_map(|r| r.times()).collect())),
+        Array::matrix("position", rows, Values::F64(positions), ["x", "y", "z"].map(String::from).to_vec()),
+        Array::column("measured", Values::Bool(measured)),
     ];
     if recordings.iter().all(|r| r.truth.is_some()) && !recordings.is_empty() {
         let truth: Vec<f64> =
             recordings.iter().flat_map(|r| r.truth.iter().flatten().flat_map(|s| s.iter().copied())).collect();
-        arrays.push(Array::per_step(
-            "true_state",
-            rows,
-            Values::F64(truth),
-            TRUE_STATE_NAMES.map(String::from).to_vec(),
-        ));
+        arrays.push(Array::matrix("true_state", rows, Values::F64(truth), TRUE_STATE_NAMES.map(String::from).to_vec()));
     }
     let count = recordings.len();
     arrays.push(Array::npz_only(
@@ -362,27 +343,17 @@ fn estimate_arrays(path: &Path) -> Result<Exported> {
     let dim = ESTIMATE_NAMES.len();
     let names = |prefix: &str| ESTIMATE_NAMES.iter().map(|n| format!("{prefix}{n}")).collect::<Vec<_>>();
     let arrays = vec![
-        Array::per_step(
-            "trajectory",
-            rows,
-            Values::I64(estimates.iter().map(|e| e.trajectory as i64).collect()),
-            vec!["trajectory".into()],
-        ),
-        Array::per_step(
-            "frame",
-            rows,
-            Values::I64(estimates.iter().map(|e| e.frame as i64).collect()),
-            vec!["frame".into()],
-        ),
-        Array::per_step("t", rows, Values::F64(estimates.iter().map(|e| e.t).collect()), vec!["t".into()]),
-        Array::per_step(
+        Array::column("trajectory", Values::I64(estimates.iter().map(|e| e.trajectory as i64).collect())),
+        Array::column("frame", Values::I64(estimates.iter().map(|e| e.frame as i64).collect())),
+        Array::column("t", Values::F64(estimates.iter().map(|e| e.t).collect())),
+        Array::matrix(
             "measurement",
             rows,
             Values::F64(estimates.iter().flat_map(|e| e.measurement.unwrap_or([f64::NAN; 3])).collect()),
             ["mx", "my", "mz"].map(String::from).to_vec(),
         ),
-        Array::per_step("mean", rows, Values::F64(estimates.iter().flat_map(|e| e.mean).collect()), names("")),
-        Array::per_step(
+        Array::matrix("mean", rows, Values::F64(estimates.iter().flat_map(|e| e.mean).collect()), names("")),
+        Array::matrix(
             "std",
             rows,
             Values::F64(
@@ -395,12 +366,7 @@ fn estimate_arrays(path: &Path) -> Result<Exported> {
             vec![rows, dim, dim],
             Values::F64(estimates.iter().flat_map(|e| e.covariance.iter().copied()).collect()),
         ),
-        Array::per_step(
-            "after_impact",
-            rows,
-            Values::Bool(estimates.iter().map(|e| e.after_impact).collect()),
-            vec!["after_impact".into()],
-        ),
+        Array::column("after_impact", Values::Bool(estimates.iter().map(|e| e.after_impact).collect())),
     ];
     Ok(Exported { kind: DataKind::BallEstimates, rows, arrays })
 }

@@ -4,7 +4,7 @@
 
 use serde::Serialize;
 
-use super::mcap_io::ExtraChannel;
+use super::mcap_io::{message_clock, ExtraChannel, Layout};
 
 pub const SCENE_SCHEMA_NAME: &str = "foxglove.SceneUpdate";
 
@@ -137,34 +137,39 @@ struct SceneUpdate {
     entities: Vec<Entity>,
 }
 
-/// One point of a trajectory: the log-clock time of its message, the trajectory and frame, and the position
-/// (`None` for a lost frame, which draws nothing but still clears the scene when a trajectory starts).
+/// One point of a trajectory: the trajectory and frame, and the position (`None` for a lost frame, which
+/// draws nothing but still clears the scene when a trajectory starts).
 pub struct ScenePoint {
-    pub clock_ns: u64,
     pub trajectory: u32,
     pub frame: u64,
     pub position: Option<[f64; 3]>,
 }
 
-/// The `topic` channel of `points`, in their order (which must be the file's time order).
-pub fn scene_channel<'a>(topic: &'a str, points: &[ScenePoint], color: Color) -> ExtraChannel<'a> {
-    let mut messages = Vec::with_capacity(points.len());
+/// The `topic` channel of `points`, point k drawn at the time of the file's main message k (`layout`).
+pub fn scene_channel<'a>(
+    topic: &'a str,
+    layout: &Layout,
+    points: impl IntoIterator<Item = ScenePoint>,
+    color: Color,
+) -> ExtraChannel<'a> {
+    let mut messages = Vec::new();
     let mut previous: Option<u32> = None;
-    for point in points {
+    for (sequence, point) in points.into_iter().enumerate() {
+        let clock_ns = message_clock(layout, sequence);
         let starts = previous != Some(point.trajectory);
         previous = Some(point.trajectory);
         if point.position.is_none() && !starts {
             continue;
         }
         let deletions = if starts {
-            vec![Deletion { timestamp: Time::of(point.clock_ns), kind: 1, id: String::new() }]
+            vec![Deletion { timestamp: Time::of(clock_ns), kind: 1, id: String::new() }]
         } else {
             Vec::new()
         };
         let entities = point
             .position
             .map(|[x, y, z]| Entity {
-                timestamp: Time::of(point.clock_ns),
+                timestamp: Time::of(clock_ns),
                 frame_id: FRAME_ID,
                 id: format!("trajectory {} frame {}", point.trajectory, point.frame),
                 lifetime: Duration { sec: 0, nsec: 0 },
@@ -191,7 +196,7 @@ pub fn scene_channel<'a>(topic: &'a str, points: &[ScenePoint], color: Color) ->
         let update = SceneUpdate { deletions, entities };
         // Plain numbers, strings and fixed structs: serialization cannot fail.
         let bytes = serde_json::to_vec(&update).unwrap_or_default();
-        messages.push((point.clock_ns, bytes));
+        messages.push((clock_ns, bytes));
     }
     ExtraChannel { topic, schema_name: SCENE_SCHEMA_NAME, schema: SCENE_SCHEMA, messages }
 }
@@ -202,14 +207,16 @@ mod tests {
 
     #[test]
     fn a_new_trajectory_clears_the_scene_and_lost_frames_draw_nothing() {
-        let point = |clock_ns, trajectory, frame, position| ScenePoint { clock_ns, trajectory, frame, position };
+        let point = |trajectory, frame, position| ScenePoint { trajectory, frame, position };
         let points = [
-            point(1, 0, 0, Some([0.1, 0.2, 0.3])),
-            point(2, 0, 1, None),
-            point(3, 0, 2, Some([0.2, 0.2, 0.3])),
-            point(4, 1, 0, None),
+            point(0, 0, Some([0.1, 0.2, 0.3])),
+            point(0, 1, None),
+            point(0, 2, Some([0.2, 0.2, 0.3])),
+            point(1, 0, None),
         ];
-        let channel = scene_channel("/scene", &points, MEASURED);
+        // One nanosecond per message: point k is drawn at time k + 1.
+        let layout = Layout { metadata_name: "m", topic: "/t", schema_name: "s", schema: "{}", tick_ns: 1 };
+        let channel = scene_channel("/scene", &layout, points, MEASURED);
         let json: Vec<serde_json::Value> =
             channel.messages.iter().map(|(_, b)| serde_json::from_slice(b).unwrap()).collect();
         assert_eq!(channel.messages.iter().map(|m| m.0).collect::<Vec<_>>(), [1, 3, 4]);

@@ -15,9 +15,9 @@ use crate::envs::ball::Orientation;
 use crate::error::{Error, Result};
 use crate::models::ball::baseline::{BaselineSettings, RidgeBaseline};
 use crate::models::ball::checkpoint::LoadedBallModel;
-use crate::models::ball::learn::{observed_side_info, SpinNetWeights};
+use crate::models::ball::learn::observed_side_info;
 use crate::models::ball::track::{filter_recording, predict_ahead, prediction_error, protocol_cut, PredictedPoint};
-use crate::models::ball::{BallModel, BallModelParams, SpinPrior};
+use crate::models::ball::BallModelParams;
 use crate::run::dir::{Provenance, RunDir};
 use crate::run::{Event, Monitor, Tee};
 use crate::util::atomic::write_text;
@@ -52,27 +52,17 @@ impl Default for BallEvalSettings {
 /// Something that predicts a recording's future from a cut frame.
 pub enum Predictor {
     /// The EKF; with a spin network its spin prior comes from the launcher settings.
-    Ekf {
-        model: BallModel,
-        spin_net: Option<SpinNetWeights>,
-    },
+    Ekf(LoadedBallModel),
     Baseline(RidgeBaseline),
-}
-
-fn spin_prior(spin_net: &Option<SpinNetWeights>, rec: &Recording) -> SpinPrior {
-    match (spin_net, rec.info.side_info) {
-        (Some(net), Some(side)) => net.prior(&side),
-        _ => SpinPrior::Uninformed,
-    }
 }
 
 impl Predictor {
     fn predict(&self, rec: &Recording, cut: u64, steps: usize) -> Option<Vec<PredictedPoint>> {
         match self {
-            Predictor::Ekf { model, spin_net } => {
-                let track = filter_recording(model, rec, Some(cut), &spin_prior(spin_net, rec)).ok()?;
+            Predictor::Ekf(ekf) => {
+                let track = filter_recording(&ekf.model, rec, Some(cut), &ekf.prior(rec)).ok()?;
                 let belief = track.beliefs.last()?;
-                Some(predict_ahead(model, belief, *track.frames.last()?, steps))
+                Some(predict_ahead(&ekf.model, belief, *track.frames.last()?, steps))
             }
             Predictor::Baseline(b) => b.predict(rec, cut, steps),
         }
@@ -196,14 +186,8 @@ pub fn evaluate(
     for (name, loaded) in ekf_models {
         // A checkpoint trained with the launcher network is scored with it; its broad-prior ablation is a
         // model trained without the network (thesis Fig. 6.4b), not this one with its prior removed.
-        let method = match loaded.spin_net {
-            Some(net) => Method {
-                name: format!("{name} + launch info"),
-                predictor: Predictor::Ekf { model: loaded.model, spin_net: Some(net) },
-            },
-            None => Method { name, predictor: Predictor::Ekf { model: loaded.model, spin_net: None } },
-        };
-        methods.push(method);
+        let name = if loaded.spin_net.is_some() { format!("{name} + launch info") } else { name };
+        methods.push(Method { name, predictor: Predictor::Ekf(loaded) });
     }
     for (name, launcher) in [("ridge baseline", false), ("ridge baseline + launch info", true)] {
         monitor.message(&format!("fitting the {name} on {} training trajectories", train.len()));
@@ -333,7 +317,7 @@ fn trajectory_plot(path: &Path, methods: &[Method], tests: &[TestSet]) -> Result
 
 /// The (y, z) series of `trajectory_plot`; every series in the side view's coordinates.
 fn trajectory_series(methods: &[Method], tests: &[TestSet]) -> Vec<Series> {
-    let Some(Method { predictor: Predictor::Ekf { model, spin_net }, name }) = methods.first() else {
+    let Some(Method { predictor: Predictor::Ekf(ekf), name }) = methods.first() else {
         return Vec::new();
     };
     let side = |p: &[f64]| (p[1], p[2]);
@@ -344,13 +328,13 @@ fn trajectory_series(methods: &[Method], tests: &[TestSet]) -> Vec<Series> {
             name: format!("{group} #{} measured", rec.id),
             points: rec.positions.iter().flatten().map(|p| side(p)).collect(),
         });
-        if let Ok(track) = filter_recording(model, rec, Some(cut), &spin_prior(spin_net, rec)) {
+        if let Ok(track) = filter_recording(&ekf.model, rec, Some(cut), &ekf.prior(rec)) {
             series.push(Series {
                 name: format!("{group} #{} filtered", rec.id),
                 points: track.beliefs.iter().map(|b| side(b.mean.as_slice())).collect(),
             });
             if let Some(b) = track.beliefs.last() {
-                let pred = predict_ahead(model, b, *track.frames.last().unwrap_or(&cut), 180);
+                let pred = predict_ahead(&ekf.model, b, *track.frames.last().unwrap_or(&cut), 180);
                 series.push(Series {
                     name: format!("{group} #{} predicted ({name})", rec.id),
                     points: pred
@@ -410,7 +394,7 @@ fn report_markdown(settings: &BallEvalSettings, methods: &[Method], rows: &[Erro
     }
     md.push_str("\nAll horizons: `summary.csv`; per trajectory: `errors.csv`.\n\n![error vs horizon](error_vs_horizon.png)\n\n![trajectories](trajectories.png)\n");
     for m in methods {
-        if let Predictor::Ekf { model, .. } = &m.predictor {
+        if let Predictor::Ekf(LoadedBallModel { model, .. }) = &m.predictor {
             md.push_str(&format!("\n## Impact matrix C of `{}`\n\nRows/columns: v_x, v_y, v_z, ω_x, ω_y, ω_z.\n\n|  |  |  |  |  |  |\n|---|---|---|---|---|---|\n{}\n", m.name, format_c(&model.params().c)));
         }
     }
@@ -424,6 +408,7 @@ fn report_markdown(settings: &BallEvalSettings, methods: &[Method], rows: &[Erro
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::models::ball::BallModel;
     use crate::run::monitor::NullMonitor;
 
     /// The side view's predicted points stay where the shot was measured (the plot once drew (x, y) on
@@ -439,7 +424,8 @@ mod tests {
         };
         let (_, tests) = datasets(&settings, 3, &NullMonitor).unwrap();
         let model = BallModel::new(BallModelParams::thesis_learned()).unwrap();
-        let methods = [Method { name: "oracle".into(), predictor: Predictor::Ekf { model, spin_net: None } }];
+        let methods =
+            [Method { name: "oracle".into(), predictor: Predictor::Ekf(LoadedBallModel { model, spin_net: None }) }];
         let series = trajectory_series(&methods, &tests);
         assert!(series.iter().any(|s| s.name.contains("predicted")), "no prediction drawn");
         for group in series.chunks(3) {
@@ -498,8 +484,9 @@ mod tests {
                 rec.info.side_info = observed_side_info(rec);
             }
         }
-        let ekf =
-            |params: BallModelParams, spin_net| Predictor::Ekf { model: BallModel::new(params).unwrap(), spin_net };
+        let ekf = |params: BallModelParams, spin_net| {
+            Predictor::Ekf(LoadedBallModel { model: BallModel::new(params).unwrap(), spin_net })
+        };
         let ridge_training =
             collect_ball(&BallCollectSettings { trajectories: 20, ..shots(3, 6) }, &NullMonitor).unwrap();
         let ridge =

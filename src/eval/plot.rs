@@ -133,33 +133,16 @@ pub fn line_plot_in(
         let root = BitMapBackend::new(tmp, SIZE).into_drawing_area();
         let mut chart = xy_chart(&root, path, title, (x_label, y_label), x0..x1, y0..y1)?;
         for (i, s) in series.iter().enumerate() {
-            let color = series_color(i);
-            // A non-finite y breaks the line, so wrapped angles do not draw vertical jumps.
-            for (j, segment) in s.points.split(|p| !p.1.is_finite()).filter(|seg| !seg.is_empty()).enumerate() {
-                // A lone point has no line to show it: mark it.
-                let drawn = if segment.len() == 1 {
-                    chart
-                        .draw_series(segment.iter().map(|&p| Circle::new(p, 4, color.filled())))
-                        .map_err(|e| plot_err(path, e))?
-                } else {
-                    chart.draw_series(LineSeries::new(segment.iter().copied(), color)).map_err(|e| plot_err(path, e))?
-                };
-                if j == 0 && s.points.len() == 1 {
-                    drawn.label(s.name.clone()).legend(move |(x, y)| Circle::new((x + 8, y), 4, color.filled()));
-                } else if j == 0 {
-                    drawn
-                        .label(s.name.clone())
-                        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], color));
-                }
-            }
+            draw_line(
+                &mut chart,
+                path,
+                s,
+                series_color(i),
+                LineLook { width: 1, mark_lone_points: true, labelled: true },
+            )?;
         }
         if series.len() <= PALETTE.len() {
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.8))
-                .border_style(BLACK)
-                .draw()
-                .map_err(|e| plot_err(path, e))?;
+            draw_legend(&mut chart, path, SeriesLabelPosition::MiddleRight, None)?;
         }
         root.present().map_err(|e| plot_err(path, e))?;
         Ok(())
@@ -202,20 +185,11 @@ pub fn line_panels(path: &Path, title: &str, x_label: &str, panels: &[Panel]) ->
             }
             mesh.draw().map_err(|e| plot_err(path, e))?;
             for (i, s) in series.iter().enumerate() {
-                let color = series_color(i);
-                for (j, segment) in s.points.split(|p| !p.1.is_finite()).filter(|seg| !seg.is_empty()).enumerate() {
-                    let drawn = chart
-                        .draw_series(LineSeries::new(segment.iter().copied(), color.stroke_width(2)))
-                        .map_err(|e| plot_err(path, e))?;
-                    if j == 0 && k == 0 {
-                        drawn
-                            .label(s.name.clone())
-                            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2)));
-                    }
-                }
+                let look = LineLook { width: 2, mark_lone_points: false, labelled: k == 0 };
+                draw_line(&mut chart, path, s, series_color(i), look)?;
             }
             if k == 0 && (2..=10).contains(&series.len()) {
-                draw_legend(&mut chart, path, SeriesLabelPosition::UpperRight, 12)?;
+                draw_legend(&mut chart, path, SeriesLabelPosition::UpperRight, Some(12))?;
             }
         }
         root.present().map_err(|e| plot_err(path, e))?;
@@ -239,7 +213,7 @@ pub fn band_plot(path: &Path, title: &str, x_label: &str, y_label: &str, bands: 
         for (i, band) in bands.iter().enumerate() {
             draw_band(&mut chart, path, band, series_color(i))?;
         }
-        draw_legend(&mut chart, path, SeriesLabelPosition::UpperLeft, 15)?;
+        draw_legend(&mut chart, path, SeriesLabelPosition::UpperLeft, Some(15))?;
         root.present().map_err(|e| plot_err(path, e))?;
         Ok(())
     })
@@ -277,7 +251,7 @@ pub fn band_panels(
                 draw_band(&mut chart, path, band, series_color(i))?;
             }
             if k == 0 {
-                draw_legend(&mut chart, path, SeriesLabelPosition::UpperLeft, 13)?;
+                draw_legend(&mut chart, path, SeriesLabelPosition::UpperLeft, Some(13))?;
             }
         }
         root.present().map_err(|e| plot_err(path, e))?;
@@ -298,21 +272,51 @@ fn draw_band(chart: &mut XyChart<'_, '_>, path: &Path, band: &Band, color: RGBAC
     Ok(())
 }
 
-/// The boxed legend of the labelled series drawn so far.
+/// The boxed legend of the labelled series drawn so far (plotters' default font when `font_size` is None).
 fn draw_legend<'a, 'b: 'a>(
     chart: &mut XyChart<'a, 'b>,
     path: &Path,
     position: SeriesLabelPosition,
-    font_size: u32,
+    font_size: Option<u32>,
 ) -> Result<()> {
-    chart
-        .configure_series_labels()
-        .position(position)
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .label_font(("sans-serif", font_size))
-        .draw()
-        .map_err(|e| plot_err(path, e))
+    let mut legend = chart.configure_series_labels();
+    legend.position(position).background_style(WHITE.mix(0.8)).border_style(BLACK);
+    if let Some(size) = font_size {
+        legend.label_font(("sans-serif", size));
+    }
+    legend.draw().map_err(|e| plot_err(path, e))
+}
+
+/// How `draw_line` draws a series.
+#[derive(Clone, Copy)]
+struct LineLook {
+    width: u32,
+    /// A segment of one point has no line to show it: draw a dot instead.
+    mark_lone_points: bool,
+    /// Give the series a legend entry.
+    labelled: bool,
+}
+
+/// One series as lines, broken wherever y is not finite (wrapped angles draw no vertical jumps).
+fn draw_line(chart: &mut XyChart<'_, '_>, path: &Path, s: &Series, color: RGBAColor, look: LineLook) -> Result<()> {
+    let style = color.stroke_width(look.width);
+    for (j, segment) in s.points.split(|p| !p.1.is_finite()).filter(|seg| !seg.is_empty()).enumerate() {
+        let drawn = if look.mark_lone_points && segment.len() == 1 {
+            chart.draw_series(segment.iter().map(|&p| Circle::new(p, 4, color.filled())))
+        } else {
+            chart.draw_series(LineSeries::new(segment.iter().copied(), style))
+        }
+        .map_err(|e| plot_err(path, e))?;
+        if j > 0 || !look.labelled {
+            continue;
+        }
+        if s.points.len() == 1 && look.mark_lone_points {
+            drawn.label(s.name.clone()).legend(move |(x, y)| Circle::new((x + 8, y), 4, color.filled()));
+        } else {
+            drawn.label(s.name.clone()).legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], style));
+        }
+    }
+    Ok(())
 }
 
 /// The five figures a box of a box plot draws, matplotlib's convention (thesis Fig. 7.9): quartiles by

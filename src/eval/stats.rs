@@ -6,31 +6,32 @@ use crate::error::{Error, Result};
 
 /// Linear-interpolated quantile (numpy's default) of finite values; `None` when there are none.
 pub fn quantile(values: &[f64], q: f64) -> Option<f64> {
-    let mut v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
-    if v.is_empty() {
-        return None;
-    }
-    v.sort_by(f64::total_cmp);
-    let pos = q.clamp(0.0, 1.0) * (v.len() - 1) as f64;
-    let (lo, hi) = (pos.floor() as usize, pos.ceil() as usize);
-    Some(v[lo] + (v[hi] - v[lo]) * (pos - lo as f64))
+    interpolated_quantile(values.iter().copied().filter(|x| x.is_finite()).collect(), q)
 }
 
 /// Quantile of errors where a failure counts as +∞: failures take the top ranks, so a method that fails
 /// on a third of the trajectories has an infinite 90 % quantile rather than a flattering finite one.
 /// NaN values are not errors and are ignored; `None` when nothing is left.
 pub fn quantile_counting_failures(values: &[f64], q: f64) -> Option<f64> {
-    let mut v: Vec<f64> = values.iter().copied().filter(|x| !x.is_nan()).collect();
-    if v.is_empty() {
+    interpolated_quantile(values.iter().copied().filter(|x| !x.is_nan()).collect(), q)
+}
+
+/// numpy's linear interpolation between the ranks around `q` of `values` (no NaN).
+fn interpolated_quantile(mut values: Vec<f64>, q: f64) -> Option<f64> {
+    if values.is_empty() {
         return None;
     }
-    v.sort_by(f64::total_cmp);
-    let pos = q.clamp(0.0, 1.0) * (v.len() - 1) as f64;
+    values.sort_by(f64::total_cmp);
+    let pos = q.clamp(0.0, 1.0) * (values.len() - 1) as f64;
     let (lo, hi) = (pos.floor() as usize, pos.ceil() as usize);
     let frac = pos - lo as f64;
     // Interpolating towards an infinite neighbour is infinite only if the neighbour carries weight (and
     // ∞ − ∞ must not turn two failures into NaN).
-    Some(if frac == 0.0 || v[lo].is_infinite() { v[lo] } else { v[lo] + (v[hi] - v[lo]) * frac })
+    Some(if frac == 0.0 || values[lo].is_infinite() {
+        values[lo]
+    } else {
+        values[lo] + (values[hi] - values[lo]) * frac
+    })
 }
 
 pub fn mean(values: &[f64]) -> Option<f64> {
