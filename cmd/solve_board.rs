@@ -8,7 +8,8 @@ use mbrl::envs::boards::sets::sample_board;
 use mbrl::envs::boards::{GameSpec, LightsOut, Split, TileSwap};
 use mbrl::envs::embodiments::Embodiment;
 use mbrl::planning::bfs::SearchLimits;
-use mbrl::planning::solve_board::{execute_plan, layout, plan_board, SearchKind};
+use mbrl::planning::board_view::layout;
+use mbrl::planning::solve_board::{execute_plan, plan_board, SearchKind};
 use mbrl::util::seeding::rng_for;
 
 use mbrl::models::seads::planner::{load as load_seads, solve_with_skills, LoadedSeads};
@@ -170,7 +171,7 @@ fn solve_learned<G: DenseIndex>(
     let bidirectional = args.search == SearchChoice::Bidirectional;
     let title = format!("solve-board: {} with learned skills", loaded.env.name());
     let outcome = run_job(global, &title, |monitor| {
-        monitor.emit(&layout(&title));
+        monitor.emit(&layout(&title, game.side()));
         solve_with_skills(
             &game,
             loaded,
@@ -233,7 +234,7 @@ fn solve<G: DenseIndex>(global: &GlobalArgs, args: &SolveBoardArgs, game: G) -> 
     let embodiment = args.embodiment.map(Embodiment::from);
     let title = format!("solve-board: {}", game.name());
     let (result, execution) = run_job(global, &title, |monitor| {
-        monitor.emit(&layout(&title));
+        monitor.emit(&layout(&title, game.side()));
         let result = plan_board(&game, board, search, &limits, monitor)?;
         let plan = result.plan.clone().unwrap_or_default();
         let execution = match embodiment {

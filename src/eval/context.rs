@@ -80,6 +80,7 @@ fn layout(title: &str) -> Event {
             x_label: "transitions".into(),
             series: vec!["calibration/entropy".into()],
             restart_on_rewind: true,
+            path: None,
         }],
     }
 }

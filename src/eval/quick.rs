@@ -78,8 +78,11 @@ pub fn run_quick(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor)
     )];
     let rows = boards::depth_report(provenance, &out_dir.join("boards"), monitor)?;
     let differing = rows.iter().filter(|r| r.thesis.is_some_and(|t| t != r.boards)).count();
+    let split_rows = rows.iter().filter(|r| r.thesis_split.is_some()).count();
+    let split_differing = rows.iter().filter(|r| r.thesis_split.is_some_and(|t| t != (r.train, r.test))).count();
     lines.push(format!(
-        "board depth tables (LightsOut 5×5, TileSwap 3×3): {} depths, {differing} differ from thesis Table 7.1; see boards/report.md",
+        "board depth tables (LightsOut 5×5, TileSwap 3×3): {} depths, {differing} differ from thesis Table 7.1; \
+         train/test split of {split_rows} depths, {split_differing} differ from Table 7.2; see boards/report.md",
         rows.len()
     ));
     let embodied = EmbodiedSettings {

@@ -67,12 +67,14 @@ pub fn layout(title: &str, learned_model: bool) -> Event {
             x_label: "step".into(),
             series: vec!["pendulum/angle".into(), "pendulum/action".into()],
             restart_on_rewind: true,
+            path: None,
         },
         PanelSpec {
             title: "CEM (current MPC step)".into(),
             x_label: "iteration".into(),
             series: vec!["cem/best_cost".into(), "cem/elite_mean_cost".into()],
             restart_on_rewind: true,
+            path: None,
         },
     ];
     if learned_model {
@@ -81,6 +83,7 @@ pub fn layout(title: &str, learned_model: bool) -> Event {
             x_label: "step".into(),
             series: vec!["model/predicted_angle".into(), "model/executed_angle".into()],
             restart_on_rewind: true,
+            path: None,
         });
     }
     Event::Layout { title: title.to_string(), panels }

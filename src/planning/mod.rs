@@ -2,6 +2,7 @@
 //! behind it.
 
 pub mod bfs;
+pub mod board_view;
 pub mod cem;
 pub mod colored_noise;
 pub mod mpc;

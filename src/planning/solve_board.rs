@@ -5,12 +5,13 @@ use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 
 use super::bfs::{bidirectional, breadth_first, GameRules, SearchLimits, SearchResult, SearchStats};
+use super::board_view::{plan_text, search_text, show_boards, EffectorTrace};
 use crate::envs::boards::BoardGame;
 use crate::envs::embodiments::embodied::{EmbodiedBoard, MoveOutcome};
 use crate::envs::embodiments::Embodiment;
 use crate::envs::Env;
 use crate::error::{Error, Result};
-use crate::run::{Event, Monitor, PanelSpec};
+use crate::run::{Event, Monitor};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
@@ -19,37 +20,6 @@ pub enum SearchKind {
     Bfs,
     /// From both ends; needs self-inverse moves.
     Bidirectional,
-}
-
-pub fn layout(title: &str) -> Event {
-    Event::Layout {
-        title: title.to_string(),
-        panels: vec![
-            PanelSpec {
-                title: "search (states stored per depth)".into(),
-                x_label: "depth".into(),
-                series: vec!["bfs/stored".into(), "bfs/expanded".into()],
-                restart_on_rewind: true,
-            },
-            PanelSpec {
-                title: "effector (current move)".into(),
-                x_label: "step".into(),
-                series: vec!["effector/x".into(), "effector/y".into()],
-                restart_on_rewind: true,
-            },
-        ],
-    }
-}
-
-fn stats_text(stats: &SearchStats) -> String {
-    format!(
-        "depth {}\nexpanded {}\ngenerated {}\nstored {}\nmemory {:.1} MiB",
-        stats.depth,
-        stats.expanded,
-        stats.generated,
-        stats.stored,
-        stats.peak_memory_bytes as f64 / (1u64 << 20) as f64
-    )
 }
 
 /// Shortest plan from `board` to the goal with the game's true rules. Unsolvable boards and plans
@@ -68,26 +38,30 @@ pub fn plan_board<G: BoardGame>(
             game.name()
         )));
     }
-    monitor.emit(&Event::text("board", game.render(board)));
+    show_boards(monitor, game, board, None);
     let model = GameRules(game);
+    // The depth counter stalls on the deep layers where the work is; stored states against the
+    // --max-nodes budget move with the work and show how near the search is to giving up.
+    let phase = "search: states stored of --max-nodes";
     let on_layer = |s: &SearchStats| {
         monitor.scalar("bfs/stored", s.depth as u64, s.stored as f64);
         monitor.scalar("bfs/expanded", s.depth as u64, s.expanded as f64);
-        // The depth counter stalls on the deep layers where the work is; stored states against the
-        // --max-nodes budget move with the work and show how near the search is to giving up.
-        monitor.progress("search: states stored of --max-nodes", s.stored, limits.max_nodes as u64);
-        monitor.emit(&Event::text("search", stats_text(s)));
+        monitor.progress(phase, s.stored, limits.max_nodes as u64);
+        monitor.emit(&Event::text("search", search_text(s)));
     };
     let result = match search {
         SearchKind::Bfs => breadth_first(&model, board, |s| *s == game.goal(), limits, on_layer)?,
         SearchKind::Bidirectional => bidirectional(&model, board, game.goal(), limits, on_layer)?,
     };
-    monitor.emit(&Event::text("search", stats_text(&result.stats)));
+    // Done: the gauge fills instead of reporting an ETA for a budget the search no longer spends.
+    monitor.progress(phase, result.stats.stored, result.stats.stored);
+    monitor.emit(&Event::text("search", search_text(&result.stats)));
     let plan = result.plan.as_ref().ok_or_else(|| {
         Error::Budget(format!("no plan of at most {} moves exists; raise --max-depth", limits.max_depth))
     })?;
-    let names: Vec<String> = plan.iter().map(|&m| game.move_name(m)).collect();
-    monitor.emit(&Event::text("plan", format!("{} moves\n{}", plan.len(), names.join("\n"))));
+    monitor.emit(&Event::text("plan", plan_text(&move_names(game, plan), 0, false)));
+    let after = plan.iter().fold(board, |b, &m| game.apply(b, m));
+    show_boards(monitor, game, board, Some(("after plan", after)));
     Ok(result)
 }
 
@@ -113,23 +87,30 @@ pub fn execute_plan<G: BoardGame>(
     let mut env = EmbodiedBoard::new(game.clone(), manipulator, board);
     env.reset(rng);
     let mut moves = Vec::with_capacity(plan.len());
+    let names = move_names(game, plan);
+    let mut trace = EffectorTrace::default();
     for (i, &mv) in plan.iter().enumerate() {
         if monitor.is_cancelled() {
             return Err(Error::Cancelled);
         }
-        let outcome = env.execute_observed(controller.as_mut(), mv, |step, p| {
-            monitor.scalar("effector/x", step as u64, p[0]);
-            monitor.scalar("effector/y", step as u64, p[1]);
-        });
+        monitor.emit(&Event::text("plan", plan_text(&names, i, true)));
+        let outcome = env.execute_observed(controller.as_mut(), mv, |_, p| trace.record(monitor, p));
         monitor.progress("execute moves", i as u64 + 1, plan.len() as u64);
-        monitor.emit(&Event::text("board", game.render(env.board())));
+        let caption = format!("after {}/{}", i + 1, plan.len());
+        show_boards(monitor, game, board, Some((&caption, env.board())));
         let ok = outcome.performed == Some(mv);
         moves.push(outcome);
         if !ok {
             break;
         }
     }
+    let played = moves.iter().zip(plan).take_while(|(m, &mv)| m.performed == Some(mv)).count();
+    monitor.emit(&Event::text("plan", plan_text(&names, played, false)));
     let final_board = env.board();
     let control_steps = moves.iter().map(|m| m.steps).sum();
     Ok(Execution { solved: final_board == game.goal(), moves, final_board, control_steps })
+}
+
+fn move_names<G: BoardGame>(game: &G, plan: &[usize]) -> Vec<String> {
+    plan.iter().map(|&m| game.move_name(m)).collect()
 }

@@ -32,6 +32,21 @@ pub struct PanelSpec {
     /// planner call), so the panel shows the latest episode instead of overdrawing all of them.
     #[serde(default)]
     pub restart_on_rewind: bool,
+    /// Set for a panel that draws its first two series against each other on a fixed plane (an
+    /// effector's path over a board) instead of against their step.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub path: Option<PathView>,
+}
+
+/// The plane of a path panel.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PathView {
+    pub x: [f64; 2],
+    pub y: [f64; 2],
+    /// Cells per side of a grid drawn under the path; 0 draws none.
+    pub grid: u32,
+    /// Whether y grows downwards, as the rows of a board printed as text do.
+    pub y_down: bool,
 }
 
 impl Event {
@@ -74,6 +89,17 @@ mod tests {
                     x_label: "x".into(),
                     series: vec!["a".into()],
                     restart_on_rewind: true,
+                    path: None,
+                }],
+            },
+            Event::Layout {
+                title: "board".into(),
+                panels: vec![PanelSpec {
+                    title: "effector".into(),
+                    x_label: "x".into(),
+                    series: vec!["effector/x".into(), "effector/y".into()],
+                    restart_on_rewind: false,
+                    path: Some(PathView { x: [0.0, 1.0], y: [0.0, 1.0], grid: 5, y_down: true }),
                 }],
             },
             Event::scalar("loss", 3, 0.5),

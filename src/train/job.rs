@@ -14,7 +14,7 @@ use crate::run::{Event, JsonlMonitor, Monitor, Tee};
 pub const MAX_TRAIN_STEPS: u64 = 1_000_000_000;
 
 /// Runs `method` to the end in `dir`. A fresh run writes `config` (the full description a resumed run is rebuilt
-/// from) and starts the metrics log with `layout`; with `resume`, `dir` must hold an unfinished checkpoint of
+/// from) and starts the metrics log with `view`; with `resume`, `dir` must hold an unfinished checkpoint of
 /// the same config, and the run continues from it so that it ends with the bytes an uninterrupted run would.
 pub fn run_training(
     dir: &Path,
@@ -22,7 +22,7 @@ pub fn run_training(
     settings: &FitSettings,
     method: &mut dyn TrainingMethod,
     resume: bool,
-    layout: &Event,
+    view: &[Event],
     monitor: &dyn Monitor,
 ) -> Result<FitOutcome> {
     if settings.total_steps > MAX_TRAIN_STEPS {
@@ -32,7 +32,9 @@ pub fn run_training(
         )));
     }
     let config_bytes = config_bytes(config)?;
-    monitor.emit(layout);
+    for event in view {
+        monitor.emit(event);
+    }
     if resume {
         let opened = OpenedCheckpoint::open(dir)?;
         if opened.manifest.total_steps != settings.total_steps {
@@ -74,7 +76,9 @@ pub fn run_training(
     let entry = ckpt.write_file(CONFIG_FILE, &config_bytes)?;
     let metrics_path = ckpt.file(METRICS_FILE);
     let metrics = JsonlMonitor::create(&metrics_path).map_err(|e| Error::io(&metrics_path, e))?;
-    metrics.emit(layout);
+    for event in view {
+        metrics.emit(event);
+    }
     let tee = Tee { first: monitor, second: &metrics };
     let outcome = fit(method, settings, &ckpt, &entry, None, &metrics, &tee)?;
     metrics.emit(&Event::Finished { ok: true });
@@ -87,10 +91,24 @@ fn config_bytes(config: &serde_json::Value) -> Result<Vec<u8>> {
     Ok(bytes)
 }
 
-/// The live-view layout of a training run. The view always charts one picked metric (train/loss first);
-/// `panels` adds what belongs beside it, such as the validation loss on its own scale.
-pub fn training_layout(title: &str, panels: Vec<crate::run::PanelSpec>) -> Event {
-    Event::Layout { title: title.to_string(), panels }
+/// What the live view shows of a training run from its start: the title and chart panels, and a
+/// text panel of the settings that stay fixed through the run (learning rate, batch, data), one
+/// `name value` pair a line. Metrics that no panel draws (a loss's terms, a schedule) are offered in
+/// the Curves panel.
+pub fn training_view(title: &str, panels: Vec<crate::run::PanelSpec>, settings: &[(&str, String)]) -> Vec<Event> {
+    let width = settings.iter().map(|(name, _)| name.chars().count()).max().unwrap_or(0);
+    let lines: Vec<String> = settings.iter().map(|(name, value)| format!("{name:<width$}  {value}")).collect();
+    vec![Event::Layout { title: title.to_string(), panels }, Event::text("settings", lines.join("\n"))]
+}
+
+/// The training loss per step, with the validation loss beside it where both measure the same
+/// objective (the curves then share one scale and overfitting shows as their gap).
+pub fn loss_panel(title: &str, with_validation: bool) -> crate::run::PanelSpec {
+    let mut series = vec!["train/loss".to_string()];
+    if with_validation {
+        series.push("valid/loss".into());
+    }
+    crate::run::PanelSpec { title: title.into(), x_label: "step".into(), series, restart_on_rewind: false, path: None }
 }
 
 /// The validation panel of methods that hold data back.
@@ -100,5 +118,6 @@ pub fn validation_panel(title: &str) -> crate::run::PanelSpec {
         x_label: "step".into(),
         series: vec!["valid/loss".into()],
         restart_on_rewind: false,
+        path: None,
     }
 }

@@ -89,9 +89,26 @@ impl App {
         self.selected.as_deref()
     }
 
-    /// All metrics seen so far, sorted by name.
+    /// The metrics the Curves panel offers, sorted by name: those no chart panel draws already, so the
+    /// same curve is never shown twice.
     pub fn metric_names(&self) -> Vec<&str> {
-        self.history.keys().map(String::as_str).collect()
+        self.history.keys().map(String::as_str).filter(|name| self.is_selectable(name)).collect()
+    }
+
+    fn is_selectable(&self, name: &str) -> bool {
+        !self.panels.iter().any(|panel| panel.draws(name))
+    }
+
+    /// Whether the Curves panel has anything to offer. Without, the method panels take the whole body;
+    /// before any metric or panel arrives the Curves placeholder stays, so a fresh run is not blank.
+    pub(crate) fn has_curves(&self) -> bool {
+        !self.metric_names().is_empty() || (self.panels.is_empty() && self.texts.as_slice().is_empty())
+    }
+
+    /// A metric's whole (capped) history, whether or not the Curves panel offers it.
+    #[cfg(test)]
+    pub(crate) fn history(&self, name: &str) -> Option<&Series> {
+        self.history.get(name)
     }
 
     /// The sender hung up; a stream that ended without `Finished` must not look like it is still running.
@@ -114,15 +131,16 @@ impl App {
         self.progress.recent(count)
     }
 
-    /// The selected metric's name, its history, and its 1-based position among all metrics.
+    /// The selected metric's name, its history, and its 1-based position among the offered metrics.
     pub(crate) fn selected_series(&self) -> Option<(&str, &Series, usize)> {
-        let name = self.selected.as_deref()?;
-        let (index, (name, series)) = self.history.iter().enumerate().find(|(_, (n, _))| *n == name)?;
-        Some((name, series, index + 1))
+        let selected = self.selected.as_deref()?;
+        let position = self.metric_names().iter().position(|n| *n == selected)?;
+        let (name, series) = self.history.get_key_value(selected)?;
+        Some((name.as_str(), series, position + 1))
     }
 
     pub(crate) fn metric_count(&self) -> usize {
-        self.history.len()
+        self.metric_names().len()
     }
 
     pub(crate) fn panels(&self) -> &[Panel] {
@@ -144,6 +162,9 @@ impl App {
             self.title = title.to_string();
         }
         self.panels = panels.iter().cloned().map(Panel::new).collect();
+        if self.selected.as_deref().is_some_and(|name| !self.is_selectable(name)) {
+            self.selected = self.metric_names().first().map(|name| name.to_string());
+        }
     }
 
     fn record_scalar(&mut self, name: &str, step: u64, value: f64) {
@@ -151,7 +172,7 @@ impl App {
         for panel in &mut self.panels {
             panel.record(name, step, value);
         }
-        if self.selected.is_none() {
+        if self.selected.is_none() && self.is_selectable(name) {
             self.selected = Some(name.to_string());
         }
     }
@@ -209,6 +230,7 @@ mod tests {
                 x_label: "t".into(),
                 series: vec!["pendulum/angle".into(), "pendulum/action".into()],
                 restart_on_rewind: true,
+                path: None,
             }],
         }
     }
@@ -261,10 +283,27 @@ mod tests {
         }
         app.ingest(&Event::scalar("pendulum/angle", 0, 9.0));
 
-        let (_, history, _) = app.selected_series().expect("angle is selected");
-        assert_eq!(history.points().len(), 6);
+        assert_eq!(app.history("pendulum/angle").expect("kept").points().len(), 6);
         let (_, panel_copy) = app.panels()[0].series().next().expect("angle series");
         assert_eq!(panel_copy.points(), &[(0.0, 9.0)]);
+    }
+
+    #[test]
+    fn metrics_a_panel_draws_are_not_offered_again() {
+        let mut app = App::new("t");
+        app.ingest(&Event::scalar("pendulum/angle", 0, 1.0));
+        assert_eq!(app.selected_metric(), Some("pendulum/angle"));
+        app.ingest(&pendulum_layout());
+        assert_eq!(app.selected_metric(), None, "the panel draws it now");
+        assert!(!app.has_curves(), "nothing left to offer");
+        app.ingest(&Event::scalar("pendulum/action", 0, 1.0));
+        app.ingest(&Event::scalar("cem/best_cost", 0, 5.0));
+        assert_eq!(app.metric_names(), vec!["cem/best_cost"]);
+        assert_eq!(app.selected_metric(), Some("cem/best_cost"));
+        assert_eq!(app.metric_count(), 1);
+        app.handle_key(key(KeyCode::Right));
+        assert_eq!(app.selected_metric(), Some("cem/best_cost"));
+        assert!(app.has_curves());
     }
 
     #[test]

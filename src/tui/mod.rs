@@ -6,6 +6,7 @@ pub mod app;
 mod keys;
 mod method;
 mod panel;
+mod path;
 mod plot;
 pub mod render;
 mod series;

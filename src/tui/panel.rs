@@ -30,6 +30,10 @@ impl Panel {
         }
     }
 
+    pub(crate) fn draws(&self, name: &str) -> bool {
+        self.spec.series.iter().any(|s| s == name)
+    }
+
     pub(crate) fn spec(&self) -> &PanelSpec {
         &self.spec
     }
@@ -50,6 +54,7 @@ mod tests {
             x_label: "t".into(),
             series: vec!["pendulum/angle".into(), "pendulum/action".into()],
             restart_on_rewind,
+            path: None,
         }
     }
 

@@ -4,7 +4,7 @@
 use ratatui::layout::Constraint;
 use ratatui::style::{Color, Style};
 use ratatui::symbols::Marker;
-use ratatui::widgets::{Axis, Block, Chart, Dataset, GraphType};
+use ratatui::widgets::{Axis, Block, Chart, Dataset, GraphType, LegendPosition};
 
 /// Fraction of the value range added above and below, so extremes do not sit on the frame.
 const Y_MARGIN: f64 = 0.05;
@@ -27,7 +27,7 @@ pub(crate) fn line_chart<'a>(traces: Vec<Trace<'a>>, x_title: &'a str, block: Bl
     let x = bounds(traces.iter().flat_map(|t| t.points.iter().map(|p| p.0)), 0.0);
     let y = bounds(traces.iter().flat_map(|t| t.points.iter().map(|p| p.1)), Y_MARGIN);
     // A legend only tells lines apart; with one line the panel title already names it.
-    let legend = (traces.len() > 1).then_some(ratatui::widgets::LegendPosition::TopRight);
+    let legend = (traces.len() > 1).then(|| legend_corner(&traces));
     let axis_style = Style::default().fg(Color::DarkGray);
     Chart::new(traces.into_iter().map(dataset).collect())
         .block(block)
@@ -35,6 +35,20 @@ pub(crate) fn line_chart<'a>(traces: Vec<Trace<'a>>, x_title: &'a str, block: Bl
         .y_axis(Axis::default().style(axis_style).bounds(y).labels(value_labels(y)))
         .legend_position(legend)
         .hidden_legend_constraints((Constraint::Ratio(1, 2), Constraint::Ratio(1, 2)))
+}
+
+/// The top corner the lines leave free: top left when they end higher than they start (states stored
+/// per depth), top right otherwise (a falling loss), so the legend does not hide the newest points.
+fn legend_corner(traces: &[Trace<'_>]) -> LegendPosition {
+    let rises = |t: &Trace<'_>| match (t.points.first(), t.points.last()) {
+        (Some(first), Some(last)) => last.1 > first.1,
+        _ => false,
+    };
+    if traces.iter().filter(|t| rises(t)).count() * 2 > traces.len() {
+        LegendPosition::TopLeft
+    } else {
+        LegendPosition::TopRight
+    }
 }
 
 fn dataset(trace: Trace<'_>) -> Dataset<'_> {
@@ -153,6 +167,16 @@ mod tests {
     fn bounds_survive_overflowing_span() {
         let [lo, hi] = bounds([-f64::MAX, f64::MAX].into_iter(), Y_MARGIN);
         assert!(lo.is_finite() && hi.is_finite() && lo < hi);
+    }
+
+    #[test]
+    fn the_legend_sits_where_the_lines_are_not() {
+        let rising = [(0.0, 1.0), (1.0, 5.0)];
+        let falling = [(0.0, 5.0), (1.0, 1.0)];
+        let trace = |points| Trace { name: String::new(), points, color: Color::Cyan };
+        assert_eq!(legend_corner(&[trace(&rising), trace(&rising)]), LegendPosition::TopLeft);
+        assert_eq!(legend_corner(&[trace(&falling), trace(&rising)]), LegendPosition::TopRight);
+        assert_eq!(legend_corner(&[trace(&[]), trace(&falling)]), LegendPosition::TopRight);
     }
 
     #[test]

@@ -10,6 +10,7 @@ use ratatui::Frame;
 use super::app::{App, Status};
 use super::method::{method_rows, stack};
 use super::panel::Panel;
+use super::path::{grid_for, path_chart, path_points};
 use super::plot::{color, format_value, line_chart, short_names, Trace};
 use super::text_panel::TextPanel;
 use crate::run::monitor::PhaseProgress;
@@ -35,17 +36,42 @@ pub fn render(app: &App, frame: &mut Frame) {
     render_messages(app, frame, messages);
 }
 
+/// Title, status and key hints on one row. A narrow terminal drops the hints first, then cuts the
+/// title (marked with …); the status always shows.
 fn render_header(app: &App, frame: &mut Frame, area: Rect) {
     let (status, status_color) = status_label(app.status());
-    let hints = if app.is_finished() { "←/→ metric" } else { "q quit · ←/→ metric" };
-    let line = Line::from(vec![
-        Span::styled(app.title(), Style::default().add_modifier(Modifier::BOLD)),
-        Span::raw("  "),
-        Span::styled(status, Style::default().fg(status_color).add_modifier(Modifier::BOLD)),
-        Span::raw("  "),
-        Span::styled(hints, Style::default().fg(Color::DarkGray)),
-    ]);
-    frame.render_widget(Paragraph::new(line), area);
+    let hints = match (app.is_finished(), app.has_curves()) {
+        (true, true) => "←/→ metric",
+        (true, false) => "",
+        (false, true) => "q quit · ←/→ metric",
+        (false, false) => "q quit",
+    };
+    let width = usize::from(area.width);
+    let title_width = app.title().chars().count();
+    let status_width = status.chars().count();
+    let hints_shown = !hints.is_empty() && title_width + status_width + hints.chars().count() + 4 <= width;
+    let title = fit(app.title(), width.saturating_sub(status_width + 2));
+    let mut spans = Vec::new();
+    if !title.is_empty() {
+        spans.extend([Span::styled(title, Style::default().add_modifier(Modifier::BOLD)), Span::raw("  ")]);
+    }
+    spans.push(Span::styled(status, Style::default().fg(status_color).add_modifier(Modifier::BOLD)));
+    if hints_shown {
+        spans.extend([Span::raw("  "), Span::styled(hints, Style::default().fg(Color::DarkGray))]);
+    }
+    frame.render_widget(Paragraph::new(Line::from(spans)), area);
+}
+
+/// `text` cut to `width` characters, the cut marked with an ellipsis.
+fn fit(text: &str, width: usize) -> String {
+    if text.chars().count() <= width {
+        return text.to_string();
+    }
+    let mut cut: String = text.chars().take(width.saturating_sub(1)).collect();
+    if width > 0 {
+        cut.push('…');
+    }
+    cut
 }
 
 fn status_label(status: Status) -> (&'static str, Color) {
@@ -94,16 +120,45 @@ fn render_body(app: &App, frame: &mut Frame, area: Rect) {
         render_curves(app, frame, area);
         return;
     }
+    if !app.has_curves() {
+        render_method_columns(app, frame, area);
+        return;
+    }
     let [curves, method] = Layout::horizontal([Constraint::Percentage(50); 2]).areas(area);
     render_curves(app, frame, curves);
     render_method(app, frame, method);
 }
 
+/// The method panels alone, with the Curves panel's half to spare: charts in the left column, text
+/// panels in the right, each column to itself when the other kind is missing.
+fn render_method_columns(app: &App, frame: &mut Frame, area: Rect) {
+    if app.panels().is_empty() || app.text_panels().is_empty() {
+        render_method(app, frame, area);
+        return;
+    }
+    let [charts, texts] = Layout::horizontal([Constraint::Percentage(50); 2]).areas(area);
+    let chart_rows = stack(charts, &method_rows(app.panels().len(), &[], charts.height));
+    for (panel, row) in app.panels().iter().zip(chart_rows) {
+        render_panel(panel, frame, row);
+    }
+    render_text_panels(app, frame, texts);
+}
+
+/// The text panels, sized to their text, using the whole of `area`.
+fn render_text_panels(app: &App, frame: &mut Frame, area: Rect) {
+    let heights = method_rows(0, &text_heights(app), area.height);
+    for (panel, row) in app.text_panels().iter().zip(stack(area, &heights)) {
+        render_text_panel(panel, frame, row);
+    }
+}
+
+fn text_heights(app: &App) -> Vec<u16> {
+    app.text_panels().iter().map(|p| u16::try_from(p.line_count() + 2).unwrap_or(u16::MAX)).collect()
+}
+
 /// The chart panels, then the text panels sized to their text.
 fn render_method(app: &App, frame: &mut Frame, area: Rect) {
-    let text_rows: Vec<u16> =
-        app.text_panels().iter().map(|p| u16::try_from(p.line_count() + 2).unwrap_or(u16::MAX)).collect();
-    let heights = method_rows(app.panels().len(), &text_rows, area.height);
+    let heights = method_rows(app.panels().len(), &text_heights(app), area.height);
     let rows = stack(area, &heights);
     let (chart_rows, text_rows) = rows.split_at(app.panels().len());
     for (panel, row) in app.panels().iter().zip(chart_rows) {
@@ -127,6 +182,17 @@ fn render_curves(app: &App, frame: &mut Frame, area: Rect) {
 }
 
 fn render_panel(panel: &Panel, frame: &mut Frame, area: Rect) {
+    let spec = panel.spec();
+    let block = Block::bordered().title(format!(" {} ", spec.title));
+    if let Some(view) = &spec.path {
+        let mut series = panel.series().map(|(_, s)| s);
+        if let (Some(xs), Some(ys)) = (series.next(), series.next()) {
+            let points = path_points(xs, ys, view);
+            let grid = grid_for(view, xs, ys);
+            frame.render_widget(path_chart(&points, &grid, view, xs, ys, block), area);
+            return;
+        }
+    }
     let names: Vec<&str> = panel.series().map(|(name, _)| name).collect();
     let traces = short_names(&names)
         .into_iter()
@@ -134,8 +200,6 @@ fn render_panel(panel: &Panel, frame: &mut Frame, area: Rect) {
         .enumerate()
         .map(|(i, (label, (_, series)))| Trace { name: label.to_string(), points: series.points(), color: color(i) })
         .collect();
-    let spec = panel.spec();
-    let block = Block::bordered().title(format!(" {} ", spec.title));
     frame.render_widget(line_chart(traces, &spec.x_label, block), area);
 }
 
@@ -189,6 +253,7 @@ mod tests {
                     x_label: "t".into(),
                     series: vec!["pendulum/angle".into(), "pendulum/action".into()],
                     restart_on_rewind: true,
+                    path: None,
                 }],
             },
             t0,
@@ -213,7 +278,7 @@ mod tests {
             "q quit",
             "mpc: 50/150 (33%) 5.0/s, ETA 20s",
             "cem/best_cost = 98.100",
-            "(1/3)",
+            "(1/1)",
             "pendulum",
             "angle",
             "action",
@@ -226,10 +291,12 @@ mod tests {
     #[test]
     fn switching_metric_changes_the_curves_title() {
         let mut app = pendulum_app();
+        app.ingest(&Event::scalar("cem/elite_std", 0, 0.5));
         app.handle_key(KeyEvent::new(KeyCode::Right, KeyModifiers::NONE));
         let screen = draw(&app, 100, 40);
-        assert!(screen.contains("pendulum/action = "), "{screen}");
+        assert!(screen.contains("cem/elite_std = 0.5000  (2/2)"), "{screen}");
         assert!(!screen.contains("cem/best_cost = "), "{screen}");
+        assert!(!screen.contains("pendulum/action ="), "a panel draws it already:\n{screen}");
     }
 
     #[test]
@@ -403,14 +470,80 @@ mod tests {
     }
 
     #[test]
-    fn without_chart_panels_text_panels_use_the_whole_method_area() {
+    fn with_nothing_to_chart_text_panels_take_the_whole_body() {
         let screen = draw(&board_app(false), 80, 24);
-        assert!(screen.contains("no metrics yet"), "the curves keep their half:\n{screen}");
+        assert!(!screen.contains("no metrics yet") && !screen.contains("metric"), "no empty Curves panel:\n{screen}");
         let (_, board_bottom) = assert_fitted_panel(&screen, "board", &BOARD.lines().collect::<Vec<_>>());
         let (plan_top, left) = find(&screen, "┌ plan ").unwrap_or_else(|| panic!("{screen}"));
         assert_eq!(plan_top, board_bottom + 1, "{screen}");
         assert_eq!(cell(&screen, 23, left), Some('└'), "the last panel reaches the bottom:\n{screen}");
-        assert!(left >= 30, "text panels sit in the method half:\n{screen}");
+        assert_eq!(left, 0, "{screen}");
+    }
+
+    /// `mbrl solve-board --embodiment reacher` halfway through its plan, on the smallest terminal the
+    /// view promises to serve.
+    fn solve_board_app() -> App {
+        use crate::envs::boards::{BoardGame, LightsOut};
+        use crate::planning::board_view::{layout, plan_text, show_boards};
+        use crate::run::{ChannelMonitor, Monitor};
+        let game = LightsOut::new(5).expect("5x5");
+        let (sender, events) = std::sync::mpsc::channel();
+        let monitor = ChannelMonitor::new(sender, Default::default());
+        let start = game.pressed(&[0, 7, 12, 18, 24]);
+        let mut app = App::new("t");
+        app.ingest(&layout("solve-board: lightsout-5x5", 5));
+        for depth in 1..=5u64 {
+            app.ingest(&Event::scalar("bfs/stored", depth, (depth * depth * 100) as f64));
+            app.ingest(&Event::scalar("bfs/expanded", depth, (depth * depth * 40) as f64));
+        }
+        let names: Vec<String> = [0, 7, 12, 18, 24].iter().map(|&m| game.move_name(m)).collect();
+        show_boards(&monitor, &game, start, Some(("after 2/5", game.pressed(&[18, 24]))));
+        monitor.emit(&Event::text("plan", plan_text(&names, 2, true)));
+        for step in 1..=30u64 {
+            let t = step as f64 / 30.0;
+            app.ingest(&Event::scalar("effector/x", step, 0.1 + 0.8 * t));
+            app.ingest(&Event::scalar("effector/y", step, 0.5));
+        }
+        drop(monitor);
+        for event in events.try_iter() {
+            app.ingest(&event);
+        }
+        app
+    }
+
+    #[test]
+    fn a_board_solve_fits_80_by_24_without_a_duplicate_chart() {
+        let screen = draw(&solve_board_app(), 80, 24);
+        assert!(!screen.contains("bfs/stored ="), "the search panel draws it already:\n{screen}");
+        assert!(screen.contains("┌ search: states per depth"), "{screen}");
+        let (path_top, path_left) =
+            find(&screen, "┌ effector path over the board").unwrap_or_else(|| panic!("{screen}"));
+        assert_eq!(path_left, 0, "charts fill the left column:\n{screen}");
+        assert!(path_top + 6 < 24, "the path panel has rows to draw in:\n{screen}");
+        let app = solve_board_app();
+        let boards = &app.text_panels().iter().find(|p| p.name == "boards").expect("boards panel").text;
+        let lines: Vec<&str> = boards.lines().collect();
+        assert_eq!(lines.len(), 6, "captions and five rows:\n{boards}");
+        assert!(lines[0].starts_with("start       after 2/5   goal"), "{boards}");
+        let (top, _) = assert_fitted_panel(&screen, "boards", &lines);
+        let (plan_top, _) = find(&screen, "┌ plan ").unwrap_or_else(|| panic!("{screen}"));
+        assert!(plan_top > top, "{screen}");
+        for line in ["✓  1 push (0, 0)", "▶  3 push (2, 2)", "   5 push (4, 4)"] {
+            assert!(screen.contains(line), "missing {line:?}:\n{screen}");
+        }
+    }
+
+    #[test]
+    fn the_header_drops_hints_then_cuts_the_title() {
+        let mut app = App::new("train context model on pendulum:quadrant with a very long title indeed");
+        app.ingest(&Event::scalar("train/loss", 1, 1.0));
+        let wide = draw(&app, 120, 10);
+        assert!(wide.contains("indeed  running  q quit · ←/→ metric"), "{wide}");
+        let narrow = draw(&app, 60, 10);
+        let header = narrow.lines().next().unwrap_or_default();
+        assert!(header.contains("…  running"), "{narrow}");
+        assert!(!header.contains("quit"), "{narrow}");
+        assert!(draw(&app, 8, 10).lines().next().unwrap_or_default().contains("running"));
     }
 
     #[test]

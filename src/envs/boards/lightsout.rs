@@ -95,6 +95,10 @@ impl BoardGame for LightsOut {
         format!("lightsout-{0}x{0}", self.n)
     }
 
+    fn side(&self) -> usize {
+        self.n
+    }
+
     fn num_moves(&self) -> usize {
         self.fields()
     }

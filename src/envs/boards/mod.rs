@@ -40,6 +40,8 @@ pub trait BoardGame: Clone + Send + Sync + 'static {
     fn parse(&self, text: &str) -> Result<Self::State>;
     /// A multi-line picture of the board for terminals.
     fn render(&self, state: Self::State) -> String;
+    /// Fields per side of the square board.
+    fn side(&self) -> usize;
     /// Board point at which a push performs `mv`.
     fn move_target(&self, mv: usize) -> BoardPoint;
     /// The move a push at `point` performs, if any.

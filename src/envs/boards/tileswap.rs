@@ -103,6 +103,10 @@ impl BoardGame for TileSwap {
         "tileswap-3x3".into()
     }
 
+    fn side(&self) -> usize {
+        SIDE
+    }
+
     fn num_moves(&self) -> usize {
         self.pairs.len()
     }

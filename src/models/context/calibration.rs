@@ -212,18 +212,21 @@ pub fn layout(title: &str, state_names: &[String]) -> crate::run::Event {
                 x_label: "transitions".into(),
                 series: vec!["calibration/entropy".into()],
                 restart_on_rewind: false,
+                path: None,
             },
             PanelSpec {
                 title: "executed trajectory".into(),
                 x_label: "step".into(),
                 series: state_names.iter().map(|n| format!("state/{n}")).collect(),
                 restart_on_rewind: false,
+                path: None,
             },
             PanelSpec {
                 title: "EIG planning: best mean posterior entropy (current step)".into(),
                 x_label: "CEM iteration".into(),
                 series: vec!["cem/best_entropy".into()],
                 restart_on_rewind: true,
+                path: None,
             },
         ],
     }

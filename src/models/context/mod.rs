@@ -26,7 +26,7 @@ use crate::run::dir::Provenance;
 use crate::run::Monitor;
 use crate::train::tensors::to_params;
 use crate::train::{
-    run_training, training_layout, validation_panel, DataFile, FitOutcome, FitSettings, OpenedCheckpoint, MODEL_FILE,
+    loss_panel, run_training, training_view, DataFile, FitOutcome, FitSettings, OpenedCheckpoint, MODEL_FILE,
 };
 use data::{ContextData, Episode, InstancePair};
 
@@ -163,19 +163,29 @@ pub fn train(request: &TrainRequest, resume: bool, monitor: &dyn Monitor) -> Res
         checkpoint_every: request.config.checkpoint_every,
     };
     let config = serde_json::to_value(&run).map_err(|e| Error::config(e.to_string()))?;
-    let title = format!(
-        "train context model on {} ({} instances, batch {} × {} states)",
-        run.env, run.instances.train, request.config.batch_size, chunk_states
+    let title = format!("train context model on {}", run.env);
+    let c = &request.config;
+    let schedule = c.context_from_target;
+    let view = training_view(
+        &title,
+        vec![loss_panel("loss, eq. 4.32 (train, held-out)", true)],
+        &[
+            ("instances", format!("{} train / {} valid", run.instances.train, run.instances.valid)),
+            ("batch", format!("{} × {chunk_states} states", c.batch_size)),
+            ("learning rate", format!("{}", c.optimizer.learning_rate)),
+            ("KL", format!("weight {}, floor {}", c.kl_weight, c.kl_floor)),
+            (
+                "p ctx target",
+                if schedule.start > 0.0 {
+                    format!("{} → 0, steps {}-{}", schedule.start, schedule.decay_from, schedule.zero_at)
+                } else {
+                    "0".to_string()
+                },
+            ),
+            ("parameters", parameters.to_string()),
+        ],
     );
-    let outcome = run_training(
-        &request.out,
-        &config,
-        &settings,
-        &mut trainer,
-        resume,
-        &training_layout(&title, vec![validation_panel("validation loss (eq. 4.32, held-out instances)")]),
-        monitor,
-    )?;
+    let outcome = run_training(&request.out, &config, &settings, &mut trainer, resume, &view, monitor)?;
     Ok(TrainReport { run, outcome, parameters })
 }
 

@@ -29,6 +29,8 @@ pub struct ContextTrainer {
     chunk: usize,
     /// Drawn once (appendix B.2.2) so every validation compares the same batches.
     valid_batches: Vec<Batch>,
+    /// The last step's loss terms and context schedule, for the live view and metrics.
+    last_terms: Vec<(&'static str, f64)>,
 }
 
 /// A fresh network of this shape (the weights of a seeded initialization).
@@ -67,7 +69,18 @@ impl ContextTrainer {
                 })
                 .collect()
         };
-        Ok(ContextTrainer { config, seed, device, net: Some(net), params, adam, train, chunk, valid_batches })
+        Ok(ContextTrainer {
+            config,
+            seed,
+            device,
+            net: Some(net),
+            params,
+            adam,
+            train,
+            chunk,
+            valid_batches,
+            last_terms: Vec::new(),
+        })
     }
 
     fn net(&self) -> &ContextNet {
@@ -104,8 +117,19 @@ impl TrainingMethod for ContextTrainer {
         }
         let mut grads = ParamSet::<f32>::gradients(net, &parts.loss.backward());
         self.adam.update(&mut self.params.values_mut(), &mut grads)?;
+        self.last_terms = vec![
+            ("context/loglik_reconstruction", scalar(&parts.reconstruction)),
+            ("context/loglik_single_step", scalar(&parts.single_step)),
+            ("context/loglik_multi_step", scalar(&parts.multi_step)),
+            ("context/kl_weighted", scalar(&parts.kl)),
+            ("context/p_context_from_target", from_target),
+        ];
         self.load_params()?;
         Ok(value)
+    }
+
+    fn step_scalars(&self) -> Vec<(&'static str, f64)> {
+        self.last_terms.clone()
     }
 
     fn validate(&mut self) -> Result<Option<f64>> {

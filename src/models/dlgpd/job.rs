@@ -21,7 +21,7 @@ use crate::run::dir::Provenance;
 use crate::run::Monitor;
 use crate::train::tensors::TensorData;
 use crate::train::{
-    run_training, training_layout, validation_panel, DataFile, FitOutcome, FitSettings, OpenedCheckpoint, MODEL_FILE,
+    loss_panel, run_training, training_view, DataFile, FitOutcome, FitSettings, OpenedCheckpoint, MODEL_FILE,
 };
 use crate::util::seeding::rng_for;
 
@@ -122,19 +122,20 @@ pub fn train(request: &TrainRequest, resume: bool, monitor: &dyn Monitor) -> Res
         ObservationKind::Images { side } => format!("{side}×{side} frames"),
         ObservationKind::Angles => "pole angles".to_string(),
     };
-    let title = format!(
-        "train DLGPD on {} ({} transitions of {observed}, batch {})",
-        run.env, run.transitions.train, request.config.batch_size
+    let c = &request.config;
+    let view = training_view(
+        &format!("train DLGPD on {}", run.env),
+        vec![loss_panel("loss: −ELBO (train, held-out)", true)],
+        &[
+            ("observations", observed),
+            ("transitions", format!("{} train / {} valid", run.transitions.train, run.transitions.valid)),
+            ("batch", format!("{} (= GP evidence)", c.batch_size)),
+            ("learning rate", format!("{} (VAE, GPs)", c.learning_rate)),
+            ("latent size", c.latent_dim.to_string()),
+            ("parameters", parameters.to_string()),
+        ],
     );
-    let outcome = run_training(
-        &request.out,
-        &config,
-        &settings,
-        &mut trainer,
-        resume,
-        &training_layout(&title, vec![validation_panel("validation loss (the training objective, held-out rollouts)")]),
-        monitor,
-    )?;
+    let outcome = run_training(&request.out, &config, &settings, &mut trainer, resume, &view, monitor)?;
     Ok(TrainReport { run, outcome, parameters })
 }
 

@@ -24,7 +24,8 @@ use crate::run::dir::Provenance;
 use crate::run::Monitor;
 use crate::train::tensors::{to_params, TensorData};
 use crate::train::{
-    run_training, training_layout, validation_panel, DataFile, FitOutcome, FitSettings, OpenedCheckpoint, MODEL_FILE,
+    loss_panel, run_training, training_view, validation_panel, DataFile, FitOutcome, FitSettings, OpenedCheckpoint,
+    MODEL_FILE,
 };
 
 pub const METHOD: &str = "pets";
@@ -176,19 +177,20 @@ pub fn train(request: &TrainRequest, resume: bool, monitor: &dyn Monitor) -> Res
         checkpoint_every: request.config.checkpoint_every,
     };
     let config = serde_json::to_value(&run).map_err(|e| Error::config(e.to_string()))?;
-    let title = format!(
-        "train PETS on {} ({} transitions, ensemble of {})",
-        run.env, run.transitions.train, request.config.ensemble
+    let c = &request.config;
+    let view = training_view(
+        &format!("train PETS on {}", run.env),
+        vec![loss_panel("train loss: Gaussian NLL", false), validation_panel("valid: MSE of the mean (held-out)")],
+        &[
+            ("transitions", format!("{} train / {} valid", run.transitions.train, run.transitions.valid)),
+            ("ensemble", format!("{}{}", c.ensemble, if c.bootstrap { ", bootstrapped" } else { "" })),
+            ("batch", format!("{} per member", c.batch_size)),
+            ("learning rate", format!("{}", c.optimizer.learning_rate)),
+            ("weight decay", format!("{}", c.optimizer.weight_decay)),
+            ("parameters", parameters.to_string()),
+        ],
     );
-    let outcome = run_training(
-        &request.out,
-        &config,
-        &settings,
-        &mut trainer,
-        resume,
-        &training_layout(&title, vec![validation_panel("validation MSE of the mean prediction (held-out rollouts)")]),
-        monitor,
-    )?;
+    let outcome = run_training(&request.out, &config, &settings, &mut trainer, resume, &view, monitor)?;
     Ok(TrainReport { run, outcome, parameters })
 }
 

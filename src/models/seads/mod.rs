@@ -25,7 +25,7 @@ use crate::envs::EnvName;
 use crate::error::{Error, Result};
 use crate::run::dir::Provenance;
 use crate::run::{Monitor, PanelSpec};
-use crate::train::{run_training, training_layout, FitOutcome, FitSettings, OpenedCheckpoint};
+use crate::train::{run_training, training_view, FitOutcome, FitSettings, OpenedCheckpoint};
 
 pub const METHOD: &str = "seads";
 pub const ENV_HELP: &str = "lightsout:cursor, tileswap:cursor, lightsout:reacher, tileswap:reacher";
@@ -110,6 +110,7 @@ fn panel(title: &str, series: &[&str]) -> PanelSpec {
         x_label: "epoch".into(),
         series: series.iter().map(|s| s.to_string()).collect(),
         restart_on_rewind: false,
+        path: None,
     }
 }
 
@@ -143,17 +144,25 @@ fn train_game<G: BoardGame>(
         checkpoint_every: config.checkpoint_every,
     };
     let json = serde_json::to_value(&run).map_err(|e| Error::config(e.to_string()))?;
-    let title = format!(
-        "train SEADS on {} ({} skills, up to {} env steps; loss = forward-model NLL per bit on new episodes)",
-        run.env, config.skills, config.env_steps
-    );
+    let title = format!("train SEADS on {}", run.env);
     let panels = vec![
+        panel("loss: forward-model NLL per bit", &["train/loss"]),
         panel("distinct game moves the skills execute", &["seads/distinct_moves"]),
         panel("mean intrinsic reward (final transitions)", &["seads/intrinsic_reward"]),
         panel("SAC losses", &["sac/critic_loss", "sac/actor_loss"]),
     ];
-    let outcome =
-        run_training(&request.out, &json, &settings, &mut trainer, resume, &training_layout(&title, panels), monitor)?;
+    let view = training_view(
+        &title,
+        panels,
+        &[
+            ("skills", config.skills.to_string()),
+            ("env steps", config.env_steps.to_string()),
+            ("episodes", format!("{} per epoch", config.episodes_per_epoch)),
+            ("model", format!("lr {}, batch {}", config.model_learning_rate, config.model_batch)),
+            ("SAC", format!("lr {}, batch {}", config.sac_learning_rate, config.sac_batch)),
+        ],
+    );
+    let outcome = run_training(&request.out, &json, &settings, &mut trainer, resume, &view, monitor)?;
     Ok(TrainReport { run, outcome, last: trainer.last.clone(), env_steps: trainer.env_steps() })
 }
 

@@ -18,6 +18,7 @@ use crate::envs::Env;
 use crate::error::{Error, Result};
 use crate::nn::ParamSet;
 use crate::planning::bfs::{bidirectional, breadth_first, SearchLimits, SearchResult, SuccessorModel};
+use crate::planning::board_view::{plan_text, show_boards, EffectorTrace};
 use crate::rl::sac::Sac;
 use crate::run::{Event, Monitor};
 use crate::train::{OpenedCheckpoint, MODEL_FILE};
@@ -238,13 +239,19 @@ pub fn solve_with_skills<G: BoardGame>(
         bidirectional: false,
     };
     let mut input = Vec::new();
+    let mut trace = EffectorTrace::default();
+    show_boards(monitor, game, board, None);
     while !out.solved && out.plans.len() <= max_replans {
         let started = Instant::now();
         let (result, bi) = plan_with_model(game, &loaded.model, env.board(), bidirectional_allowed, limits)?;
         out.planning_seconds += started.elapsed().as_secs_f64();
         out.bidirectional |= bi;
         let Some(plan) = result.plan else { break };
-        monitor.emit(&Event::text("plan", format!("plan {}: skills {:?}", out.plans.len() + 1, plan)));
+        let skills: Vec<String> = plan.iter().map(|k| format!("skill {k}")).collect();
+        monitor.emit(&Event::text(
+            "plan",
+            format!("plan {} of skills:\n{}", out.plans.len() + 1, plan_text(&skills, 0, false)),
+        ));
         out.plans.push(plan.clone());
         for &skill in &plan {
             let before = env.board();
@@ -261,6 +268,7 @@ pub fn solve_with_skills<G: BoardGame>(
                 policy_input(&obs, skill, k, &mut input);
                 let action: Vec<f64> = loaded.policy.act(&input, 1, true, rng).iter().map(|&a| a as f64).collect();
                 let step = env.step(&action);
+                trace.record(monitor, env.manipulator().effector());
                 steps += 1;
                 if env.board() != before {
                     performed = (0..game.num_moves()).find(|&m| game.apply(before, m) == env.board());
@@ -271,7 +279,8 @@ pub fn solve_with_skills<G: BoardGame>(
             }
             out.control_steps += steps;
             out.executed.push(ExecutedSkill { skill, performed, steps });
-            monitor.emit(&Event::text("board", game.render(env.board())));
+            let caption = format!("after {} skills", out.executed.len());
+            show_boards(monitor, game, board, Some((&caption, env.board())));
             if env.board() != expected {
                 break;
             }

@@ -13,7 +13,7 @@ use crate::error::{Error, Result};
 use crate::models::ball::BallModelParams;
 use crate::run::dir::Provenance;
 use crate::run::Monitor;
-use crate::train::{run_training, training_layout, DataFile, FitOutcome, FitSettings, OpenedCheckpoint};
+use crate::train::{loss_panel, run_training, training_view, DataFile, FitOutcome, FitSettings, OpenedCheckpoint};
 
 pub const METHOD: &str = "ball-ekf";
 /// Steps between checkpoints; a checkpoint costs a few ms next to steps of ~60 ms.
@@ -65,8 +65,18 @@ pub fn train_checkpointed(request: &BallTrainRequest, resume: bool, monitor: &dy
         checkpoint_every: CHECKPOINT_EVERY,
     };
     let config = serde_json::to_value(&run).map_err(|e| Error::config(e.to_string()))?;
-    let layout = training_layout("train ball EKF (negative log-likelihood per measurement)", Vec::new());
-    let outcome = run_training(&request.out, &config, &settings, &mut trainer, resume, &layout, monitor)?;
+    let t = &request.settings;
+    let view = training_view(
+        "train ball EKF",
+        vec![loss_panel("loss: NLL per measurement", false)],
+        &[
+            ("recordings", recordings.len().to_string()),
+            ("batch", format!("{} chunks × {} frames", t.batch_size, t.chunk_len)),
+            ("learning rate", format!("{}", t.learning_rate)),
+            ("spin prior", if t.launcher_prior { "launcher net (C.1.3)" } else { "broad" }.to_string()),
+        ],
+    );
+    let outcome = run_training(&request.out, &config, &settings, &mut trainer, resume, &view, monitor)?;
     let (params, spin_net) = trainer.current();
     params.validate().map_err(|e| Error::Diverged(format!("ball EKF training ended with unusable parameters: {e}")))?;
     Ok(BallTrainReport { run, outcome, params, spin_net })

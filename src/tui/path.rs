@@ -1,0 +1,157 @@
+//! A path panel: the (x, y) pairs of two series drawn on a fixed plane over an optional grid, such as
+//! an effector's path over the board it plays on.
+
+use ratatui::style::{Color, Style};
+use ratatui::symbols::Marker;
+use ratatui::widgets::{Axis, Block, Chart, Dataset, GraphType};
+
+use super::plot::bounds;
+use super::series::Series;
+use crate::run::PathView;
+
+/// Finer grids are not drawn: their cells would be thinner than a braille dot, and a corrupt layout in
+/// a replayed file must not make the view allocate without bound.
+const MAX_GRID: u32 = 64;
+
+/// The points of `xs` and `ys` recorded at the same step, oldest first, with y mirrored inside the
+/// plane where the plane's y grows downwards. Both series are fed together, so their newest points
+/// line up; a point without a partner (one series trimmed further) is dropped.
+pub(crate) fn path_points(xs: &Series, ys: &Series, view: &PathView) -> Vec<(f64, f64)> {
+    let [y_lo, y_hi] = plane(view.y, ys);
+    let mut pairs: Vec<(f64, f64)> = xs
+        .points()
+        .iter()
+        .rev()
+        .zip(ys.points().iter().rev())
+        .filter(|(x, y)| x.0 == y.0)
+        .map(|(x, y)| (x.1, if view.y_down { y_lo + y_hi - y.1 } else { y.1 }))
+        .collect();
+    pairs.reverse();
+    pairs
+}
+
+/// The plane's range along one axis: the declared one when it is a real interval, else the data's.
+fn plane(declared: [f64; 2], series: &Series) -> [f64; 2] {
+    let [lo, hi] = declared;
+    if lo.is_finite() && hi.is_finite() && lo < hi {
+        declared
+    } else {
+        bounds(series.points().iter().map(|p| p.1), 0.0)
+    }
+}
+
+/// Every line of an n × n grid over the plane as one polyline: the horizontal lines walked
+/// alternately left and right, then the vertical ones up and down, so each connecting stroke runs along
+/// the border, itself a grid line.
+fn grid_polyline([x_lo, x_hi]: [f64; 2], [y_lo, y_hi]: [f64; 2], cells: u32) -> Vec<(f64, f64)> {
+    if cells == 0 || cells > MAX_GRID {
+        return Vec::new();
+    }
+    let at = |lo: f64, hi: f64, k: u32| lo + (hi - lo) * f64::from(k) / f64::from(cells);
+    let mut points = Vec::with_capacity(4 * (cells as usize + 1));
+    for k in 0..=cells {
+        let y = at(y_lo, y_hi, k);
+        let (a, b) = if k % 2 == 0 { (x_lo, x_hi) } else { (x_hi, x_lo) };
+        points.extend([(a, y), (b, y)]);
+    }
+    // The horizontal walk ends on the top edge, at the right end when it made an odd number of
+    // turns; the vertical walk starts there, so no stroke cuts across the grid.
+    let ends_right = cells % 2 == 0;
+    for j in 0..=cells {
+        let k = if ends_right { cells - j } else { j };
+        let x = at(x_lo, x_hi, k);
+        let (a, b) = if j % 2 == 0 { (y_hi, y_lo) } else { (y_lo, y_hi) };
+        points.extend([(x, a), (x, b)]);
+    }
+    points
+}
+
+/// The chart of a path panel. `path` comes from [`path_points`]; `grid` must outlive the chart, so the
+/// caller holds it (see [`grid_for`]).
+pub(crate) fn path_chart<'a>(
+    path: &'a [(f64, f64)],
+    grid: &'a [(f64, f64)],
+    view: &PathView,
+    xs: &Series,
+    ys: &Series,
+    block: Block<'a>,
+) -> Chart<'a> {
+    let x = plane(view.x, xs);
+    let y = plane(view.y, ys);
+    let line = |points: &'a [(f64, f64)], color: Color| {
+        Dataset::default()
+            .marker(Marker::Braille)
+            .graph_type(GraphType::Line)
+            .style(Style::default().fg(color))
+            .data(points)
+    };
+    let mut datasets = vec![line(grid, Color::DarkGray), line(path, Color::Cyan)];
+    if let Some(last) = path.len().checked_sub(1) {
+        datasets.push(
+            Dataset::default()
+                .marker(Marker::Block)
+                .graph_type(GraphType::Scatter)
+                .style(Style::default().fg(Color::Yellow))
+                .data(&path[last..]),
+        );
+    }
+    Chart::new(datasets).block(block).x_axis(Axis::default().bounds(x)).y_axis(Axis::default().bounds(y))
+}
+
+/// The grid polyline of a path panel over the plane its series are drawn on.
+pub(crate) fn grid_for(view: &PathView, xs: &Series, ys: &Series) -> Vec<(f64, f64)> {
+    grid_polyline(plane(view.x, xs), plane(view.y, ys), view.grid)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn series(points: &[(u64, f64)]) -> Series {
+        let mut s = Series::default();
+        for &(step, value) in points {
+            s.push(step, value);
+        }
+        s
+    }
+
+    fn board(y_down: bool) -> PathView {
+        PathView { x: [0.0, 1.0], y: [0.0, 1.0], grid: 5, y_down }
+    }
+
+    #[test]
+    fn points_pair_by_step_and_mirror_a_downward_y() {
+        let xs = series(&[(1, 0.1), (2, 0.2), (3, 0.3)]);
+        let ys = series(&[(2, 0.9), (3, 0.7)]);
+        assert_eq!(path_points(&xs, &ys, &board(false)), vec![(0.2, 0.9), (0.3, 0.7)]);
+        let flipped = path_points(&xs, &ys, &board(true));
+        assert!((flipped[0].1 - 0.1).abs() < 1e-12 && (flipped[1].1 - 0.3).abs() < 1e-12, "{flipped:?}");
+    }
+
+    #[test]
+    fn the_grid_walks_every_line_once_along_the_border() {
+        let grid = grid_polyline([0.0, 1.0], [0.0, 1.0], 2);
+        assert_eq!(grid.len(), 12);
+        // Every stroke is axis-parallel and lies on a grid line (0, 0.5 or 1 in the coordinate held).
+        for w in grid.windows(2) {
+            let ((x0, y0), (x1, y1)) = (w[0], w[1]);
+            assert!(x0 == x1 || y0 == y1, "{w:?}");
+            let held = if x0 == x1 { x0 } else { y0 };
+            assert!([0.0, 0.5, 1.0].contains(&held), "{w:?}");
+        }
+        for cells in 1..6 {
+            let grid = grid_polyline([0.0, 1.0], [0.0, 1.0], cells);
+            assert!(grid.windows(2).all(|w| w[0].0 == w[1].0 || w[0].1 == w[1].1), "{cells}: {grid:?}");
+        }
+        assert!(grid_polyline([0.0, 1.0], [0.0, 1.0], 0).is_empty());
+        assert!(grid_polyline([0.0, 1.0], [0.0, 1.0], u32::MAX).is_empty(), "absurd grids are not drawn");
+    }
+
+    #[test]
+    fn an_empty_or_inverted_plane_falls_back_to_the_data() {
+        let ys = series(&[(1, 2.0), (2, 4.0)]);
+        assert_eq!(plane([1.0, 1.0], &ys), [2.0, 4.0]);
+        assert_eq!(plane([f64::NAN, 1.0], &ys), [2.0, 4.0]);
+        assert_eq!(plane([0.0, 1.0], &ys), [0.0, 1.0]);
+    }
+}
