@@ -9,7 +9,7 @@ use std::time::Duration;
 use anyhow::Context;
 use clap::Args;
 use mbrl::run::dir::METRICS_FILE;
-use mbrl::run::follow::MetricsFollower;
+use mbrl::run::follow::{latest_progress_only, MetricsFollower};
 use mbrl::run::Event;
 use mbrl::tui::run_live;
 
@@ -38,8 +38,13 @@ pub fn run(global: &GlobalArgs, args: WatchArgs) -> anyhow::Result<()> {
     let title = format!("watch {}", args.run_dir.display());
     std::thread::scope(|scope| {
         let reader = scope.spawn(move || -> mbrl::Result<()> {
+            let mut backlog = true;
             while !stop.load(Ordering::Relaxed) {
-                for event in follower.poll()? {
+                let mut events = follower.poll()?;
+                if std::mem::take(&mut backlog) {
+                    events = latest_progress_only(events);
+                }
+                for event in events {
                     let finished = matches!(event, Event::Finished { .. });
                     if sender.send(event).is_err() || finished {
                         return Ok(());

@@ -20,7 +20,8 @@ pub fn layout(title: &str, side: usize) -> Event {
                 title: "search: states per depth".into(),
                 x_label: "depth".into(),
                 series: vec!["bfs/stored".into(), "bfs/expanded".into()],
-                restart_on_rewind: true,
+                // One search per solve: the panel holds its whole history.
+                restart_on_rewind: false,
                 path: None,
             },
             PanelSpec {

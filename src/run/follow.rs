@@ -49,6 +49,28 @@ impl MetricsFollower {
     }
 }
 
+/// A run's backlog with each phase's progress reduced to its latest update, in place. Replayed at once,
+/// the earlier updates would be timed as arriving within a millisecond and show absurd rates; from the
+/// latest alone the view starts each phase's clock when the watch starts, so a finished run shows no
+/// rate and a running one the rate it has from then on.
+pub fn latest_progress_only(events: Vec<Event>) -> Vec<Event> {
+    let mut last_update = std::collections::HashMap::new();
+    for (i, event) in events.iter().enumerate() {
+        if let Event::Progress { phase, .. } = event {
+            last_update.insert(phase.clone(), i);
+        }
+    }
+    events
+        .into_iter()
+        .enumerate()
+        .filter(|(i, event)| match event {
+            Event::Progress { phase, .. } => last_update.get(phase) == Some(i),
+            _ => true,
+        })
+        .map(|(_, event)| event)
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -77,5 +99,25 @@ mod tests {
         std::fs::write(&path, "{\"kind\":\"finished\",\"ok\":true}\nnot json\n").unwrap();
         let err = MetricsFollower::open(&path).unwrap().poll().unwrap_err().to_string();
         assert!(err.contains("metrics.jsonl") && err.contains("line 2"), "{err}");
+    }
+
+    #[test]
+    fn a_backlog_keeps_only_the_latest_progress_of_each_phase() {
+        let events = vec![
+            Event::progress("train", 1, 10),
+            Event::scalar("loss", 1, 0.5),
+            Event::progress("eval", 1, 2),
+            Event::progress("train", 2, 10),
+            Event::scalar("loss", 2, 0.4),
+        ];
+        assert_eq!(
+            latest_progress_only(events),
+            vec![
+                Event::scalar("loss", 1, 0.5),
+                Event::progress("eval", 1, 2),
+                Event::progress("train", 2, 10),
+                Event::scalar("loss", 2, 0.4),
+            ]
+        );
     }
 }

@@ -89,14 +89,14 @@ impl App {
         self.selected.as_deref()
     }
 
-    /// The metrics the Curves panel offers, sorted by name: those no chart panel draws already, so the
-    /// same curve is never shown twice.
+    /// The metrics the Curves panel offers, sorted by name: all but those a chart panel already draws
+    /// in full, so the same curve is never shown twice.
     pub fn metric_names(&self) -> Vec<&str> {
         self.history.keys().map(String::as_str).filter(|name| self.is_selectable(name)).collect()
     }
 
     fn is_selectable(&self, name: &str) -> bool {
-        !self.panels.iter().any(|panel| panel.draws(name))
+        !self.panels.iter().any(|panel| panel.draws_full_history(name))
     }
 
     /// Whether the Curves panel has anything to offer. Without, the method panels take the whole body;
@@ -289,11 +289,14 @@ mod tests {
     }
 
     #[test]
-    fn metrics_a_panel_draws_are_not_offered_again() {
+    fn metrics_a_panel_draws_in_full_are_not_offered_again() {
         let mut app = App::new("t");
         app.ingest(&Event::scalar("pendulum/angle", 0, 1.0));
-        assert_eq!(app.selected_metric(), Some("pendulum/angle"));
         app.ingest(&pendulum_layout());
+        assert_eq!(app.selected_metric(), Some("pendulum/angle"), "the panel shows one episode, Curves all");
+        let Event::Layout { title, mut panels } = pendulum_layout() else { unreachable!() };
+        panels[0].restart_on_rewind = false;
+        app.ingest(&Event::Layout { title, panels });
         assert_eq!(app.selected_metric(), None, "the panel draws it now");
         assert!(!app.has_curves(), "nothing left to offer");
         app.ingest(&Event::scalar("pendulum/action", 0, 1.0));

@@ -30,8 +30,11 @@ impl Panel {
         }
     }
 
-    pub(crate) fn draws(&self, name: &str) -> bool {
-        self.spec.series.iter().any(|s| s == name)
+    /// Whether the panel draws the whole history of `name`, as the Curves panel would. A panel that
+    /// restarts on a rewind shows only the latest episode or planner call, so the Curves panel still
+    /// has the history to add.
+    pub(crate) fn draws_full_history(&self, name: &str) -> bool {
+        !self.spec.restart_on_rewind && self.spec.series.iter().any(|s| s == name)
     }
 
     pub(crate) fn spec(&self) -> &PanelSpec {
