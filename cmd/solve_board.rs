@@ -214,13 +214,12 @@ fn solve_learned<G: DenseIndex>(
 
 fn solve<G: DenseIndex>(global: &GlobalArgs, args: &SolveBoardArgs, game: G) -> anyhow::Result<()> {
     let seed = global.seed;
-    let board = match (&args.board, args.random_depth) {
-        (Some(text), _) => game.parse(text).with_context(|| format!("--board '{text}'"))?,
-        (None, Some(depth)) => {
-            let table = DepthTable::build(&game)?;
-            sample_board(&game, &table, depth, args.split.map(Split::from), &mut rng_for(seed, &[0]))?
-        }
-        (None, None) => bail!("give --board or --random-depth"),
+    // A malformed --board is refused before the view opens; a random board is drawn inside the job, so
+    // the view is up while the depth table is built.
+    let given = match &args.board {
+        Some(text) => Some(game.parse(text).with_context(|| format!("--board '{text}'"))?),
+        None if args.random_depth.is_none() => bail!("give --board or --random-depth"),
+        None => None,
     };
     let limits = SearchLimits {
         max_depth: args.max_depth,
@@ -233,15 +232,23 @@ fn solve<G: DenseIndex>(global: &GlobalArgs, args: &SolveBoardArgs, game: G) -> 
     };
     let embodiment = args.embodiment.map(Embodiment::from);
     let title = format!("solve-board: {}", game.name());
-    let (result, execution) = run_job(global, &title, |monitor| {
+    let (board, result, execution) = run_job(global, &title, |monitor| {
         monitor.emit(&layout(&title, game.side()));
+        let board = match (given, args.random_depth) {
+            (Some(board), _) => board,
+            (None, depth) => {
+                let depth = depth.unwrap_or_default();
+                let table = DepthTable::build(&game)?;
+                sample_board(&game, &table, depth, args.split.map(Split::from), &mut rng_for(seed, &[0]))?
+            }
+        };
         let result = plan_board(&game, board, search, &limits, monitor)?;
         let plan = result.plan.clone().unwrap_or_default();
         let execution = match embodiment {
             Some(e) => Some(execute_plan(&game, board, &plan, e, &mut rng_for(seed, &[1]), monitor)?),
             None => None,
         };
-        Ok((result, execution))
+        Ok((board, result, execution))
     })?;
     let plan = result.plan.unwrap_or_default();
     say!("board {} ({}):\n{}", game.canonical_string(board), game.name(), game.render(board));
