@@ -424,6 +424,7 @@ fn eval_context(global: &GlobalArgs, provenance: &Provenance, a: ContextArgs) ->
     for (s, m) in strategies.iter().zip(&summary.mean_mse) {
         say!("{:<10} mean prediction MSE {m:.4e}", s.name());
     }
+    say!("no calibration (empty context, reference) mean prediction MSE {:.4e}", summary.empty_context_mse);
     for (better, worse, p) in &summary.tests {
         say!("Wilcoxon: {} lower than {}: p = {p:.3e}", better.name(), worse.name());
     }

@@ -45,6 +45,9 @@ pub struct ContextEvalSettings {
 }
 
 /// What one strategy achieved in one context.
+/// The reference row's name in CSVs: the model given no calibration transitions.
+const EMPTY_CONTEXT: &str = "empty-context";
+
 #[derive(Clone, Debug)]
 struct Outcome {
     /// Per-step MSE over the validation rollouts (averaged over state dims and rollouts), by horizon.
@@ -57,6 +60,9 @@ struct Outcome {
 pub struct ContextEvalSummary {
     /// Mean over contexts of the mean validation MSE, per strategy (in `settings.strategies` order).
     pub mean_mse: Vec<f64>,
+    /// The same for the model given no calibration at all (the mean of q(β | ∅)): the reference that shows
+    /// whether the model uses its context.
+    pub empty_context_mse: f64,
     /// One-sided p-values that the first strategy named has lower MSE than the second.
     pub tests: Vec<(Strategy, Strategy, f64)>,
     /// Toy only: (mean entropy after one informative transition, after one non-informative transition).
@@ -195,6 +201,8 @@ pub fn evaluate(
     let seed = provenance.seed;
     let is_quadrant = env.canonical() == "pendulum:quadrant";
     let mut outcomes: Vec<Vec<Outcome>> = Vec::with_capacity(settings.contexts);
+    let mut empty_context: Vec<Vec<f64>> = Vec::with_capacity(settings.contexts);
+    let empty_beta = model.fast.belief(&model.fast.pool(&[]), 1).mean;
     let mut ground_truth_returns = Vec::new();
     for k in 0..settings.contexts as u64 {
         if monitor.is_cancelled() {
@@ -207,6 +215,7 @@ pub fn evaluate(
         let validation: Vec<Rollout> = (0..settings.validation_rollouts)
             .map(|_| random_rollout(env_k.as_mut(), settings.validation_steps, &mut rng))
             .collect();
+        empty_context.push(mse_by_horizon(model, &empty_beta, &validation, settings.validation_steps));
         // One start for every strategy: the thesis' fixed start, or one reset draw.
         let start = crate::models::context::calibration::default_start(env).unwrap_or_else(|| {
             env_k.reset(&mut rng);
@@ -242,10 +251,7 @@ pub fn evaluate(
             }
             let rows = context_rows(model, &calibration.rollout);
             let beta = model.fast.belief(&model.fast.pool(&rows), 1).mean;
-            let errors: Vec<Vec<f64>> = validation.iter().map(|r| prediction_errors(model, &beta, r)).collect();
-            let mse_by_horizon = (0..settings.validation_steps)
-                .map(|t| errors.iter().map(|e| e[t]).sum::<f64>() / errors.len() as f64)
-                .collect();
+            let mse_by_horizon = mse_by_horizon(model, &beta, &validation, settings.validation_steps);
             let quadrants = is_quadrant.then(|| {
                 let mut seen = [false; 4];
                 for s in &calibration.rollout.states {
@@ -270,9 +276,15 @@ pub fn evaluate(
         outcomes.push(per_strategy);
     }
     monitor.progress("contexts", settings.contexts as u64, settings.contexts as u64);
-    let summary = write_report(model, env, settings, &run, &outcomes, &ground_truth_returns)?;
+    let summary = write_report(model, env, settings, &run, &outcomes, &empty_context, &ground_truth_returns)?;
     metrics.emit(&Event::Finished { ok: true });
     Ok(summary)
+}
+
+/// Per-step MSE of open-loop predictions with context `beta`, averaged over the validation rollouts.
+fn mse_by_horizon(model: &LoadedModel, beta: &[f32], validation: &[Rollout], steps: usize) -> Vec<f64> {
+    let errors: Vec<Vec<f64>> = validation.iter().map(|r| prediction_errors(model, beta, r)).collect();
+    (0..steps).map(|t| errors.iter().map(|e| e[t]).sum::<f64>() / errors.len() as f64).collect()
 }
 
 /// Wilcoxon signed-rank tests of open-loop and MPC against random and of MPC against open-loop, on the per-context
@@ -309,16 +321,28 @@ fn write_report(
     settings: &ContextEvalSettings,
     run: &RunDir,
     outcomes: &[Vec<Outcome>],
+    empty_context: &[Vec<f64>],
     ground_truth_returns: &[f64],
 ) -> Result<ContextEvalSummary> {
     let strategies = &settings.strategies;
     let per_context_mse =
         |j: usize| -> Vec<f64> { outcomes.iter().map(|o| mean(&o[j].mse_by_horizon).unwrap_or(f64::NAN)).collect() };
     let mean_mse: Vec<f64> = (0..strategies.len()).map(|j| mean(&per_context_mse(j)).unwrap_or(f64::NAN)).collect();
+    let empty_per_context: Vec<f64> = empty_context.iter().map(|m| mean(m).unwrap_or(f64::NAN)).collect();
+    let empty_context_mse = mean(&empty_per_context).unwrap_or(f64::NAN);
+    let prior_entropy = gaussian_entropy(&model.fast.belief(&model.fast.pool(&[]), 1).std);
 
     // Per-context table.
     let mut rows = Vec::new();
     for (k, o) in outcomes.iter().enumerate() {
+        rows.push(vec![
+            k.to_string(),
+            EMPTY_CONTEXT.to_string(),
+            format!("{:.6e}", empty_per_context[k]),
+            format!("{prior_entropy:.4}"),
+            String::new(),
+            String::new(),
+        ]);
         for (j, s) in strategies.iter().enumerate() {
             rows.push(vec![
                 k.to_string(),
@@ -347,23 +371,24 @@ fn write_report(
         .collect();
     let mut header = vec!["horizon".to_string()];
     header.extend(strategies.iter().map(|s| format!("mse_{}", s.name().replace('-', "_"))));
+    header.push(format!("mse_{}", EMPTY_CONTEXT.replace('-', "_")));
+    let empty_by_horizon: Vec<f64> = (0..horizon)
+        .map(|t| empty_context.iter().map(|m| m[t]).sum::<f64>() / empty_context.len() as f64)
+        .collect();
     let header_refs: Vec<&str> = header.iter().map(String::as_str).collect();
     let rows: Vec<Vec<String>> = (0..horizon)
         .map(|t| {
             let mut row = vec![(t + 1).to_string()];
             row.extend(by_horizon.iter().map(|v| format!("{:.6e}", v[t])));
+            row.push(format!("{:.6e}", empty_by_horizon[t]));
             row
         })
         .collect();
     write_csv(&run.file("mse_vs_horizon.csv"), &header_refs, &rows)?;
-    let series: Vec<Series> = strategies
-        .iter()
-        .zip(&by_horizon)
-        .map(|(s, v)| Series {
-            name: s.name().into(),
-            points: v.iter().enumerate().map(|(t, m)| ((t + 1) as f64, *m)).collect(),
-        })
-        .collect();
+    let curve = |v: &[f64]| v.iter().enumerate().map(|(t, m)| ((t + 1) as f64, *m)).collect();
+    let mut series: Vec<Series> =
+        strategies.iter().zip(&by_horizon).map(|(s, v)| Series { name: s.name().into(), points: curve(v) }).collect();
+    series.push(Series { name: "no calibration (empty context)".into(), points: curve(&empty_by_horizon) });
     line_plot(
         &run.file("mse_vs_horizon.png"),
         &format!("{}: prediction MSE after calibration ({} contexts)", env.canonical(), outcomes.len()),
@@ -475,6 +500,12 @@ fn write_report(
         if has_quadrants { "---|" } else { "" },
         if swingup.is_some() { "---|" } else { "" }
     );
+    let _ = writeln!(
+        md,
+        "| no calibration (empty context, reference) | {empty_context_mse:.4e} | {prior_entropy:.3} |{}{}",
+        if has_quadrants { " - |" } else { "" },
+        if swingup.is_some() { " - |" } else { "" }
+    );
     for (j, s) in strategies.iter().enumerate() {
         let entropies: Vec<f64> = outcomes.iter().map(|o| o[j].final_entropy).collect();
         let quad = outcomes[0][j].quadrants.map(|_| {
@@ -517,6 +548,15 @@ fn write_report(
     for (a, b, p) in &tests {
         let _ = writeln!(md, "| {} | {} | {:.3e} |", a.name(), b.name(), p);
     }
+    for (j, s) in strategies.iter().enumerate() {
+        let p = wilcoxon_signed_rank(&per_context_mse(j), &empty_per_context, Alternative::Less)?.p_value;
+        let _ = writeln!(md, "| {} | no calibration | {p:.3e} |", s.name());
+    }
+    let _ = writeln!(
+        md,
+        "\nThe reference row conditions the model on no transitions at all. A strategy no better than it means the \
+         model draws nothing usable from that strategy's context set."
+    );
     if let Some((informative, non_informative)) = toy_entropy {
         let _ = writeln!(
             md,
@@ -532,7 +572,7 @@ fn write_report(
         if toy_entropy.is_some() { ", entropy_vs_action.csv/.png" } else { "" }
     );
     write_text(&run.file("report.md"), &md)?;
-    Ok(ContextEvalSummary { mean_mse, tests, toy_entropy, swingup })
+    Ok(ContextEvalSummary { mean_mse, empty_context_mse, tests, toy_entropy, swingup })
 }
 
 #[cfg(test)]
