@@ -372,9 +372,8 @@ fn write_report(
     let mut header = vec!["horizon".to_string()];
     header.extend(strategies.iter().map(|s| format!("mse_{}", s.name().replace('-', "_"))));
     header.push(format!("mse_{}", EMPTY_CONTEXT.replace('-', "_")));
-    let empty_by_horizon: Vec<f64> = (0..horizon)
-        .map(|t| empty_context.iter().map(|m| m[t]).sum::<f64>() / empty_context.len() as f64)
-        .collect();
+    let empty_by_horizon: Vec<f64> =
+        (0..horizon).map(|t| empty_context.iter().map(|m| m[t]).sum::<f64>() / empty_context.len() as f64).collect();
     let header_refs: Vec<&str> = header.iter().map(String::as_str).collect();
     let rows: Vec<Vec<String>> = (0..horizon)
         .map(|t| {

@@ -56,7 +56,7 @@ fn grid_polyline([x_lo, x_hi]: [f64; 2], [y_lo, y_hi]: [f64; 2], cells: u32) -> 
     }
     // The horizontal walk ends on the top edge, at the right end when it made an odd number of
     // turns; the vertical walk starts there, so no stroke cuts across the grid.
-    let ends_right = cells % 2 == 0;
+    let ends_right = cells.is_multiple_of(2);
     for j in 0..=cells {
         let k = if ends_right { cells - j } else { j };
         let x = at(x_lo, x_hi, k);
