@@ -17,7 +17,7 @@ pub fn layout(title: &str, side: usize) -> Event {
         title: title.to_string(),
         panels: vec![
             PanelSpec {
-                title: "search: states per depth".into(),
+                title: "search: stored, expanded per depth".into(),
                 x_label: "depth".into(),
                 series: vec!["bfs/stored".into(), "bfs/expanded".into()],
                 // One search per solve: the panel holds its whole history.

@@ -513,7 +513,7 @@ mod tests {
     fn a_board_solve_fits_80_by_24_without_a_duplicate_chart() {
         let screen = draw(&solve_board_app(), 80, 24);
         assert!(!screen.contains("bfs/stored ="), "the search panel draws it already:\n{screen}");
-        assert!(screen.contains("┌ search: states per depth"), "{screen}");
+        assert!(screen.contains("┌ search: stored, expanded per depth"), "{screen}");
         let (path_top, path_left) =
             find(&screen, "┌ effector path over the board").unwrap_or_else(|| panic!("{screen}"));
         assert_eq!(path_left, 0, "charts fill the left column:\n{screen}");
