@@ -82,7 +82,7 @@ fn layout(title: &str) -> Event {
     Event::Layout {
         title: title.into(),
         panels: vec![PanelSpec {
-            title: "entropy of q(β | calibration transitions) [nats]".into(),
+            title: "entropy of q(β | context) [nats]".into(),
             x_label: "transitions".into(),
             series: vec!["calibration/entropy".into()],
             restart_on_rewind: true,

@@ -208,7 +208,7 @@ pub fn layout(title: &str, state_names: &[String]) -> crate::run::Event {
         title: title.to_string(),
         panels: vec![
             PanelSpec {
-                title: "entropy of q(β | calibration transitions) [nats]".into(),
+                title: "entropy of q(β | context) [nats]".into(),
                 x_label: "transitions".into(),
                 series: vec!["calibration/entropy".into()],
                 restart_on_rewind: false,
@@ -222,7 +222,7 @@ pub fn layout(title: &str, state_names: &[String]) -> crate::run::Event {
                 path: None,
             },
             PanelSpec {
-                title: "EIG planning: best mean posterior entropy (current step)".into(),
+                title: "EIG plan: best entropy (this step)".into(),
                 x_label: "CEM iteration".into(),
                 series: vec!["cem/best_entropy".into()],
                 restart_on_rewind: true,

@@ -147,8 +147,8 @@ fn train_game<G: BoardGame>(
     let title = format!("train SEADS on {}", run.env);
     let panels = vec![
         panel("loss: forward-model NLL per bit", &["train/loss"]),
-        panel("distinct game moves the skills execute", &["seads/distinct_moves"]),
-        panel("mean intrinsic reward (final transitions)", &["seads/intrinsic_reward"]),
+        panel("distinct moves the skills execute", &["seads/distinct_moves"]),
+        panel("intrinsic reward (final steps)", &["seads/intrinsic_reward"]),
         panel("SAC losses", &["sac/critic_loss", "sac/actor_loss"]),
     ];
     let view = training_view(
