@@ -171,7 +171,7 @@ fn solve_learned<G: DenseIndex>(
     let bidirectional = args.search == SearchChoice::Bidirectional;
     let title = format!("solve-board: {} with learned skills", loaded.env.name());
     let outcome = run_job(global, &title, |monitor| {
-        monitor.emit(&layout(&title, game.side()));
+        monitor.emit(&layout(&title, game.side(), false));
         solve_with_skills(
             &game,
             loaded,
@@ -233,7 +233,7 @@ fn solve<G: DenseIndex>(global: &GlobalArgs, args: &SolveBoardArgs, game: G) -> 
     let embodiment = args.embodiment.map(Embodiment::from);
     let title = format!("solve-board: {}", game.name());
     let (board, result, execution) = run_job(global, &title, |monitor| {
-        monitor.emit(&layout(&title, game.side()));
+        monitor.emit(&layout(&title, game.side(), true));
         let board = match (given, args.random_depth) {
             (Some(board), _) => board,
             (None, depth) => {

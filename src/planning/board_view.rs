@@ -10,34 +10,29 @@ use crate::run::{Event, Monitor, PanelSpec, PathView};
 /// Columns of the plan panel once the plan is longer than this; one column below.
 const ONE_COLUMN_MOVES: usize = 6;
 
-/// The panels of a board solve: the search per depth, and the effector's path over an n × n board in
-/// [0, 1]², rows growing downwards as in the printed board.
-pub fn layout(title: &str, side: usize) -> Event {
-    Event::Layout {
-        title: title.to_string(),
-        panels: vec![
-            PanelSpec {
-                title: "search: stored, expanded per depth".into(),
-                x_label: "depth".into(),
-                series: vec!["bfs/stored".into(), "bfs/expanded".into()],
-                // One search per solve: the panel holds its whole history.
-                restart_on_rewind: false,
-                path: None,
-            },
-            PanelSpec {
-                title: "effector path over the board".into(),
-                x_label: "x".into(),
-                series: vec!["effector/x".into(), "effector/y".into()],
-                restart_on_rewind: false,
-                path: Some(PathView {
-                    x: [0.0, 1.0],
-                    y: [0.0, 1.0],
-                    grid: u32::try_from(side).unwrap_or(0),
-                    y_down: true,
-                }),
-            },
-        ],
+/// The panels of a board solve: the search per depth (`with_search`: the search reports its layers),
+/// and the effector's path over an n × n board in [0, 1]², rows growing downwards as in the printed
+/// board.
+pub fn layout(title: &str, side: usize, with_search: bool) -> Event {
+    let mut panels = Vec::new();
+    if with_search {
+        panels.push(PanelSpec {
+            title: "search: stored, expanded per depth".into(),
+            x_label: "depth".into(),
+            series: vec!["bfs/stored".into(), "bfs/expanded".into()],
+            // One search per solve: the panel holds its whole history.
+            restart_on_rewind: false,
+            path: None,
+        });
     }
+    panels.push(PanelSpec {
+        title: "effector path over the board".into(),
+        x_label: "x".into(),
+        series: vec!["effector/x".into(), "effector/y".into()],
+        restart_on_rewind: false,
+        path: Some(PathView { x: [0.0, 1.0], y: [0.0, 1.0], grid: u32::try_from(side).unwrap_or(0), y_down: true }),
+    });
+    Event::Layout { title: title.to_string(), panels }
 }
 
 /// Boards printed next to each other under their captions, two spaces of gap wider than the widest

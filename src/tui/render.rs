@@ -489,7 +489,7 @@ mod tests {
         let monitor = ChannelMonitor::new(sender, Default::default());
         let start = game.pressed(&[0, 7, 12, 18, 24]);
         let mut app = App::new("t");
-        app.ingest(&layout("solve-board: lightsout-5x5", 5));
+        app.ingest(&layout("solve-board: lightsout-5x5", 5, true));
         for depth in 1..=5u64 {
             app.ingest(&Event::scalar("bfs/stored", depth, (depth * depth * 100) as f64));
             app.ingest(&Event::scalar("bfs/expanded", depth, (depth * depth * 40) as f64));

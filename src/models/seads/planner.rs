@@ -248,12 +248,16 @@ pub fn solve_with_skills<G: BoardGame>(
         out.bidirectional |= bi;
         let Some(plan) = result.plan else { break };
         let skills: Vec<String> = plan.iter().map(|k| format!("skill {k}")).collect();
-        monitor.emit(&Event::text(
-            "plan",
-            format!("plan {} of skills:\n{}", out.plans.len() + 1, plan_text(&skills, 0, false)),
-        ));
+        let number = out.plans.len() + 1;
+        let show_plan = |played: usize, playing: bool| {
+            let text = format!("plan {number} of skills:\n{}", plan_text(&skills, played, playing));
+            monitor.emit(&Event::text("plan", text));
+        };
+        show_plan(0, false);
         out.plans.push(plan.clone());
-        for &skill in &plan {
+        let phase = format!("plan {}: skills played", out.plans.len());
+        for (i, &skill) in plan.iter().enumerate() {
+            show_plan(i, true);
             let before = env.board();
             let expected = successors.predict(before, skill);
             env.set_board(before);
@@ -279,6 +283,8 @@ pub fn solve_with_skills<G: BoardGame>(
             }
             out.control_steps += steps;
             out.executed.push(ExecutedSkill { skill, performed, steps });
+            monitor.progress(&phase, i as u64 + 1, plan.len() as u64);
+            show_plan(i + 1, false);
             let caption = format!("after {} skills", out.executed.len());
             show_boards(monitor, game, board, Some((&caption, env.board())));
             if env.board() != expected {
