@@ -13,18 +13,55 @@ use crate::run::PathView;
 /// a replayed file must not make the view allocate without bound.
 const MAX_GRID: u32 = 64;
 
-/// The points of `xs` and `ys` recorded at the same step, oldest first, with y mirrored inside the
-/// plane where the plane's y grows downwards. Both series are fed together, so their newest points
-/// line up; a point without a partner (one series trimmed further) is dropped.
-pub(crate) fn path_points(xs: &Series, ys: &Series, view: &PathView) -> Vec<(f64, f64)> {
-    let [y_lo, y_hi] = plane(view.y, ys);
+/// What a path panel draws: its plane, the path on it and the grid under it.
+pub(crate) struct PathPlot {
+    x: [f64; 2],
+    y: [f64; 2],
+    points: Vec<(f64, f64)>,
+    grid: Vec<(f64, f64)>,
+}
+
+impl PathPlot {
+    pub(crate) fn new(xs: &Series, ys: &Series, view: &PathView) -> Self {
+        let x = plane(view.x, xs);
+        let y = plane(view.y, ys);
+        PathPlot { x, y, points: path_points(xs, ys, view.y_down, y), grid: grid_polyline(x, y, view.grid) }
+    }
+
+    /// The grid in grey, the path in cyan, its newest point as a yellow block.
+    pub(crate) fn chart<'a>(&'a self, block: Block<'a>) -> Chart<'a> {
+        let line = |points: &'a [(f64, f64)], color: Color| {
+            Dataset::default()
+                .marker(Marker::Braille)
+                .graph_type(GraphType::Line)
+                .style(Style::default().fg(color))
+                .data(points)
+        };
+        let mut datasets = vec![line(&self.grid, Color::DarkGray), line(&self.points, Color::Cyan)];
+        if let Some(last) = self.points.len().checked_sub(1) {
+            datasets.push(
+                Dataset::default()
+                    .marker(Marker::Block)
+                    .graph_type(GraphType::Scatter)
+                    .style(Style::default().fg(Color::Yellow))
+                    .data(&self.points[last..]),
+            );
+        }
+        Chart::new(datasets).block(block).x_axis(Axis::default().bounds(self.x)).y_axis(Axis::default().bounds(self.y))
+    }
+}
+
+/// The points of `xs` and `ys` recorded at the same step, oldest first, with y mirrored inside
+/// `[y_lo, y_hi]` where the plane's y grows downwards. Both series are fed together, so their newest
+/// points line up; a point without a partner (one series trimmed further) is dropped.
+fn path_points(xs: &Series, ys: &Series, y_down: bool, [y_lo, y_hi]: [f64; 2]) -> Vec<(f64, f64)> {
     let mut pairs: Vec<(f64, f64)> = xs
         .points()
         .iter()
         .rev()
         .zip(ys.points().iter().rev())
         .filter(|(x, y)| x.0 == y.0)
-        .map(|(x, y)| (x.1, if view.y_down { y_lo + y_hi - y.1 } else { y.1 }))
+        .map(|(x, y)| (x.1, if y_down { y_lo + y_hi - y.1 } else { y.1 }))
         .collect();
     pairs.reverse();
     pairs
@@ -66,43 +103,6 @@ fn grid_polyline([x_lo, x_hi]: [f64; 2], [y_lo, y_hi]: [f64; 2], cells: u32) -> 
     points
 }
 
-/// The chart of a path panel. `path` comes from [`path_points`]; `grid` must outlive the chart, so the
-/// caller holds it (see [`grid_for`]).
-pub(crate) fn path_chart<'a>(
-    path: &'a [(f64, f64)],
-    grid: &'a [(f64, f64)],
-    view: &PathView,
-    xs: &Series,
-    ys: &Series,
-    block: Block<'a>,
-) -> Chart<'a> {
-    let x = plane(view.x, xs);
-    let y = plane(view.y, ys);
-    let line = |points: &'a [(f64, f64)], color: Color| {
-        Dataset::default()
-            .marker(Marker::Braille)
-            .graph_type(GraphType::Line)
-            .style(Style::default().fg(color))
-            .data(points)
-    };
-    let mut datasets = vec![line(grid, Color::DarkGray), line(path, Color::Cyan)];
-    if let Some(last) = path.len().checked_sub(1) {
-        datasets.push(
-            Dataset::default()
-                .marker(Marker::Block)
-                .graph_type(GraphType::Scatter)
-                .style(Style::default().fg(Color::Yellow))
-                .data(&path[last..]),
-        );
-    }
-    Chart::new(datasets).block(block).x_axis(Axis::default().bounds(x)).y_axis(Axis::default().bounds(y))
-}
-
-/// The grid polyline of a path panel over the plane its series are drawn on.
-pub(crate) fn grid_for(view: &PathView, xs: &Series, ys: &Series) -> Vec<(f64, f64)> {
-    grid_polyline(plane(view.x, xs), plane(view.y, ys), view.grid)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -123,8 +123,8 @@ mod tests {
     fn points_pair_by_step_and_mirror_a_downward_y() {
         let xs = series(&[(1, 0.1), (2, 0.2), (3, 0.3)]);
         let ys = series(&[(2, 0.9), (3, 0.7)]);
-        assert_eq!(path_points(&xs, &ys, &board(false)), vec![(0.2, 0.9), (0.3, 0.7)]);
-        let flipped = path_points(&xs, &ys, &board(true));
+        assert_eq!(PathPlot::new(&xs, &ys, &board(false)).points, vec![(0.2, 0.9), (0.3, 0.7)]);
+        let flipped = PathPlot::new(&xs, &ys, &board(true)).points;
         assert!((flipped[0].1 - 0.1).abs() < 1e-12 && (flipped[1].1 - 0.3).abs() < 1e-12, "{flipped:?}");
     }
 

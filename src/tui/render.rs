@@ -10,7 +10,7 @@ use ratatui::Frame;
 use super::app::{App, Status};
 use super::method::{method_rows, stack};
 use super::panel::Panel;
-use super::path::{grid_for, path_chart, path_points};
+use super::path::PathPlot;
 use super::plot::{color, format_value, line_chart, short_names, Trace};
 use super::text_panel::TextPanel;
 use crate::run::monitor::PhaseProgress;
@@ -187,9 +187,7 @@ fn render_panel(panel: &Panel, frame: &mut Frame, area: Rect) {
     if let Some(view) = &spec.path {
         let mut series = panel.series().map(|(_, s)| s);
         if let (Some(xs), Some(ys)) = (series.next(), series.next()) {
-            let points = path_points(xs, ys, view);
-            let grid = grid_for(view, xs, ys);
-            frame.render_widget(path_chart(&points, &grid, view, xs, ys, block), area);
+            frame.render_widget(PathPlot::new(xs, ys, view).chart(block), area);
             return;
         }
     }
@@ -528,6 +526,35 @@ mod tests {
         assert!(plan_top > top, "{screen}");
         for line in ["✓  1 push (0, 0)", "▶  3 push (2, 2)", "   5 push (4, 4)"] {
             assert!(screen.contains(line), "missing {line:?}:\n{screen}");
+        }
+    }
+
+    /// A replayed metrics file may carry any path plane: none of them may panic or allocate without bound.
+    #[test]
+    fn absurd_path_planes_render() {
+        use crate::run::{PanelSpec, PathView};
+        for (x, y, grid) in [
+            ([f64::NAN, 1.0], [0.0, f64::INFINITY], u32::MAX),
+            ([1.0, 0.0], [5.0, 5.0], 0),
+            ([-f64::MAX, f64::MAX], [0.0, 1.0], 64),
+        ] {
+            let mut app = App::new("t");
+            app.ingest(&Event::Layout {
+                title: "t".into(),
+                panels: vec![PanelSpec {
+                    title: "path".into(),
+                    x_label: "x".into(),
+                    series: vec!["p/x".into(), "p/y".into()],
+                    restart_on_rewind: false,
+                    path: Some(PathView { x, y, grid, y_down: true }),
+                }],
+            });
+            for step in 0..3 {
+                app.ingest(&Event::scalar("p/x", step, step as f64));
+                app.ingest(&Event::scalar("p/y", step, f64::NAN));
+            }
+            assert!(draw(&app, 80, 24).contains("┌ path "));
+            draw(&app, 3, 3);
         }
     }
 
