@@ -66,7 +66,9 @@ pub struct CalibrateArgs {
     /// β samples of the Monte Carlo information gain.
     #[arg(long, default_value_t = 20)]
     beta_samples: usize,
-    /// Start state, comma-separated in the env's state order (pendulum: θ,θ̇).
+    /// Start state, comma-separated in the env's state order (pendulum: θ,θ̇). Default: the thesis' start
+    /// (toy x = 0; MountainCar x = ẋ = 0; pendulum:quadrant hanging down, |θ − π|, |θ̇| ≤ 0.05, drawn from
+    /// --seed), elsewhere a reset drawn from --seed.
     #[arg(long)]
     init_state: Option<String>,
     /// Where to write the calibration transitions (default: datasets/calib-<env>-<strategy>-i<S>.mcap).

@@ -217,7 +217,7 @@ pub fn evaluate(
             .collect();
         empty_context.push(mse_by_horizon(model, &empty_beta, &validation, settings.validation_steps));
         // One start for every strategy: the thesis' fixed start, or one reset draw.
-        let start = crate::models::context::calibration::default_start(env).unwrap_or_else(|| {
+        let start = crate::models::context::calibration::default_start(env, &mut rng).unwrap_or_else(|| {
             env_k.reset(&mut rng);
             env_k.state()
         });

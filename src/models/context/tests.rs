@@ -196,3 +196,20 @@ fn model_spec_sizes_must_agree_and_be_plausible() {
     let huge = super::ModelSpec { action_dim: usize::MAX, ..spec };
     assert!(huge.validate().unwrap_err().to_string().contains("1..=256"));
 }
+
+#[test]
+fn quadrant_pendulum_calibration_starts_hanging_down_nearly_at_rest() {
+    use super::calibration::default_start;
+    use crate::envs::registry::parse_env;
+    use crate::util::seeding::rng_for;
+    use std::f64::consts::PI;
+    let quadrant = parse_env("pendulum:quadrant").unwrap();
+    let starts: Vec<Vec<f64>> =
+        (0..50).map(|seed| default_start(&quadrant, &mut rng_for(seed, &[4])).expect("a thesis start")).collect();
+    for s in &starts {
+        assert!((s[0] - PI).abs() <= 0.05 && s[1].abs() <= 0.05, "{s:?} is not hanging down at rest");
+    }
+    assert_ne!(starts[0], starts[1], "the start is drawn from the seed");
+    assert_eq!(Some(starts[3].clone()), default_start(&quadrant, &mut rng_for(3, &[4])));
+    assert_eq!(default_start(&parse_env("pendulum").unwrap(), &mut rng_for(0, &[4])), None);
+}
