@@ -421,10 +421,15 @@ fn eval_context(global: &GlobalArgs, provenance: &Provenance, a: ContextArgs) ->
     let summary = run_job(global, "eval context", |monitor| {
         mbrl::eval::context::evaluate(&model, &env, &settings, provenance, &a.out, monitor)
     })?;
-    for (s, m) in strategies.iter().zip(&summary.mean_mse) {
-        say!("{:<10} mean prediction MSE {m:.4e}", s.name());
+    for ((s, m), r) in strategies.iter().zip(&summary.mean_mse).zip(&summary.action_response) {
+        say!("{:<10} mean prediction MSE {m:.4e}, action response {r:.3}", s.name());
     }
-    say!("no calibration (empty context, reference) mean prediction MSE {:.4e}", summary.empty_context_mse);
+    say!(
+        "no calibration (empty context, reference) mean prediction MSE {:.4e}, action response {:.3}",
+        summary.empty_context_mse,
+        summary.empty_context_action_response
+    );
+    say!("(action response: the model's one-step response to the action over the simulator's; 1 right, 0 ignored)");
     for (better, worse, p) in &summary.tests {
         say!("Wilcoxon: {} lower than {}: p = {p:.3e}", better.name(), worse.name());
     }

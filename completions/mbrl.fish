@@ -144,7 +144,7 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l candidates -d 'C
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l elites -d 'CEM elites' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l iters -d 'CEM iterations' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l beta-samples -d 'β samples of the Monte Carlo information gain' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l init-state -d 'Start state, comma-separated in the env\'s state order (pendulum: θ,θ̇)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l init-state -d 'Start state, comma-separated in the env\'s state order (pendulum: θ,θ̇). Default: the thesis\' start (toy x = 0; MountainCar x = ẋ = 0; pendulum:quadrant hanging down, |θ − π|, |θ̇| ≤ 0.05, drawn from --seed), elsewhere a reset drawn from --seed' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l out -d 'Where to write the calibration transitions (default: datasets/calib-<env>-<strategy>-i<S>.mcap)' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l threads -d 'Worker threads (0 = one per core)' -r

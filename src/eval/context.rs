@@ -55,6 +55,7 @@ struct Outcome {
     final_entropy: f64,
     quadrants: Option<usize>,
     swingup_return: Option<f64>,
+    action_response: f64,
 }
 
 pub struct ContextEvalSummary {
@@ -63,6 +64,10 @@ pub struct ContextEvalSummary {
     /// The same for the model given no calibration at all (the mean of q(β | ∅)): the reference that shows
     /// whether the model uses its context.
     pub empty_context_mse: f64,
+    /// Median over contexts of the action response (model / simulator, 1 = right, 0 = action ignored), per
+    /// strategy, and for the model given no calibration.
+    pub action_response: Vec<f64>,
+    pub empty_context_action_response: f64,
     /// One-sided p-values that the first strategy named has lower MSE than the second.
     pub tests: Vec<(Strategy, Strategy, f64)>,
     /// Toy only: (mean entropy after one informative transition, after one non-informative transition).
@@ -202,6 +207,7 @@ pub fn evaluate(
     let is_quadrant = env.canonical() == "pendulum:quadrant";
     let mut outcomes: Vec<Vec<Outcome>> = Vec::with_capacity(settings.contexts);
     let mut empty_context: Vec<Vec<f64>> = Vec::with_capacity(settings.contexts);
+    let mut empty_response: Vec<f64> = Vec::with_capacity(settings.contexts);
     let empty_beta = model.fast.belief(&model.fast.pool(&[]), 1).mean;
     let mut ground_truth_returns = Vec::new();
     for k in 0..settings.contexts as u64 {
@@ -216,6 +222,7 @@ pub fn evaluate(
             .map(|_| random_rollout(env_k.as_mut(), settings.validation_steps, &mut rng))
             .collect();
         empty_context.push(mse_by_horizon(model, &empty_beta, &validation, settings.validation_steps));
+        empty_response.push(action_response(model, &empty_beta, env_k.as_mut(), &validation));
         // One start for every strategy: the thesis' fixed start, or one reset draw.
         let start = crate::models::context::calibration::default_start(env, &mut rng).unwrap_or_else(|| {
             env_k.reset(&mut rng);
@@ -252,6 +259,7 @@ pub fn evaluate(
             let rows = context_rows(model, &calibration.rollout);
             let beta = model.fast.belief(&model.fast.pool(&rows), 1).mean;
             let mse_by_horizon = mse_by_horizon(model, &beta, &validation, settings.validation_steps);
+            let response = action_response(model, &beta, env_k.as_mut(), &validation);
             let quadrants = is_quadrant.then(|| {
                 let mut seen = [false; 4];
                 for s in &calibration.rollout.states {
@@ -271,14 +279,57 @@ pub fn evaluate(
                 }
                 None => None,
             };
-            per_strategy.push(Outcome { mse_by_horizon, final_entropy, quadrants, swingup_return });
+            per_strategy.push(Outcome {
+                mse_by_horizon,
+                final_entropy,
+                quadrants,
+                swingup_return,
+                action_response: response,
+            });
         }
         outcomes.push(per_strategy);
     }
     monitor.progress("contexts", settings.contexts as u64, settings.contexts as u64);
-    let summary = write_report(model, env, settings, &run, &outcomes, &empty_context, &ground_truth_returns)?;
+    let summary =
+        write_report(model, env, settings, &run, &outcomes, (&empty_context, &empty_response), &ground_truth_returns)?;
     metrics.emit(&Event::Finished { ok: true });
     Ok(summary)
+}
+
+/// How the model's one-step prediction responds to the action, against the simulator from the same states:
+/// Σ⟨Δ_model, Δ_true⟩ / Σ‖Δ_true‖², where Δ is the next state (model space) under the highest action minus under
+/// the middle of the action range. 1: the response is right; 0: the model ignores the action (its context did not
+/// tell it how the action acts here); negative: the wrong direction. It separates a model that cannot use a
+/// context from a context that holds nothing, which the prediction MSE alone does not.
+fn action_response(model: &LoadedModel, beta: &[f32], env: &mut dyn crate::envs::Env, validation: &[Rollout]) -> f64 {
+    let spec = env.spec();
+    let high: Vec<f64> = spec.action_high.clone();
+    let middle: Vec<f64> = spec.action_low.iter().zip(&high).map(|(l, h)| 0.5 * (l + h)).collect();
+    let actions: Vec<f32> = high.iter().chain(&middle).map(|a| *a as f32).collect();
+    let betas: Vec<f32> = beta.iter().chain(beta).copied().collect();
+    let s = model.fast.state_dim;
+    let mut predicted = vec![0.0f32; 2 * s];
+    let mut scratch = RolloutScratch::default();
+    let (mut along, mut norm) = (0.0, 0.0);
+    for state in validation.iter().flat_map(|r| &r.states[..r.len()]) {
+        model.fast.rollout_means(&model.features(state), &actions, &betas, 2, 1, &mut predicted, &mut scratch);
+        let mut next = |action: &[f64]| {
+            env.set_state(state);
+            env.step(action);
+            model.features(&env.state())
+        };
+        let (true_high, true_middle) = (next(&high), next(&middle));
+        for d in 0..s {
+            let true_delta = (true_high[d] - true_middle[d]) as f64;
+            along += (predicted[d] - predicted[s + d]) as f64 * true_delta;
+            norm += true_delta * true_delta;
+        }
+    }
+    if norm > 0.0 {
+        along / norm
+    } else {
+        f64::NAN
+    }
 }
 
 /// Per-step MSE of open-loop predictions with context `beta`, averaged over the validation rollouts.
@@ -321,7 +372,7 @@ fn write_report(
     settings: &ContextEvalSettings,
     run: &RunDir,
     outcomes: &[Vec<Outcome>],
-    empty_context: &[Vec<f64>],
+    (empty_context, empty_response): (&[Vec<f64>], &[f64]),
     ground_truth_returns: &[f64],
 ) -> Result<ContextEvalSummary> {
     let strategies = &settings.strategies;
@@ -342,6 +393,7 @@ fn write_report(
             format!("{prior_entropy:.4}"),
             String::new(),
             String::new(),
+            format!("{:.4}", empty_response[k]),
         ]);
         for (j, s) in strategies.iter().enumerate() {
             rows.push(vec![
@@ -351,12 +403,13 @@ fn write_report(
                 format!("{:.4}", o[j].final_entropy),
                 o[j].quadrants.map(|q| q.to_string()).unwrap_or_default(),
                 o[j].swingup_return.map(|r| format!("{r:.3}")).unwrap_or_default(),
+                format!("{:.4}", o[j].action_response),
             ]);
         }
     }
     write_csv(
         &run.file("per_context.csv"),
-        &["context", "strategy", "mean_mse", "final_entropy", "quadrants", "swingup_return"],
+        &["context", "strategy", "mean_mse", "final_entropy", "quadrants", "swingup_return", "action_response"],
         &rows,
     )?;
 
@@ -489,19 +542,20 @@ fn write_report(
     let has_quadrants = outcomes[0][0].quadrants.is_some();
     let _ = writeln!(
         md,
-        "| strategy | mean MSE | median final entropy [nats] |{}{}",
+        "| strategy | mean MSE | median final entropy [nats] | action response (model / simulator) |{}{}",
         if has_quadrants { " contexts visiting all 4 quadrants |" } else { "" },
         if swingup.is_some() { " mean swing-up return |" } else { "" }
     );
     let _ = writeln!(
         md,
-        "|---|---|---|{}{}",
+        "|---|---|---|---|{}{}",
         if has_quadrants { "---|" } else { "" },
         if swingup.is_some() { "---|" } else { "" }
     );
     let _ = writeln!(
         md,
-        "| no calibration (empty context, reference) | {empty_context_mse:.4e} | {prior_entropy:.3} |{}{}",
+        "| no calibration (empty context, reference) | {empty_context_mse:.4e} | {prior_entropy:.3} | {:.3} |{}{}",
+        median(empty_response),
         if has_quadrants { " - |" } else { "" },
         if swingup.is_some() { " - |" } else { "" }
     );
@@ -512,10 +566,11 @@ fn write_report(
         });
         let _ = writeln!(
             md,
-            "| {} | {:.4e} | {:.3} |{}{}",
+            "| {} | {:.4e} | {:.3} | {:.3} |{}{}",
             s.name(),
             mean_mse[j],
             super::stats::quantile(&entropies, 0.5).unwrap_or(f64::NAN),
+            median(&outcomes.iter().map(|o| o[j].action_response).collect::<Vec<_>>()),
             quad.unwrap_or_default(),
             swingup.as_ref().map(|sw| format!(" {:.1} |", sw.mean_return[j])).unwrap_or_default()
         );
@@ -554,7 +609,9 @@ fn write_report(
     let _ = writeln!(
         md,
         "\nThe reference row conditions the model on no transitions at all. A strategy no better than it means the \
-         model draws nothing usable from that strategy's context set."
+         model draws nothing usable from that strategy's context set. The action response (median over contexts) \
+         compares the model's one-step prediction under the highest minus the middle action with the simulator's, \
+         from every validation state: 1 is the true response, 0 a model that ignores the action."
     );
     if let Some((informative, non_informative)) = toy_entropy {
         let _ = writeln!(
@@ -571,7 +628,23 @@ fn write_report(
         if toy_entropy.is_some() { ", entropy_vs_action.csv/.png" } else { "" }
     );
     write_text(&run.file("report.md"), &md)?;
-    Ok(ContextEvalSummary { mean_mse, empty_context_mse, tests, toy_entropy, swingup })
+    let action_response = (0..strategies.len())
+        .map(|j| median(&outcomes.iter().map(|o| o[j].action_response).collect::<Vec<_>>()))
+        .collect();
+    Ok(ContextEvalSummary {
+        mean_mse,
+        empty_context_mse,
+        action_response,
+        empty_context_action_response: median(empty_response),
+        tests,
+        toy_entropy,
+        swingup,
+    })
+}
+
+/// The median of the finite values (NaN when there are none).
+fn median(values: &[f64]) -> f64 {
+    super::stats::quantile(values, 0.5).unwrap_or(f64::NAN)
 }
 
 #[cfg(test)]
@@ -626,5 +699,9 @@ mod tests {
         assert!(p < 0.05, "open-loop vs random: p = {p}, mean MSE {:?}", summary.mean_mse);
         let (informative, non_informative) = summary.toy_entropy.unwrap();
         assert!(informative < non_informative, "entropy {informative} (informative) vs {non_informative}");
+        // Without a context the model cannot know the sign of α, so it predicts no action effect; one
+        // informative transition tells it.
+        let (empty, open_loop) = (summary.empty_context_action_response, summary.action_response[1]);
+        assert!(empty.abs() < 0.3 && open_loop > 0.6, "action response: no context {empty}, open-loop {open_loop}");
     }
 }
