@@ -222,7 +222,8 @@ pub fn evaluate(
             .map(|_| random_rollout(env_k.as_mut(), settings.validation_steps, &mut rng))
             .collect();
         empty_context.push(mse_by_horizon(model, &empty_beta, &validation, settings.validation_steps));
-        empty_response.push(action_response(model, &empty_beta, env_k.as_mut(), &validation));
+        let probe = action_probe(model, env_k.as_mut(), &validation);
+        empty_response.push(action_response(model, &empty_beta, &probe));
         // One start for every strategy: the thesis' fixed start, or one reset draw.
         let start = crate::models::context::calibration::default_start(env, &mut rng).unwrap_or_else(|| {
             env_k.reset(&mut rng);
@@ -259,7 +260,7 @@ pub fn evaluate(
             let rows = context_rows(model, &calibration.rollout);
             let beta = model.fast.belief(&model.fast.pool(&rows), 1).mean;
             let mse_by_horizon = mse_by_horizon(model, &beta, &validation, settings.validation_steps);
-            let response = action_response(model, &beta, env_k.as_mut(), &validation);
+            let response = action_response(model, &beta, &probe);
             let quadrants = is_quadrant.then(|| {
                 let mut seen = [false; 4];
                 for s in &calibration.rollout.states {
@@ -296,33 +297,55 @@ pub fn evaluate(
     Ok(summary)
 }
 
-/// How the model's one-step prediction responds to the action, against the simulator from the same states:
-/// Σ⟨Δ_model, Δ_true⟩ / Σ‖Δ_true‖², where Δ is the next state (model space) under the highest action minus under
-/// the middle of the action range. 1: the response is right; 0: the model ignores the action (its context did not
-/// tell it how the action acts here); negative: the wrong direction. It separates a model that cannot use a
-/// context from a context that holds nothing, which the prediction MSE alone does not.
-fn action_response(model: &LoadedModel, beta: &[f32], env: &mut dyn crate::envs::Env, validation: &[Rollout]) -> f64 {
+/// The simulator's one-step response to the action from every validation state, measured once per context and
+/// shared by every β compared on it: Δ = next state (model space) under the highest action minus under the middle
+/// of the action range.
+struct ActionProbe {
+    /// The highest and the middle action, as the model takes them.
+    actions: Vec<f32>,
+    /// Model-space start states, one row each.
+    starts: Vec<Vec<f32>>,
+    /// The simulator's Δ per start, state_dim each.
+    true_deltas: Vec<f32>,
+}
+
+fn action_probe(model: &LoadedModel, env: &mut dyn crate::envs::Env, validation: &[Rollout]) -> ActionProbe {
     let spec = env.spec();
-    let high: Vec<f64> = spec.action_high.clone();
+    let high = spec.action_high.clone();
     let middle: Vec<f64> = spec.action_low.iter().zip(&high).map(|(l, h)| 0.5 * (l + h)).collect();
-    let actions: Vec<f32> = high.iter().chain(&middle).map(|a| *a as f32).collect();
-    let betas: Vec<f32> = beta.iter().chain(beta).copied().collect();
-    let s = model.fast.state_dim;
-    let mut predicted = vec![0.0f32; 2 * s];
-    let mut scratch = RolloutScratch::default();
-    let (mut along, mut norm) = (0.0, 0.0);
+    let mut probe = ActionProbe {
+        actions: high.iter().chain(&middle).map(|a| *a as f32).collect(),
+        starts: Vec::new(),
+        true_deltas: Vec::new(),
+    };
     for state in validation.iter().flat_map(|r| &r.states[..r.len()]) {
-        model.fast.rollout_means(&model.features(state), &actions, &betas, 2, 1, &mut predicted, &mut scratch);
         let mut next = |action: &[f64]| {
             env.set_state(state);
             env.step(action);
             model.features(&env.state())
         };
         let (true_high, true_middle) = (next(&high), next(&middle));
-        for d in 0..s {
-            let true_delta = (true_high[d] - true_middle[d]) as f64;
-            along += (predicted[d] - predicted[s + d]) as f64 * true_delta;
-            norm += true_delta * true_delta;
+        probe.true_deltas.extend(true_high.iter().zip(&true_middle).map(|(h, m)| h - m));
+        probe.starts.push(model.features(state));
+    }
+    probe
+}
+
+/// How the model's one-step prediction under `beta` responds to the action, against the simulator:
+/// Σ⟨Δ_model, Δ_true⟩ / Σ‖Δ_true‖². 1: the response is right; 0: the model ignores the action (its context did not
+/// tell it how the action acts here); negative: the wrong direction. It separates a model that cannot use a
+/// context from a context that holds nothing, which the prediction MSE alone does not.
+fn action_response(model: &LoadedModel, beta: &[f32], probe: &ActionProbe) -> f64 {
+    let s = model.fast.state_dim;
+    let betas: Vec<f32> = beta.iter().chain(beta).copied().collect();
+    let mut predicted = vec![0.0f32; 2 * s];
+    let mut scratch = RolloutScratch::default();
+    let (mut along, mut norm) = (0.0, 0.0);
+    for (start, true_delta) in probe.starts.iter().zip(probe.true_deltas.chunks_exact(s)) {
+        model.fast.rollout_means(start, &probe.actions, &betas, 2, 1, &mut predicted, &mut scratch);
+        for (d, t) in true_delta.iter().enumerate() {
+            along += ((predicted[d] - predicted[s + d]) * t) as f64;
+            norm += (t * t) as f64;
         }
     }
     if norm > 0.0 {
@@ -382,6 +405,10 @@ fn write_report(
     let empty_per_context: Vec<f64> = empty_context.iter().map(|m| mean(m).unwrap_or(f64::NAN)).collect();
     let empty_context_mse = mean(&empty_per_context).unwrap_or(f64::NAN);
     let prior_entropy = gaussian_entropy(&model.fast.belief(&model.fast.pool(&[]), 1).std);
+    let action_response: Vec<f64> = (0..strategies.len())
+        .map(|j| median(&outcomes.iter().map(|o| o[j].action_response).collect::<Vec<_>>()))
+        .collect();
+    let empty_context_action_response = median(empty_response);
 
     // Per-context table.
     let mut rows = Vec::new();
@@ -554,8 +581,8 @@ fn write_report(
     );
     let _ = writeln!(
         md,
-        "| no calibration (empty context, reference) | {empty_context_mse:.4e} | {prior_entropy:.3} | {:.3} |{}{}",
-        median(empty_response),
+        "| no calibration (empty context, reference) | {empty_context_mse:.4e} | {prior_entropy:.3} | \
+         {empty_context_action_response:.3} |{}{}",
         if has_quadrants { " - |" } else { "" },
         if swingup.is_some() { " - |" } else { "" }
     );
@@ -569,8 +596,8 @@ fn write_report(
             "| {} | {:.4e} | {:.3} | {:.3} |{}{}",
             s.name(),
             mean_mse[j],
-            super::stats::quantile(&entropies, 0.5).unwrap_or(f64::NAN),
-            median(&outcomes.iter().map(|o| o[j].action_response).collect::<Vec<_>>()),
+            median(&entropies),
+            action_response[j],
             quad.unwrap_or_default(),
             swingup.as_ref().map(|sw| format!(" {:.1} |", sw.mean_return[j])).unwrap_or_default()
         );
@@ -628,14 +655,11 @@ fn write_report(
         if toy_entropy.is_some() { ", entropy_vs_action.csv/.png" } else { "" }
     );
     write_text(&run.file("report.md"), &md)?;
-    let action_response = (0..strategies.len())
-        .map(|j| median(&outcomes.iter().map(|o| o[j].action_response).collect::<Vec<_>>()))
-        .collect();
     Ok(ContextEvalSummary {
         mean_mse,
         empty_context_mse,
         action_response,
-        empty_context_action_response: median(empty_response),
+        empty_context_action_response,
         tests,
         toy_entropy,
         swingup,
