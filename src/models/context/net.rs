@@ -74,6 +74,9 @@ pub struct LossParts {
     pub single_step: Tensor<1>,
     pub multi_step: Tensor<1>,
     pub kl: Tensor<1>,
+    /// Mean std of q(β | C ∪ D) and of q(β | C): how certain the encoder is, with and without the chunk.
+    pub posterior_std: Tensor<1>,
+    pub context_std: Tensor<1>,
 }
 
 impl ContextNet {
@@ -183,6 +186,8 @@ impl ContextNet {
         let empty = self.belief(zeros([1, config.transition_features], device));
 
         let kl_empty = kl_standard_normal(&empty).sum();
+        let posterior_std = posterior.std.clone().mean();
+        let context_std = prior.std.clone().mean();
         let kl_per_dim = kl_gaussians(&posterior, &prior).clamp_min(config.kl_floor as f32);
         let kl_context = kl_per_dim.sum_dim(1).mean();
 
@@ -241,7 +246,7 @@ impl ContextNet {
         let multi_step = multi_step.reshape([b]).mean();
         let kl = kl_empty + kl_context * config.kl_weight as f32;
         let loss = (reconstruction.clone() + single_step.clone() + multi_step.clone()).neg() + kl.clone();
-        LossParts { loss, reconstruction, single_step, multi_step, kl }
+        LossParts { loss, reconstruction, single_step, multi_step, kl, posterior_std, context_std }
     }
 }
 

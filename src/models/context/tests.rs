@@ -166,6 +166,11 @@ fn training_lowers_the_loss_and_resumes_identically() {
     }
     let later = trainer.validate().unwrap().unwrap();
     assert!(later < first - 1.0, "validation loss {first} → {later}");
+    // Adding the chunk to the context can only sharpen the belief (monotone std head), so the logged mean std
+    // of q(β | C ∪ D) is never above that of q(β | C).
+    let scalar = |name: &str| trainer.step_scalars().iter().find(|(n, _)| *n == name).map(|(_, v)| *v).unwrap();
+    let (posterior, context) = (scalar("context/posterior_std"), scalar("context/context_std"));
+    assert!(0.01 < posterior && posterior <= context * (1.0 + 1e-6), "{posterior} vs {context}");
 
     // Stop at step 30 and restore into a fresh trainer: the next steps give the same losses.
     let mut a = ContextTrainer::new(config.clone(), 7, train.clone(), valid.clone()).unwrap();

@@ -122,6 +122,8 @@ impl TrainingMethod for ContextTrainer {
             ("context/loglik_single_step", scalar(&parts.single_step)),
             ("context/loglik_multi_step", scalar(&parts.multi_step)),
             ("context/kl_weighted", scalar(&parts.kl)),
+            ("context/posterior_std", scalar(&parts.posterior_std)),
+            ("context/context_std", scalar(&parts.context_std)),
             ("context/p_context_from_target", from_target),
         ];
         self.load_params()?;
