@@ -58,6 +58,12 @@ struct Outcome {
     action_response: f64,
 }
 
+/// The model given no calibration at all (the mean of q(β | ∅)) in one context: the reference row.
+struct NoCalibration {
+    mse_by_horizon: Vec<f64>,
+    action_response: f64,
+}
+
 pub struct ContextEvalSummary {
     /// Mean over contexts of the mean validation MSE, per strategy (in `settings.strategies` order).
     pub mean_mse: Vec<f64>,
@@ -206,8 +212,7 @@ pub fn evaluate(
     let seed = provenance.seed;
     let is_quadrant = env.canonical() == "pendulum:quadrant";
     let mut outcomes: Vec<Vec<Outcome>> = Vec::with_capacity(settings.contexts);
-    let mut empty_context: Vec<Vec<f64>> = Vec::with_capacity(settings.contexts);
-    let mut empty_response: Vec<f64> = Vec::with_capacity(settings.contexts);
+    let mut no_calibration: Vec<NoCalibration> = Vec::with_capacity(settings.contexts);
     let empty_beta = model.fast.belief(&model.fast.pool(&[]), 1).mean;
     let mut ground_truth_returns = Vec::new();
     for k in 0..settings.contexts as u64 {
@@ -221,9 +226,11 @@ pub fn evaluate(
         let validation: Vec<Rollout> = (0..settings.validation_rollouts)
             .map(|_| random_rollout(env_k.as_mut(), settings.validation_steps, &mut rng))
             .collect();
-        empty_context.push(mse_by_horizon(model, &empty_beta, &validation, settings.validation_steps));
         let probe = action_probe(model, env_k.as_mut(), &validation);
-        empty_response.push(action_response(model, &empty_beta, &probe));
+        no_calibration.push(NoCalibration {
+            mse_by_horizon: mse_by_horizon(model, &empty_beta, &validation, settings.validation_steps),
+            action_response: action_response(model, &empty_beta, &probe),
+        });
         // One start for every strategy: the thesis' fixed start, or one reset draw.
         let start = crate::models::context::calibration::default_start(env, &mut rng).unwrap_or_else(|| {
             env_k.reset(&mut rng);
@@ -291,8 +298,7 @@ pub fn evaluate(
         outcomes.push(per_strategy);
     }
     monitor.progress("contexts", settings.contexts as u64, settings.contexts as u64);
-    let summary =
-        write_report(model, env, settings, &run, &outcomes, (&empty_context, &empty_response), &ground_truth_returns)?;
+    let summary = write_report(model, env, settings, &run, &outcomes, &no_calibration, &ground_truth_returns)?;
     metrics.emit(&Event::Finished { ok: true });
     Ok(summary)
 }
@@ -395,20 +401,21 @@ fn write_report(
     settings: &ContextEvalSettings,
     run: &RunDir,
     outcomes: &[Vec<Outcome>],
-    (empty_context, empty_response): (&[Vec<f64>], &[f64]),
+    no_calibration: &[NoCalibration],
     ground_truth_returns: &[f64],
 ) -> Result<ContextEvalSummary> {
     let strategies = &settings.strategies;
     let per_context_mse =
         |j: usize| -> Vec<f64> { outcomes.iter().map(|o| mean(&o[j].mse_by_horizon).unwrap_or(f64::NAN)).collect() };
     let mean_mse: Vec<f64> = (0..strategies.len()).map(|j| mean(&per_context_mse(j)).unwrap_or(f64::NAN)).collect();
-    let empty_per_context: Vec<f64> = empty_context.iter().map(|m| mean(m).unwrap_or(f64::NAN)).collect();
+    let empty_per_context: Vec<f64> =
+        no_calibration.iter().map(|n| mean(&n.mse_by_horizon).unwrap_or(f64::NAN)).collect();
     let empty_context_mse = mean(&empty_per_context).unwrap_or(f64::NAN);
     let prior_entropy = gaussian_entropy(&model.fast.belief(&model.fast.pool(&[]), 1).std);
     let action_response: Vec<f64> = (0..strategies.len())
         .map(|j| median(&outcomes.iter().map(|o| o[j].action_response).collect::<Vec<_>>()))
         .collect();
-    let empty_context_action_response = median(empty_response);
+    let empty_context_action_response = median(&no_calibration.iter().map(|n| n.action_response).collect::<Vec<_>>());
 
     // Per-context table.
     let mut rows = Vec::new();
@@ -420,7 +427,7 @@ fn write_report(
             format!("{prior_entropy:.4}"),
             String::new(),
             String::new(),
-            format!("{:.4}", empty_response[k]),
+            format!("{:.4}", no_calibration[k].action_response),
         ]);
         for (j, s) in strategies.iter().enumerate() {
             rows.push(vec![
@@ -452,8 +459,9 @@ fn write_report(
     let mut header = vec!["horizon".to_string()];
     header.extend(strategies.iter().map(|s| format!("mse_{}", s.name().replace('-', "_"))));
     header.push(format!("mse_{}", EMPTY_CONTEXT.replace('-', "_")));
-    let empty_by_horizon: Vec<f64> =
-        (0..horizon).map(|t| empty_context.iter().map(|m| m[t]).sum::<f64>() / empty_context.len() as f64).collect();
+    let empty_by_horizon: Vec<f64> = (0..horizon)
+        .map(|t| no_calibration.iter().map(|n| n.mse_by_horizon[t]).sum::<f64>() / no_calibration.len() as f64)
+        .collect();
     let header_refs: Vec<&str> = header.iter().map(String::as_str).collect();
     let rows: Vec<Vec<String>> = (0..horizon)
         .map(|t| {
