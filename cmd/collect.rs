@@ -15,19 +15,22 @@ use mbrl::data::collect_embodied::{
     collect_embodied, parse_manipulator_state, replay_embodied, EmbodiedCollectSettings, EmbodiedReplaySettings,
 };
 use mbrl::data::collect_frames::{add_pendulum_frames, check_frames_size};
+use mbrl::data::terrain_set::{read_terrain_set, write_terrain_set};
 use mbrl::data::{write_dataset, Dataset};
 use mbrl::envs::ball::Orientation;
 use mbrl::envs::boards::depth::{DenseIndex, DepthTable};
 use mbrl::envs::boards::sets::board_set;
 use mbrl::envs::boards::{GameSpec, LightsOut, Split, TileSwap};
 use mbrl::envs::embodiments::Embodiment;
+use mbrl::envs::terrain::{TerrainMap, TerrainSplit};
+use mbrl::envs::unicycle::UnicycleTerrain;
 use mbrl::envs::{parse_env, EnvName};
 
 use crate::common::{check_output_file, command_line, file_stem, run_job, GlobalArgs};
 
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
 pub enum Policy {
-    /// Uniformly random actions within the action bounds.
+    /// Random actions: uniform within the action bounds (the unicycle: colored noise, as its authors drew).
     Random,
 }
 
@@ -47,6 +50,9 @@ Examples:
   mbrl collect --env ball --trajectories 30 --orientation unseen-3 --out datasets/ball-unseen-3.mcap
   mbrl collect --env lightsout:cursor --episodes 1000 --seed 1 --out datasets/lightsout-cursor-random.mcap
   mbrl collect --env tileswap:reacher --actions actions.csv --init-state 0.5,1.2,0,0 --board 1,0,2,3,4,5,6,7,8
+  mbrl collect --env terrain --maps 100 --out datasets/terrain
+  mbrl collect --env unicycle --maps datasets/terrain --split train --instances 10000 --steps 100
+  mbrl collect --env unicycle --map datasets/terrain/map050.png --actions actions.csv --init-state 0.2,0.3,0,1.57
 
 Start states: θ ~ U[-π, π], θ̇ ~ U[-8, 8] (pendulum); s ~ N(0, I) (toy); x ~ U[-0.8, 0.8],
 ẋ ~ U[-2, 2] (mountaincar). Actions uniform in the env's bounds. Parametrized envs (pendulum:quadrant,
@@ -56,6 +62,12 @@ share instance k); the parameters go into the metadata.
 --init-state or a reset state drawn from --seed, in the instance --instance-seed names (default: --seed);
 actions beyond the bounds are clipped by the env.
 Board sets (lightsout 5x5, tileswap) hold every board of depth 1..D with its train/test split.
+Terrain: --maps N writes N random 460 × 460 PNG maps (background colour and Bézier patches) and a
+manifest, terrain.json, into the new directory --out (default datasets/terrain): maps 0..N/2 train, the
+rest test. Unicycle: on one --map PNG (any 8-bit RGB image, resized to 460 × 460; x runs down its rows,
+y along its columns) or on the --split of a map set --maps DIR, a map drawn per instance with the robot
+(mass, throttle and steer gains of Table 5.1); x, y ~ U[0, 1], v ~ U[-5, 5], φ ~ U[0, 2π); actions
+colored noise (β 0.5, std 0.5, clipped to [-1, 1]); --init-state x,y,v,φ.
 Embodied boards (<game>:cursor|reacher) are recorded as skill episodes, one rollout each: an episode ends
 when the board changes or after 10 (cursor) / 50 (reacher) steps. --episodes N: random actions, each
 episode from a uniformly scrambled board and a reset manipulator. --actions: one run through the CSV
@@ -76,7 +88,7 @@ pub struct CollectArgs {
     #[arg(long, value_name = "CSV", conflicts_with_all = ["rollouts", "instances", "steps", "trajectories", "boards"])]
     actions: Option<PathBuf>,
     /// With --actions: the start state, comma-separated (pendulum: θ,θ̇; toy: s1,s2; mountaincar: x,ẋ;
-    /// <game>:cursor: x,y; <game>:reacher: shoulder,wrist,shoulder velocity,wrist velocity).
+    /// unicycle: x,y,v,φ; <game>:cursor: x,y; <game>:reacher: shoulder,wrist,shoulder velocity,wrist velocity).
     #[arg(long, value_name = "X1,X2,…", requires = "actions", allow_hyphen_values = true)]
     init_state: Option<String>,
     /// With --actions: which instance of a parametrized env (default: --seed); the same seed names the same
@@ -119,13 +131,31 @@ pub struct CollectArgs {
     /// Deepest solution depth in a board set.
     #[arg(long, requires = "boards")]
     max_depth: Option<u8>,
-    /// Only boards of this split.
-    #[arg(long, value_enum, requires = "boards")]
+    /// Only boards of this split (--boards), or the maps of this split of a map set (--maps DIR).
+    #[arg(long, value_enum)]
     split: Option<crate::solve_board::SplitChoice>,
+    /// For --env terrain: how many maps to make. For --env unicycle: a map set directory (with terrain.json)
+    /// whose --split maps the instances are drawn on.
+    #[arg(long, value_name = "N|DIR", conflicts_with = "map")]
+    maps: Option<String>,
+    /// For --env unicycle: drive on this terrain map (an 8-bit RGB PNG).
+    #[arg(long, value_name = "PNG")]
+    map: Option<PathBuf>,
 }
 
 pub fn run(global: &GlobalArgs, args: CollectArgs) -> anyhow::Result<()> {
-    let env = parse_env(&args.env)?;
+    let mut env = parse_env(&args.env)?;
+    if env == EnvName::Terrain {
+        return collect_terrain(global, &args);
+    }
+    if let EnvName::Unicycle(_) = env {
+        env = env.with_terrain(unicycle_terrain(args.map.as_deref(), args.maps.as_deref(), args.split)?)?;
+    } else if args.map.is_some() || args.maps.is_some() {
+        bail!("--map and --maps are for --env unicycle (maps) and --env terrain (--maps N), not '{}'", env.canonical());
+    }
+    if args.split.is_some() && !args.boards && args.maps.is_none() {
+        bail!("--split needs --boards (board sets) or --maps DIR (a terrain map set)");
+    }
     if args.images {
         check_frames_size(&env, 0.0)?;
     }
@@ -285,6 +315,56 @@ fn collect_embodied_episodes(
     };
     let episodes = data.meta.instances.len();
     say!("wrote {} steps in {episodes} skill episodes of {name} to {}", data.steps.len(), out.display());
+    Ok(())
+}
+
+/// The maps `--map` / `--maps DIR --split S` name, loaded once for every instance.
+pub fn unicycle_terrain(
+    map: Option<&Path>,
+    maps: Option<&str>,
+    split: Option<crate::solve_board::SplitChoice>,
+) -> anyhow::Result<UnicycleTerrain> {
+    match (map, maps) {
+        (Some(path), _) => {
+            if split.is_some() {
+                bail!("--split picks maps of a set (--maps DIR); a single --map has no split");
+            }
+            Ok(UnicycleTerrain::new(vec![TerrainMap::read_png(path)?], path.display().to_string()))
+        }
+        (None, Some(dir)) => {
+            let Some(split) = split else {
+                bail!("--maps {dir}: give --split train or --split test (models train on one half of a map set and are tested on the other)");
+            };
+            let split = match split {
+                crate::solve_board::SplitChoice::Train => TerrainSplit::Train,
+                crate::solve_board::SplitChoice::Test => TerrainSplit::Test,
+            };
+            let maps = read_terrain_set(Path::new(dir), Some(split))?;
+            Ok(UnicycleTerrain::new(maps, format!("{dir} ({} split)", split.name())))
+        }
+        (None, None) => bail!(
+            "'unicycle' drives on terrain maps: give --map MAP.png, or --maps DIR --split train|test with a map set from \
+             `mbrl collect --env terrain --maps 100 --out DIR`"
+        ),
+    }
+}
+
+fn collect_terrain(global: &GlobalArgs, args: &CollectArgs) -> anyhow::Result<()> {
+    let Some(count) = &args.maps else {
+        bail!("'terrain' makes map sets: give --maps N (e.g. --maps 100: 50 train and 50 test maps)");
+    };
+    let count: usize = count.parse().map_err(|_| {
+        anyhow::anyhow!("--maps: '{count}' is not a count; --env terrain takes the number of maps to make")
+    })?;
+    if args.map.is_some() || args.split.is_some() || args.actions.is_some() || args.instances.is_some() || args.images {
+        bail!("--env terrain takes only --maps N, --out DIR and --seed");
+    }
+    let out = args.out.clone().unwrap_or_else(|| PathBuf::from("datasets/terrain"));
+    run_job(global, "collect terrain", |monitor| {
+        write_terrain_set(&out, count, global.seed, &command_line(), monitor)
+    })?;
+    let train = count.div_ceil(2);
+    say!("wrote {count} terrain maps ({train} train, {} test) to {}", count - train, out.display());
     Ok(())
 }
 

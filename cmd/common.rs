@@ -158,7 +158,10 @@ pub fn pendulum_variant(name: &str) -> anyhow::Result<mbrl::envs::pendulum::Pend
                 "'ball' has no control task; use `mbrl filter` / `mbrl predict`; CEM planning supports pendulum envs"
             )
         }
-        env @ (mbrl::envs::EnvName::Toy(_) | mbrl::envs::EnvName::MountainCar) => {
+        env @ (mbrl::envs::EnvName::Toy(_)
+        | mbrl::envs::EnvName::MountainCar
+        | mbrl::envs::EnvName::Unicycle(_)
+        | mbrl::envs::EnvName::Terrain) => {
             anyhow::bail!("'{}' has no MPC task here yet; CEM planning supports pendulum envs", env.canonical())
         }
         env @ mbrl::envs::EnvName::Embodied(..) => anyhow::bail!(

@@ -282,7 +282,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__collect)
-            opts="-q -h -V --env --rollouts --instances --actions --init-state --instance-seed --board --episodes --steps --images --policy --out --trajectories --orientation --augment-rotations --boards --max-depth --split --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --env --rollouts --instances --actions --init-state --instance-seed --board --episodes --steps --images --policy --out --trajectories --orientation --augment-rotations --boards --max-depth --split --maps --map --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -350,6 +350,14 @@ _mbrl() {
                     ;;
                 --split)
                     COMPREPLY=($(compgen -W "train test" -- "${cur}"))
+                    return 0
+                    ;;
+                --maps)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --map)
+                    COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
                 --seed)

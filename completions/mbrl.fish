@@ -44,23 +44,25 @@ complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "watch" -d 'Follow a runni
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "export" -d 'Convert a dataset, board set, ball recording or filter-estimate file to CSV or NumPy `.npz`'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "completions" -d 'Print a shell completion script'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l env -d 'Environment: pendulum[:light|heavy|mass=<m>|inverted|quadrant], toy:inner|outer, mountaincar, lightsout[:<n>x<n>], tileswap, <game>:cursor|reacher (a board game played by a manipulator, e.g. lightsout:cursor), ball' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l env -d 'Environment: pendulum[:light|heavy|mass=<m>|inverted|quadrant], toy:inner|outer, mountaincar, unicycle (with --map or --maps), terrain (map sets), lightsout[:<n>x<n>], tileswap, <game>:cursor|reacher (a board game played by a manipulator, e.g. lightsout:cursor), ball' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l rollouts -d 'Number of rollouts, each in its own instance of a parametrized env' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l instances -d 'Instead of --rollouts: N instances with two rollouts each (ids 2k, 2k+1), for context models' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l actions -d 'Replay these actions (CSV: one row per step, one column per action dimension) instead of random ones' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l init-state -d 'With --actions: the start state, comma-separated (pendulum: θ,θ̇; toy: s1,s2; mountaincar: x,ẋ; <game>:cursor: x,y; <game>:reacher: shoulder,wrist,shoulder velocity,wrist velocity)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l init-state -d 'With --actions: the start state, comma-separated (pendulum: θ,θ̇; toy: s1,s2; mountaincar: x,ẋ; unicycle: x,y,v,φ; <game>:cursor: x,y; <game>:reacher: shoulder,wrist,shoulder velocity,wrist velocity)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l instance-seed -d 'With --actions: which instance of a parametrized env (default: --seed); the same seed names the same instance in every subcommand' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l board -d 'With --actions on <game>:cursor|reacher: the start board, comma-separated as solve-board takes it (default: the solved board)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l episodes -d 'For <game>:cursor|reacher: N skill episodes of random actions, each from a scrambled board' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l steps -d 'Steps per rollout' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l policy -d 'Behaviour policy' -r -f -a "random\t'Uniformly random actions within the action bounds'"
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l policy -d 'Behaviour policy' -r -f -a "random\t'Random actions: uniform within the action bounds (the unicycle: colored noise, as its authors drew)'"
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l out -d 'Output file (default: datasets/<env>-random.mcap, <env>-pairs.mcap, <env>-replay.mcap, or <game>-boards-d<D>.mcap)' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l trajectories -d 'For the ball: number of simulated shots (each with exactly one table bounce)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l orientation -d 'For the ball: launcher pose, default or unseen-1..unseen-5 (thesis 6.5.1)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l augment-rotations -d 'For the ball: rotated copies added per shot, about z through its lowest point (19 in the thesis)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l max-depth -d 'Deepest solution depth in a board set' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l split -d 'Only boards of this split' -r -f -a "train\t''
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l split -d 'Only boards of this split (--boards), or the maps of this split of a map set (--maps DIR)' -r -f -a "train\t''
 test\t''"
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l maps -d 'For --env terrain: how many maps to make. For --env unicycle: a map set directory (with terrain.json) whose --split maps the instances are drawn on' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l map -d 'For --env unicycle: drive on this terrain map (an 8-bit RGB PNG)' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r

@@ -5,9 +5,10 @@ use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
 use super::{Dataset, DatasetLayout, DatasetMeta, Rollout, Timestep, FORMAT_VERSION};
-use crate::envs::{instance_env, Env, EnvName, EnvSpec};
+use crate::envs::{instance_env, Env, EnvName, EnvSpec, Exploration};
 use crate::error::{Error, Result};
 use crate::run::Monitor;
+use crate::util::colored_noise::ColoredNoise;
 use crate::util::seeding::{derive_seed, rng_for};
 
 /// The random stream under `--seed` that a replay's reset state (and toy noise) come from.
@@ -130,6 +131,9 @@ pub fn replay(settings: &ReplaySettings) -> Result<Dataset> {
     env.reset(&mut rng_for(settings.seed, &[REPLAY_STREAM]));
     if let Some(state) = &settings.init_state {
         check_state(&spec, state)?;
+        if let Some(reason) = env.state_error(state) {
+            return Err(Error::config(format!("--init-state: {reason} ({})", spec.state_names.join(","))));
+        }
         env.set_state(state);
     }
     let mut rollout = Rollout::start(env.state(), env.observe());
@@ -179,9 +183,15 @@ fn check_state(spec: &EnvSpec, state: &[f64]) -> Result<()> {
 fn random_rollout(env: &mut dyn Env, spec: &EnvSpec, rng: &mut ChaCha8Rng, steps: usize) -> Rollout {
     let obs = env.reset(rng);
     let mut rollout = Rollout::start(env.state(), obs);
-    for _ in 0..steps {
-        let action: Vec<f64> =
-            spec.action_low.iter().zip(&spec.action_high).map(|(&lo, &hi)| rng.random_range(lo..=hi)).collect();
+    let colored = match env.exploration() {
+        Exploration::Uniform => None,
+        Exploration::Colored { beta, std, min_len } => Some(colored_actions(spec, rng, steps, beta, std, min_len)),
+    };
+    for t in 0..steps {
+        let action: Vec<f64> = match &colored {
+            Some(actions) => actions[t].clone(),
+            None => spec.action_low.iter().zip(&spec.action_high).map(|(&lo, &hi)| rng.random_range(lo..=hi)).collect(),
+        };
         let step = env.step(&action);
         rollout.push(action, step.reward, env.state(), step.obs);
         if step.done {
@@ -189,6 +199,37 @@ fn random_rollout(env: &mut dyn Env, spec: &EnvSpec, rng: &mut ChaCha8Rng, steps
         }
     }
     rollout
+}
+
+/// `steps` actions of Gaussian colored noise, one sequence per action dimension (at least `min_len` long, of
+/// which the first `steps` are used, so the spectrum does not depend on the rollout length), clipped.
+fn colored_actions(
+    spec: &EnvSpec,
+    rng: &mut ChaCha8Rng,
+    steps: usize,
+    beta: f64,
+    std: f64,
+    min_len: usize,
+) -> Vec<Vec<f64>> {
+    let len = steps.max(min_len);
+    let noise = ColoredNoise::new(beta, len);
+    let mut scratch = vec![rustfft::num_complex::Complex::new(0.0, 0.0); len];
+    let per_dim: Vec<Vec<f64>> = (0..spec.action_dim())
+        .map(|_| {
+            let mut sequence = vec![0.0; len];
+            noise.sample_into(rng, &mut scratch, &mut sequence);
+            sequence
+        })
+        .collect();
+    (0..steps)
+        .map(|t| {
+            per_dim
+                .iter()
+                .zip(spec.action_low.iter().zip(&spec.action_high))
+                .map(|(seq, (&lo, &hi))| (seq[t] * std).clamp(lo, hi))
+                .collect()
+        })
+        .collect()
 }
 
 /// Observations are stored only where they differ from the state (see datasets/README.md).

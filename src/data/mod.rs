@@ -18,6 +18,7 @@ pub mod mcap_io;
 pub mod rollout;
 pub mod scene;
 pub mod schema;
+pub mod terrain_set;
 
 pub use dataset::{instance_pairs, read_dataset, write_dataset, Dataset, DatasetLayout, DatasetMeta, FORMAT_VERSION};
 pub use rollout::{Rollout, Timestep};

@@ -7,7 +7,9 @@ pub mod embodiments;
 pub mod mountaincar;
 pub mod pendulum;
 pub mod registry;
+pub mod terrain;
 pub mod toy;
+pub mod unicycle;
 
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
@@ -60,6 +62,24 @@ pub trait Env {
     fn sample_instance(&mut self, _rng: &mut ChaCha8Rng) {}
     /// The pure dynamics of this instance, for continuous planners; `None` where planning is symbolic.
     fn dynamics(&self) -> Option<Box<dyn Dynamics>>;
+    /// Why `state` cannot be a start state of this env (outside its bounds), if it cannot.
+    fn state_error(&self, _state: &[f64]) -> Option<String> {
+        None
+    }
+    /// How `collect` draws random actions in this env.
+    fn exploration(&self) -> Exploration {
+        Exploration::Uniform
+    }
+}
+
+/// The random actions of collected data.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Exploration {
+    /// Independent uniform actions within the bounds.
+    Uniform,
+    /// Gaussian colored noise (power ∝ 1/f^beta) of standard deviation `std`, one sequence of at least
+    /// `min_len` samples per action dimension, clipped to the bounds: it travels farther than white noise.
+    Colored { beta: f64, std: f64, min_len: usize },
 }
 
 /// What a planner rolls out: many candidate action sequences at once from one start state. Implemented by the

@@ -7,9 +7,11 @@ use super::embodiments::Embodiment;
 use super::mountaincar::MountainCar;
 use super::pendulum::{Pendulum, PendulumVariant};
 use super::toy::{Squash, Toy};
+use super::unicycle::{Unicycle, UnicycleTerrain};
 use super::Env;
 use crate::error::{Error, Result};
 use crate::util::seeding::rng_for;
+use std::sync::Arc;
 
 /// The pendulum family as a flag's help text names it; a macro so `concat!` can build help strings from it.
 #[macro_export]
@@ -26,7 +28,7 @@ macro_rules! known_envs {
     () => {
         concat!(
             $crate::pendulum_envs!(),
-            ", toy:inner|outer, mountaincar, lightsout[:<n>x<n>], tileswap, <game>:cursor|reacher (a board game \
+            ", toy:inner|outer, mountaincar, unicycle (with --map or --maps), terrain (map sets), lightsout[:<n>x<n>], tileswap, <game>:cursor|reacher (a board game \
              played by a manipulator, e.g. lightsout:cursor), ball"
         )
     };
@@ -52,6 +54,11 @@ pub enum EnvName {
     Embodied(GameSpec, Embodiment),
     /// The table-tennis ball simulator: recorded as camera trajectories, not stepped by actions.
     Ball,
+    /// TRADYN's unicycle robot on terrain maps. The name alone carries no maps (`None`); the subcommand attaches
+    /// them from `--map` / `--maps` with [`EnvName::with_terrain`].
+    Unicycle(Option<Arc<UnicycleTerrain>>),
+    /// Terrain map sets for the unicycle: made by `collect --env terrain --maps N`, never stepped.
+    Terrain,
 }
 
 pub fn parse_env(name: &str) -> Result<EnvName> {
@@ -70,6 +77,8 @@ pub fn parse_env(name: &str) -> Result<EnvName> {
         "mountaincar" if variant.is_empty() => Ok(EnvName::MountainCar),
         "lightsout" | "tileswap" => Ok(EnvName::Board(GameSpec::parse(name)?)),
         "ball" if variant.is_empty() => Ok(EnvName::Ball),
+        "unicycle" if variant.is_empty() => Ok(EnvName::Unicycle(None)),
+        "terrain" if variant.is_empty() => Ok(EnvName::Terrain),
         _ => Err(Error::config(format!("unknown env '{name}'; supported: {KNOWN_ENVS}"))),
     }
 }
@@ -114,6 +123,24 @@ impl EnvName {
             EnvName::Ball => Err(Error::config(
                 "'ball' is recorded as camera trajectories: use `mbrl collect --env ball --trajectories N`",
             )),
+            EnvName::Unicycle(Some(terrain)) => Ok(Box::new(Unicycle::new(terrain.clone()))),
+            EnvName::Unicycle(None) => Err(Error::config(
+                "'unicycle' drives on terrain maps: give --map MAP.png, or --maps DIR --split train|test with a map set \
+                 from `mbrl collect --env terrain --maps 100 --out DIR`",
+            )),
+            EnvName::Terrain => Err(Error::config(
+                "'terrain' makes map sets, it is not stepped: use `mbrl collect --env terrain --maps N --out DIR`",
+            )),
+        }
+    }
+
+    /// The unicycle on these maps; other envs take no maps.
+    pub fn with_terrain(&self, terrain: UnicycleTerrain) -> Result<EnvName> {
+        match self {
+            EnvName::Unicycle(_) => Ok(EnvName::Unicycle(Some(Arc::new(terrain)))),
+            other => {
+                Err(Error::config(format!("--map and --maps are for --env unicycle, not '{}'", other.canonical())))
+            }
         }
     }
 
@@ -123,7 +150,13 @@ impl EnvName {
             EnvName::Pendulum(v) => super::pendulum::dynamics::PendulumReward::for_params(&v.fixed_params())
                 .map(|r| Box::new(r) as Box<dyn super::RewardFn>),
             // The toy has no task; MountainCar's reward depends on the hidden terrain.
-            EnvName::Toy(_) | EnvName::MountainCar | EnvName::Board(_) | EnvName::Embodied(..) | EnvName::Ball => None,
+            EnvName::Toy(_)
+            | EnvName::MountainCar
+            | EnvName::Board(_)
+            | EnvName::Embodied(..)
+            | EnvName::Ball
+            | EnvName::Unicycle(_)
+            | EnvName::Terrain => None,
         }
     }
 
@@ -135,6 +168,8 @@ impl EnvName {
             EnvName::Board(g) => g.name(),
             EnvName::Embodied(g, e) => format!("{}:{}", g.name(), e.name()),
             EnvName::Ball => "ball".into(),
+            EnvName::Unicycle(_) => "unicycle".into(),
+            EnvName::Terrain => "terrain".into(),
         }
     }
 }

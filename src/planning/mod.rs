@@ -4,7 +4,8 @@
 pub mod bfs;
 pub mod board_view;
 pub mod cem;
-pub mod colored_noise;
+/// Lives in util so that data collection (below planning) can draw colored exploration noise too.
+pub use crate::util::colored_noise;
 pub mod mpc;
 pub mod solve_board;
 
