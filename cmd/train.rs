@@ -300,12 +300,18 @@ fn context_config(args: &TrainArgs, env: &mbrl::envs::EnvName) -> anyhow::Result
         PresetChoice::Medium => context::Preset::Medium,
         PresetChoice::Paper => context::Preset::Paper,
     };
-    let mut config = ContextConfig::preset(preset, context::family_of(env));
+    let preset_config = ContextConfig::preset(preset, context::family_of(env));
+    let mut config = preset_config.clone();
     if let Some(path) = &args.config {
         config = apply_toml_file(&config, path)?;
     }
     if let Some(n) = args.steps {
         config.steps = n;
+    }
+    // The p_ctx-from-A schedule is a share of the run (B.2.1: 30 % and 60 % of it); a run made longer or
+    // shorter keeps those shares unless the config file sets the schedule itself.
+    if config.context_from_target == preset_config.context_from_target {
+        config.context_from_target = preset_config.context_from_target.rescaled(preset_config.steps, config.steps);
     }
     if let Some(n) = args.batch {
         config.batch_size = n;

@@ -36,6 +36,12 @@ fn collect_train_calibrate_plan() {
         serde_json::from_slice(&std::fs::read(d.join("models/c/config.json")).unwrap()).unwrap();
     assert_eq!(config["method"], "context");
     assert_eq!(config["config"]["latent_dim"], 16, "pendulum takes Table B.1's D_β");
+    let schedule = &config["config"]["context_from_target"];
+    assert_eq!(
+        (schedule["decay_from"].as_u64(), schedule["zero_at"].as_u64()),
+        (Some(6), Some(12)),
+        "30 % and 60 % of 20 steps"
+    );
 
     let out = mbrl(d)
         .args(["calibrate", "--model", "models/c", "--env", "pendulum:quadrant", "--instance-seed", "3"])

@@ -53,6 +53,12 @@ pub struct ContextFromTarget {
 }
 
 impl ContextFromTarget {
+    /// The same schedule over a run of `to_steps` instead of `from_steps` (its switch points scaled).
+    pub fn rescaled(&self, from_steps: u64, to_steps: u64) -> Self {
+        let scale = |s: u64| ((s as u128 * to_steps as u128) / from_steps.max(1) as u128) as u64;
+        ContextFromTarget { start: self.start, decay_from: scale(self.decay_from), zero_at: scale(self.zero_at) }
+    }
+
     pub fn at(&self, step: u64) -> f64 {
         if step < self.decay_from {
             self.start
@@ -210,6 +216,8 @@ mod tests {
         );
         let s = control.context_from_target;
         assert_eq!((s.at(0), s.at(30_000), s.at(45_000), s.at(60_000)), (0.5, 0.5, 0.25, 0.0));
+        let short = s.rescaled(100_000, 4000);
+        assert_eq!((short.decay_from, short.zero_at, short.start), (1200, 2400, 0.5));
         assert!(toy.validate().is_ok() && control.validate().is_ok());
     }
 }
