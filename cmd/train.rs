@@ -15,6 +15,7 @@ use mbrl::models::pets::{self, PetsConfig, Preset, RewardSource};
 use mbrl::models::seads::{self, EmbodiedGame, SeadsConfig};
 use mbrl::run::dir::{Provenance, METRICS_FILE};
 use mbrl::train::config::apply_toml_file;
+use mbrl::train::data_file::scalar_history;
 use mbrl::train::{loss_history, OpenedCheckpoint};
 use mbrl::util::table::write_csv;
 
@@ -436,13 +437,30 @@ fn finish_ball(report: &BallTrainReport, out: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// losses.csv and loss.png of a finished run, from its metrics log (so a resumed run gets the whole curve).
+/// losses.csv and loss.png of a finished run, from its metrics log (so a resumed run gets the whole curve): the
+/// batch loss of every step and, where the method validates, the held-out loss at each validation (the curve
+/// that shows overfitting and which snapshot was kept as the best).
 fn write_loss_report(out: &Path, title: &str, y_label: &str) -> anyhow::Result<Vec<(u64, f64)>> {
-    let losses = loss_history(&out.join(METRICS_FILE))?;
-    let rows: Vec<Vec<String>> = losses.iter().map(|(k, l)| vec![k.to_string(), format!("{l:.6}")]).collect();
-    write_csv(&out.join("losses.csv"), &["step", "loss"], &rows)?;
-    let curve = Series { name: "batch loss".into(), points: losses.iter().map(|(k, l)| (*k as f64, *l)).collect() };
-    line_plot(&out.join("loss.png"), title, "step", y_label, &[curve])?;
+    let metrics = out.join(METRICS_FILE);
+    let losses = loss_history(&metrics)?;
+    let validation: std::collections::BTreeMap<u64, f64> =
+        scalar_history(&metrics, "valid/loss")?.into_iter().collect();
+    let rows: Vec<Vec<String>> = losses
+        .iter()
+        .map(|(k, l)| {
+            vec![k.to_string(), format!("{l:.6}"), validation.get(k).map_or(String::new(), |v| format!("{v:.6}"))]
+        })
+        .collect();
+    write_csv(&out.join("losses.csv"), &["step", "loss", "validation_loss"], &rows)?;
+    let mut curves =
+        vec![Series { name: "batch loss".into(), points: losses.iter().map(|(k, l)| (*k as f64, *l)).collect() }];
+    if !validation.is_empty() {
+        curves.push(Series {
+            name: "validation loss (held out)".into(),
+            points: validation.iter().map(|(k, v)| (*k as f64, *v)).collect(),
+        });
+    }
+    line_plot(&out.join("loss.png"), title, "step", y_label, &curves)?;
     Ok(losses)
 }
 

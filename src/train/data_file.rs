@@ -37,12 +37,17 @@ impl DataFile {
 
 /// The `train/loss` values a run logged, by step, from its metrics file (for loss tables and plots).
 pub fn loss_history(metrics: &Path) -> Result<Vec<(u64, f64)>> {
+    scalar_history(metrics, "train/loss")
+}
+
+/// Every (step, value) a metrics log holds for scalar `name`, in the order logged.
+pub fn scalar_history(metrics: &Path, name: &str) -> Result<Vec<(u64, f64)>> {
     let bytes = read_bounded(metrics, 1 << 30)?;
     let text = String::from_utf8_lossy(&bytes);
     let mut out = Vec::new();
     for line in text.lines() {
-        if let Ok(crate::run::Event::Scalar { name, step, value }) = serde_json::from_str(line) {
-            if name == "train/loss" {
+        if let Ok(crate::run::Event::Scalar { name: logged, step, value }) = serde_json::from_str(line) {
+            if logged == name {
                 out.push((step, value));
             }
         }
