@@ -89,6 +89,8 @@ enum Kind {
     /// Text (JSON, JSONL, CSV, TOML): token- and line-aware mutations, sometimes raw bytes; JSON and TOML also
     /// as documents (a value changed, written back valid).
     Text,
+    /// PNG: raw bytes, mostly with the chunk CRCs recomputed so damaged sizes and lengths reach the decoder.
+    Png,
 }
 
 /// Which program a target runs.
@@ -121,6 +123,10 @@ const fn mcap(seed: &'static str) -> Input {
 
 const fn text(seed: &'static str) -> Input {
     Input::File { seed, kind: Kind::Text }
+}
+
+const fn png(seed: &'static str) -> Input {
+    Input::File { seed, kind: Kind::Png }
 }
 
 /// CEM settings that make a planning run take milliseconds.
@@ -170,6 +176,13 @@ fn targets() -> Vec<Target> {
         target("images-export", mcap("img.mcap"), "export --input {in} --format npz --out {out}"),
         target("ball-csv", text("ball.csv"), "filter --model thesis --input {in} --out {out}"),
         target("actions-pendulum", text("actions.csv"), "collect --env pendulum --actions {in} --out {out}"),
+        // Terrain: a user's map, and a map set (its manifest, or a map the manifest vouches for).
+        target("terrain-map", png("map.png"), "collect --env unicycle --map {in} --rollouts 1 --steps 3 --out {out}"),
+        target(
+            "terrain-set",
+            Input::Checkpoint { dir: "terrain", files: &["terrain.json", "map000.png"] },
+            "collect --env unicycle --maps {in} --split train --rollouts 1 --steps 3 --out {out}",
+        ),
         target(
             "actions-cursor",
             text("cursor.csv"),
@@ -353,6 +366,8 @@ fn generate_seeds(dir: &Path) {
     make(dir, "collect --env pendulum:quadrant --instances 4 --steps 12 --out quad.mcap");
     make(dir, "collect --env ball --trajectories 2 --out ball.mcap");
     make(dir, "collect --env lightsout --boards --max-depth 2 --out boards.mcap");
+    make(dir, "collect --env terrain --maps 2 --out terrain");
+    fs::copy(dir.join("terrain/map000.png"), dir.join("map.png")).unwrap();
 
     make(dir, "train --method pets --data roll.mcap --config pets.toml --ensemble 2 --steps 5 --out pets");
     make(dir, "train --method context --data ctx.mcap --config context.toml --steps 5 --out context-model");
@@ -1000,19 +1015,25 @@ fn mutate_records(rng: &mut ChaCha8Rng, doc: &mut McapDoc) -> String {
     }
 }
 
-/// A camera frame message (JSON with base64 PNG `data`): the PNG mutated as bytes, and mostly with its chunk
-/// CRCs recomputed so that damaged dimensions or chunk lengths get past the CRC check to the decoder.
+/// A camera frame message (JSON with base64 PNG `data`), its PNG mutated as [`mutate_png`] does.
 fn mutate_frame_png(rng: &mut ChaCha8Rng, message: &[u8]) -> Option<(Vec<u8>, String)> {
     let mut json: serde_json::Value = serde_json::from_slice(message).ok()?;
     let engine = base64::engine::general_purpose::STANDARD;
     let mut png = engine.decode(json.get("data")?.as_str()?).ok()?;
-    let mut what = stacked(rng, &mut png, mutate_bytes);
-    if rng.random_bool(0.8) {
-        fix_png_crcs(&mut png);
-        what += " (chunk CRCs fixed)";
-    }
+    let what = mutate_png(rng, &mut png);
     json["data"] = engine.encode(&png).into();
     Some((serde_json::to_vec(&json).ok()?, what))
+}
+
+/// A PNG mutated as bytes, and mostly with its chunk CRCs recomputed so that damaged dimensions or chunk lengths
+/// get past the CRC check to the decoder.
+fn mutate_png(rng: &mut ChaCha8Rng, png: &mut Vec<u8>) -> String {
+    let mut what = stacked(rng, png, mutate_bytes);
+    if rng.random_bool(0.8) {
+        fix_png_crcs(png);
+        what += " (chunk CRCs fixed)";
+    }
+    what
 }
 
 fn fix_png_crcs(png: &mut [u8]) {
@@ -1060,6 +1081,11 @@ fn prepare(target: &Target, seeds: &Path, work: &Path, index: Option<u64>, campa
                 (Some(_), Kind::Text) => {
                     let mut bytes = fs::read(&seed_path).unwrap();
                     let what = mutate_document(&mut rng, &mut bytes);
+                    (bytes, what)
+                }
+                (Some(_), Kind::Png) => {
+                    let mut bytes = fs::read(&seed_path).unwrap();
+                    let what = mutate_png(&mut rng, &mut bytes);
                     (bytes, what)
                 }
             };
@@ -1115,14 +1141,17 @@ fn mutate_checkpoint(rng: &mut ChaCha8Rng, dir: &Path, file: &str) -> String {
     let mut bytes = fs::read(&path).unwrap();
     let what = if file.ends_with(".safetensors") {
         mutate_safetensors(rng, &mut bytes)
+    } else if file.ends_with(".png") {
+        mutate_png(rng, &mut bytes)
     } else {
         mutate_document(rng, &mut bytes)
     };
     fs::write(&path, &bytes).unwrap();
-    if file == "checkpoint.json" {
+    let manifest_path = dir.join("checkpoint.json");
+    // A map set's manifest vouches by pixel CRC, which a fuzzer cannot forge without decoding: left as is.
+    if file == "checkpoint.json" || !manifest_path.exists() {
         return format!("{file}: {what}");
     }
-    let manifest_path = dir.join("checkpoint.json");
     let mut manifest: serde_json::Value = serde_json::from_slice(&fs::read(&manifest_path).unwrap()).unwrap();
     if let Some(entry) = manifest["files"].get_mut(file) {
         entry["bytes"] = bytes.len().into();

@@ -128,6 +128,12 @@ fn bad_maps_sets_and_start_states_are_one_line_errors() {
     write_png(&d.join("gray.png"), 2, 2, png::ColorType::Grayscale, &[9; 4]);
     write_png(&d.join("ok.png"), 2, 2, png::ColorType::Rgb, &[9; 12]);
     std::fs::create_dir(d.join("empty")).unwrap();
+    // A header that declares 16000 × 16000 pixels over a few bytes of data.
+    let mut huge = std::fs::read(d.join("ok.png")).unwrap();
+    huge[16..24].copy_from_slice(&[0, 0, 0x3e, 0x80, 0, 0, 0x3e, 0x80]);
+    let crc = crc32fast::hash(&huge[12..29]);
+    huge[29..33].copy_from_slice(&crc.to_be_bytes());
+    std::fs::write(d.join("huge.png"), huge).unwrap();
     let replay =
         |map: &str| ["--env", "unicycle", "--map", map, "--actions", "a.csv", "--out", "bad.mcap"].map(String::from);
     let cases: Vec<(Vec<String>, Vec<&str>)> = vec![
@@ -135,6 +141,7 @@ fn bad_maps_sets_and_start_states_are_one_line_errors() {
         (replay("rgba.png").to_vec(), vec!["rgba.png", "Rgba", "expected 8-bit RGB"]),
         (replay("gray.png").to_vec(), vec!["gray.png", "Grayscale", "expected 8-bit RGB"]),
         (replay("missing.png").to_vec(), vec!["missing.png"]),
+        (replay("huge.png").to_vec(), vec!["huge.png", "16000 × 16000", "bytes can hold"]),
         (
             [&replay("ok.png")[..], &["--init-state".into(), "1.5,0.5,0,0".into()]].concat(),
             vec!["--init-state", "outside the map"],

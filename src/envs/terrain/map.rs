@@ -13,6 +13,7 @@ pub const MU_MAX: f64 = 10.0;
 /// A user's PNG is read only up to this many bytes and this many pixels a side.
 const MAX_PNG_BYTES: u64 = 256 << 20;
 const MAX_PNG_SIDE: u32 = 16_384;
+const DEFLATE_MAX_RATIO: usize = 1032;
 
 #[derive(Clone, PartialEq)]
 pub struct TerrainMap {
@@ -107,7 +108,16 @@ impl TerrainMap {
                 depth as u8
             )));
         }
-        let mut pixels = vec![0; reader.output_buffer_size().ok_or_else(|| bad("map too large".into()))?];
+        let needed = reader.output_buffer_size().ok_or_else(|| bad("map too large".into()))?;
+        // Deflate expands at most 1032-fold: a header that declares more pixels than the file's bytes can hold
+        // is refused before its buffer is allocated.
+        if needed > bytes.len().saturating_mul(DEFLATE_MAX_RATIO) {
+            return Err(bad(format!(
+                "declares {width} × {height} pixels, more than its {} bytes can hold",
+                bytes.len()
+            )));
+        }
+        let mut pixels = vec![0; needed];
         let frame = reader.next_frame(&mut pixels).map_err(|e| bad(format!("PNG data: {e}")))?;
         let stride = frame.line_size;
         let mut rgb = vec![0u8; MAP_SIZE * MAP_SIZE * 3];
