@@ -329,23 +329,15 @@ pub fn unicycle_terrain(
             if split.is_some() {
                 bail!("--split picks maps of a set (--maps DIR); a single --map has no split");
             }
-            Ok(UnicycleTerrain::new(vec![TerrainMap::read_png(path)?], path.display().to_string()))
+            Ok(UnicycleTerrain::new(vec![TerrainMap::read_png(path)?]))
         }
         (None, Some(dir)) => {
             let Some(split) = split else {
                 bail!("--maps {dir}: give --split train or --split test (models train on one half of a map set and are tested on the other)");
             };
-            let split = match split {
-                crate::solve_board::SplitChoice::Train => TerrainSplit::Train,
-                crate::solve_board::SplitChoice::Test => TerrainSplit::Test,
-            };
-            let maps = read_terrain_set(Path::new(dir), Some(split))?;
-            Ok(UnicycleTerrain::new(maps, format!("{dir} ({} split)", split.name())))
+            Ok(UnicycleTerrain::new(read_terrain_set(Path::new(dir), Some(TerrainSplit::from(split)))?))
         }
-        (None, None) => bail!(
-            "'unicycle' drives on terrain maps: give --map MAP.png, or --maps DIR --split train|test with a map set from \
-             `mbrl collect --env terrain --maps 100 --out DIR`"
-        ),
+        (None, None) => bail!(mbrl::envs::registry::UNICYCLE_NEEDS_MAPS),
     }
 }
 

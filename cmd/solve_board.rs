@@ -38,6 +38,15 @@ pub enum EmbodimentChoice {
     Reacher,
 }
 
+impl From<SplitChoice> for mbrl::envs::terrain::TerrainSplit {
+    fn from(choice: SplitChoice) -> Self {
+        match choice {
+            SplitChoice::Train => Self::Train,
+            SplitChoice::Test => Self::Test,
+        }
+    }
+}
+
 impl From<SplitChoice> for Split {
     fn from(choice: SplitChoice) -> Split {
         match choice {

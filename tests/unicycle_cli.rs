@@ -105,7 +105,7 @@ fn a_replay_on_a_user_map_steps_the_simulator_with_the_given_actions() {
     let map = TerrainMap::read_png(&dir.path().join("user.png")).unwrap();
     assert_eq!(map.friction_at(0.2, 0.5), 0.1, "white: lowest friction");
     assert!((map.friction_at(0.8, 0.5) - 10.0).abs() < 1e-9, "black: highest");
-    let env = EnvName::Unicycle(Some(Arc::new(UnicycleTerrain::new(vec![map], "user.png"))));
+    let env = EnvName::Unicycle(Some(Arc::new(UnicycleTerrain::new(vec![map]))));
     let mut sim = instance_env(&env, 5).unwrap();
     sim.set_state(&[0.2, 0.3, 0.0, 1.57]);
     assert_eq!(data.meta.instances, vec![sim.params()]);

@@ -36,6 +36,10 @@ macro_rules! known_envs {
 
 pub const KNOWN_ENVS: &str = known_envs!();
 
+/// What to give when the unicycle is named without maps.
+pub const UNICYCLE_NEEDS_MAPS: &str = "'unicycle' drives on terrain maps: give --map MAP.png, or --maps DIR --split \
+                                       train|test with a map set from `mbrl collect --env terrain --maps 100 --out DIR`";
+
 /// The random stream, under an instance seed, that draws an instance's hidden parameters. Fixed forever:
 /// changing it would change which instance every recorded `--instance-seed` names.
 pub const INSTANCE_STREAM: u64 = u64::from_be_bytes(*b"instance");
@@ -124,10 +128,7 @@ impl EnvName {
                 "'ball' is recorded as camera trajectories: use `mbrl collect --env ball --trajectories N`",
             )),
             EnvName::Unicycle(Some(terrain)) => Ok(Box::new(Unicycle::new(terrain.clone()))),
-            EnvName::Unicycle(None) => Err(Error::config(
-                "'unicycle' drives on terrain maps: give --map MAP.png, or --maps DIR --split train|test with a map set \
-                 from `mbrl collect --env terrain --maps 100 --out DIR`",
-            )),
+            EnvName::Unicycle(None) => Err(Error::config(UNICYCLE_NEEDS_MAPS)),
             EnvName::Terrain => Err(Error::config(
                 "'terrain' makes map sets, it is not stepped: use `mbrl collect --env terrain --maps N --out DIR`",
             )),

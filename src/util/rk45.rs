@@ -164,7 +164,18 @@ where
         }
         k[s] = f(&ys);
     }
-    inside(&dormand_prince_step(f, y, k0, h).0)
+    inside(&fifth_order_end(y, &k, h))
+}
+
+/// y + h·Σ B_s k_s over the six stages.
+fn fifth_order_end<const N: usize>(y: &[f64; N], k: &[[f64; N]], h: f64) -> [f64; N] {
+    let mut y_new = *y;
+    for (s, b) in B.iter().enumerate() {
+        for i in 0..N {
+            y_new[i] += h * b * k[s][i];
+        }
+    }
+    y_new
 }
 
 fn stage_point<const N: usize>(y: &[f64; N], k: &[[f64; N]], s: usize, h: f64) -> [f64; N] {
@@ -192,12 +203,7 @@ where
     for s in 1..6 {
         k[s] = f(&stage_point(y, &k, s, h));
     }
-    let mut y_new = *y;
-    for (s, b) in B.iter().enumerate() {
-        for i in 0..N {
-            y_new[i] += h * b * k[s][i];
-        }
-    }
+    let y_new = fifth_order_end(y, &k, h);
     k[6] = f(&y_new);
     let mut error = [0.0; N];
     for (s, e) in E.iter().enumerate() {

@@ -20,14 +20,12 @@ use super::{Dynamics, Env, EnvSpec, Exploration, Step};
 #[derive(Debug)]
 pub struct UnicycleTerrain {
     pub maps: Vec<Arc<TerrainMap>>,
-    /// Where the maps came from, for messages ("maps/ (train split)", "hill.png").
-    pub source: String,
 }
 
 impl UnicycleTerrain {
-    pub fn new(maps: Vec<TerrainMap>, source: impl Into<String>) -> Self {
+    pub fn new(maps: Vec<TerrainMap>) -> Self {
         assert!(!maps.is_empty(), "a unicycle terrain needs at least one map");
-        UnicycleTerrain { maps: maps.into_iter().map(Arc::new).collect(), source: source.into() }
+        UnicycleTerrain { maps: maps.into_iter().map(Arc::new).collect() }
     }
 }
 
@@ -161,7 +159,7 @@ mod tests {
 
     fn env(maps: usize) -> Unicycle {
         let maps = (0..maps as u64).map(|i| generate_map(1, i)).collect();
-        Unicycle::new(Arc::new(UnicycleTerrain::new(maps, "test")))
+        Unicycle::new(Arc::new(UnicycleTerrain::new(maps)))
     }
 
     #[test]
