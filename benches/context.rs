@@ -37,7 +37,7 @@ fn data(instances: usize, len: usize) -> ContextData {
         len,
     };
     let pairs = (0..instances).map(|_| InstancePair { target: episode(), source: episode() }).collect();
-    ContextData { state_dim: STATE, action_dim: ACTION, pairs }
+    ContextData { state_dim: STATE, action_dim: ACTION, local_dim: 0, pairs }
 }
 
 fn paper_config(batch: usize) -> ContextConfig {
@@ -64,7 +64,7 @@ fn train_step(c: &mut Criterion) {
 
 fn model() -> FastContextModel {
     let config = paper_config(64);
-    let net = ContextNet::init(&config, STATE, ACTION, &inference_device(), &mut ChaCha8Rng::seed_from_u64(2));
+    let net = ContextNet::init(&config, STATE, ACTION, 0, &inference_device(), &mut ChaCha8Rng::seed_from_u64(2));
     FastContextModel::from_params(&ParamSet::<f32>::from_module(&net, param_name)).unwrap()
 }
 
@@ -83,7 +83,7 @@ fn planning(c: &mut Criterion) {
     group.bench_function("rollout_1000x20_mean_one_thread", |b| {
         let mut out = vec![0.0; candidates * horizon * STATE];
         let mut scratch = RolloutScratch::default();
-        b.iter(|| fast.rollout_means(&init, &actions, &betas, candidates, horizon, &mut out, &mut scratch))
+        b.iter(|| fast.rollout_means(&init, &actions, &betas, candidates, horizon, None, &mut out, &mut scratch))
     });
     group.throughput(Throughput::Elements((candidates * horizon * 20) as u64));
     group.bench_function("eig_cem_iteration_1000x20_beta20", |b| {
@@ -106,7 +106,16 @@ fn mpc_step(c: &mut Criterion) {
     let mut config = paper_config(64);
     config.steps = 1;
     let provenance = Provenance::new(String::new(), 0, 1);
-    let request = TrainRequest { out: dir.path().join("model"), data, env: None, config, seed: 0, provenance };
+    let request = TrainRequest {
+        method: mbrl::models::context::METHOD.into(),
+        space: mbrl::models::context::StateSpace::EnvState,
+        out: dir.path().join("model"),
+        data,
+        env: None,
+        config,
+        seed: 0,
+        provenance,
+    };
     train(&request, false, &NullMonitor).unwrap();
     let model = load(&request.out, &env).unwrap();
     let context: Vec<f32> = (0..10 * model.fast.transition_dim()).map(|i| ((i % 7) as f32 - 3.0) * 0.3).collect();

@@ -6,11 +6,15 @@ use std::path::PathBuf;
 use anyhow::bail;
 use clap::{Args, ValueEnum};
 use mbrl::data::write_dataset;
-use mbrl::envs::parse_env;
+use mbrl::envs::terrain::TerrainMap;
+use mbrl::envs::unicycle::UnicycleTerrain;
+use mbrl::envs::{parse_env, EnvName};
 use mbrl::models::context::calibration::{
     calibration_dataset, layout, run_calibration, CalibrationRequest, CalibrationSettings, Strategy,
 };
-use mbrl::models::context::{self, fast::gaussian_entropy};
+use mbrl::models::context::{self, fast::gaussian_entropy, LoadedModel};
+use mbrl::models::tradyn::{self, TradynModel};
+use mbrl::train::OpenedCheckpoint;
 
 use crate::common::{check_output_file, command_line, file_stem, parse_floats, run_job, GlobalArgs};
 
@@ -31,26 +35,32 @@ Examples:
   mbrl calibrate --model models/context-toy-inner --env toy:inner --instance-seed 7 --strategy open-loop --transitions 1 --out calib.mcap
   mbrl calibrate --model models/context-pendulum-quadrant --env pendulum:quadrant --instance-seed 3 --strategy mpc --transitions 30 --horizon 20
   mbrl plan --env pendulum:quadrant --model models/context-pendulum-quadrant --context calib.mcap --instance-seed 3
+  mbrl calibrate --model models/tradyn-terrain --env unicycle --map datasets/terrain/map050.png --instance-seed 4 --strategy random --init-state 0.2,0.3,0,1.57 --out calib-uni.mcap
 
 The instance (hidden parameters) is the one --instance-seed names in every command. Starts: toy and
 MountainCar at x = 0 (thesis), pendulum from its reset draw (--seed), or --init-state. The thesis uses
 CEM 1000 candidates / 100 elites / 10 iterations and 20 β samples; pendulum N = 30, H_max = 20;
-MountainCar N = 50, H_max = 30. The command prints the entropy of q(β | transitions) before and after.")]
+MountainCar N = 50, H_max = 30. The command prints the entropy of q(β | transitions) before and after.
+A TRADYN model calibrates with random colored actions (as its data were collected), 10 transitions by
+default, on the --map the robot drives on; the instance is the robot (mass, throttle and steering gains).")]
 pub struct CalibrateArgs {
-    /// A context-model checkpoint (`mbrl train --method context`).
+    /// A context-model checkpoint (`mbrl train --method context`, or `--method tradyn` for the unicycle).
     #[arg(long)]
     model: PathBuf,
-    /// Environment the model was trained on, e.g. toy:inner, pendulum:quadrant, mountaincar.
+    /// Environment the model was trained on, e.g. toy:inner, pendulum:quadrant, mountaincar, unicycle.
     #[arg(long)]
     env: String,
+    /// For --env unicycle: the terrain map (PNG) the robot calibrates on.
+    #[arg(long)]
+    map: Option<PathBuf>,
     /// Which instance (hidden parameters) to calibrate in.
     #[arg(long)]
     instance_seed: u64,
     #[arg(long, value_enum)]
     strategy: StrategyChoice,
-    /// Calibration transitions N.
-    #[arg(long, default_value_t = 30)]
-    transitions: usize,
+    /// Calibration transitions N (default 30; TRADYN 10).
+    #[arg(long)]
+    transitions: Option<usize>,
     /// H_max: the longest planning horizon of MPC calibration.
     #[arg(long, default_value_t = 20)]
     horizon: usize,
@@ -66,7 +76,7 @@ pub struct CalibrateArgs {
     /// β samples of the Monte Carlo information gain.
     #[arg(long, default_value_t = 20)]
     beta_samples: usize,
-    /// Start state, comma-separated in the env's state order (pendulum: θ,θ̇). Default: the thesis' start
+    /// Start state, comma-separated in the env's state order (pendulum: θ,θ̇; unicycle: x,y,v,φ). Default: the thesis' start
     /// (toy x = 0; MountainCar x = ẋ = 0; pendulum:quadrant hanging down, |θ − π|, |θ̇| ≤ 0.05, drawn from
     /// --seed), elsewhere a reset drawn from --seed.
     #[arg(long)]
@@ -87,11 +97,19 @@ impl StrategyChoice {
 }
 
 pub fn run(global: &GlobalArgs, args: CalibrateArgs) -> anyhow::Result<()> {
-    let env = parse_env(&args.env)?;
+    let mut env = parse_env(&args.env)?;
+    let unicycle = matches!(env, EnvName::Unicycle(_));
+    match (&args.map, unicycle) {
+        (Some(map), true) => env = env.with_terrain(UnicycleTerrain::new(vec![TerrainMap::read_png(map)?]))?,
+        (None, true) => bail!("--env unicycle: give --map PNG, the terrain the robot calibrates on"),
+        (Some(_), false) => bail!("--map is the unicycle's terrain; '{}' has none", env.canonical()),
+        (None, false) => {}
+    }
     let strategy = args.strategy.strategy();
+    let transitions = args.transitions.unwrap_or(if unicycle { 10 } else { 30 });
     let settings = CalibrationSettings {
         strategy,
-        transitions: args.transitions,
+        transitions,
         horizon_max: args.horizon,
         candidates: args.candidates,
         elites: args.elites,
@@ -103,7 +121,7 @@ pub fn run(global: &GlobalArgs, args: CalibrateArgs) -> anyhow::Result<()> {
     if !args.model.is_dir() {
         bail!("--model {}: no such checkpoint directory", args.model.display());
     }
-    let model = context::load(&args.model, &env)?;
+    let model = load_model(&args.model, &env)?;
     let out = args.out.clone().unwrap_or_else(|| {
         PathBuf::from(format!(
             "datasets/calib-{}-{}-i{}.mcap",
@@ -125,7 +143,7 @@ pub fn run(global: &GlobalArgs, args: CalibrateArgs) -> anyhow::Result<()> {
         "calibrate {} ({}, {} transitions, instance {})",
         env.canonical(),
         strategy.name(),
-        args.transitions,
+        transitions,
         args.instance_seed
     );
     let (calibration, instance) = run_job(global, "calibrate", |monitor| {
@@ -149,4 +167,20 @@ pub fn run(global: &GlobalArgs, args: CalibrateArgs) -> anyhow::Result<()> {
     );
     say!("context set written to {}", out.display());
     Ok(())
+}
+
+/// A context model of `env`, or a TRADYN model when `env` is the unicycle.
+fn load_model(dir: &std::path::Path, env: &EnvName) -> anyhow::Result<LoadedModel> {
+    let method = OpenedCheckpoint::open(dir)?.manifest.method;
+    let unicycle = matches!(env, EnvName::Unicycle(_));
+    if unicycle && method != tradyn::METHOD {
+        bail!(
+            "{}: is a '{method}' checkpoint; the unicycle calibrates a TRADYN model (`mbrl train --method tradyn`)",
+            dir.display()
+        );
+    }
+    if method == tradyn::METHOD && !unicycle {
+        bail!("{}: is a TRADYN model of the unicycle; calibrate it with --env unicycle --map PNG", dir.display());
+    }
+    Ok(if unicycle { TradynModel::load(dir)?.loaded } else { context::load(dir, env)? })
 }

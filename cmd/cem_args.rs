@@ -13,44 +13,61 @@ pub enum NoiseChoice {
     Colored,
 }
 
+/// Defaults are the task's planner: pendulum swing-up 20 / 1000 / 100 / 10, white, warm start; unicycle
+/// navigation (TRADYN) 30 / 1000 / 50 / 20, colored β 0.5, initial std 0.5, no warm start.
 #[derive(Args, Clone, Debug)]
 pub struct CemArgs {
-    /// Planning horizon in steps.
-    #[arg(long, default_value_t = 20)]
-    pub horizon: usize,
-    /// Candidate action sequences per iteration.
-    #[arg(long, default_value_t = 1000)]
-    pub candidates: usize,
-    /// Elite candidates used to refit the sampling distribution.
-    #[arg(long, default_value_t = 100)]
-    pub elites: usize,
-    /// CEM iterations per planning call.
-    #[arg(long, default_value_t = 10)]
-    pub iters: usize,
-    /// Sampling noise.
-    #[arg(long, value_enum, default_value_t = NoiseChoice::White)]
-    pub noise: NoiseChoice,
-    /// Exponent β of colored noise (used with --noise colored).
-    #[arg(long, default_value_t = 0.5, value_parser = finite_f64)]
-    pub beta: f64,
+    /// Planning horizon in steps (pendulum 20; unicycle 30, shrinking to the steps left).
+    #[arg(long)]
+    pub horizon: Option<usize>,
+    /// Candidate action sequences per iteration (1000).
+    #[arg(long)]
+    pub candidates: Option<usize>,
+    /// Elite candidates used to refit the sampling distribution (pendulum 100; unicycle 50).
+    #[arg(long)]
+    pub elites: Option<usize>,
+    /// CEM iterations per planning call (pendulum 10; unicycle 20).
+    #[arg(long)]
+    pub iters: Option<usize>,
+    /// Sampling noise (pendulum white; unicycle colored).
+    #[arg(long, value_enum)]
+    pub noise: Option<NoiseChoice>,
+    /// Exponent β of colored noise (0.5; used with --noise colored).
+    #[arg(long, value_parser = finite_f64)]
+    pub beta: Option<f64>,
     /// Start every planning call from zero instead of the previous plan shifted by one step.
     #[arg(long)]
     pub no_warm_start: bool,
 }
 
 impl CemArgs {
+    /// The pendulum planner (Algorithm 1 defaults) over these flags.
     pub fn config(&self, action_low: &[f64], action_high: &[f64]) -> CemConfig {
-        CemConfig {
-            horizon: self.horizon,
-            candidates: self.candidates,
-            elites: self.elites,
-            iterations: self.iters,
-            noise: match self.noise {
-                NoiseChoice::White => NoiseKind::White,
-                NoiseChoice::Colored => NoiseKind::Colored { beta: self.beta },
+        self.over(CemConfig::for_box(action_low, action_high))
+    }
+
+    /// `base` with the flags given applied.
+    pub fn over(&self, base: CemConfig) -> CemConfig {
+        let beta = self.beta.unwrap_or(match base.noise {
+            NoiseKind::Colored { beta } => beta,
+            NoiseKind::White => 0.5,
+        });
+        let noise = match self.noise {
+            Some(NoiseChoice::White) => NoiseKind::White,
+            Some(NoiseChoice::Colored) => NoiseKind::Colored { beta },
+            None => match base.noise {
+                NoiseKind::Colored { .. } => NoiseKind::Colored { beta },
+                white => white,
             },
-            warm_start: !self.no_warm_start,
-            ..CemConfig::for_box(action_low, action_high)
+        };
+        CemConfig {
+            horizon: self.horizon.unwrap_or(base.horizon),
+            candidates: self.candidates.unwrap_or(base.candidates),
+            elites: self.elites.unwrap_or(base.elites),
+            iterations: self.iters.unwrap_or(base.iterations),
+            noise,
+            warm_start: base.warm_start && !self.no_warm_start,
+            ..base
         }
     }
 }

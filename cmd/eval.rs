@@ -79,6 +79,13 @@ enum Protocol {
                             mbrl eval context --model models/context-pendulum-quadrant --env pendulum:quadrant --contexts 50 --transitions 30 --horizon 20 --swingup"
     )]
     Context(ContextArgs),
+    /// TRADYN (thesis 5.5): ±terrain lookup × ±calibration on navigation tasks on test maps: energy, final
+    /// distance, failures (Table 5.2), Wilcoxon on energies (Fig. 5.7), prediction error (Fig. 5.5), paths (Fig. 5.6).
+    #[command(
+        after_help = "Examples:\n  mbrl eval tradyn --model-terrain models/tradyn-terrain --model-no-terrain models/tradyn-no-terrain --maps datasets/terrain --tasks 20\n  \
+                            mbrl eval tradyn --model-terrain models/tradyn-terrain --model-no-terrain models/tradyn-no-terrain --maps datasets/terrain --tasks 150 --candidates 1000 --iters 20"
+    )]
+    Tradyn(TradynArgs),
     /// SEADS (thesis 7.4): skill coverage, boards solved per depth with and without replanning, planning time.
     #[command(
         after_help = "Example:\n  mbrl eval seads --model models/seads-tileswap-cursor --boards 20 --out reports/seads-tileswap"
@@ -203,6 +210,7 @@ pub fn run(global: &GlobalArgs, args: EvalArgs) -> anyhow::Result<()> {
             say!("report: {}", out.join("report.md").display());
         }
         Protocol::Context(a) => eval_context(global, &provenance, a)?,
+        Protocol::Tradyn(a) => eval_tradyn(global, &provenance, a)?,
         Protocol::Seads(a) => eval_seads(global, &provenance, a)?,
         Protocol::Dlgpd(a) => eval_dlgpd(global, &provenance, a)?,
         Protocol::Boards { out } => {
@@ -317,6 +325,109 @@ pub fn run(global: &GlobalArgs, args: EvalArgs) -> anyhow::Result<()> {
             );
         }
     }
+    Ok(())
+}
+
+#[derive(Args, Debug)]
+struct TradynArgs {
+    /// The TRADYN model with terrain lookup (`mbrl train --method tradyn`): the +T variants.
+    #[arg(long)]
+    model_terrain: PathBuf,
+    /// The ablation trained with `--no-terrain`: the −T variants.
+    #[arg(long)]
+    model_no_terrain: PathBuf,
+    /// The map set (`mbrl collect --env terrain`); tasks are drawn on its test maps.
+    #[arg(long)]
+    maps: PathBuf,
+    /// Navigation tasks (thesis: 150 per model seed).
+    #[arg(long, default_value_t = 20)]
+    tasks: usize,
+    /// Random colored calibration transitions from each start (thesis 10).
+    #[arg(long, default_value_t = 10)]
+    transitions: usize,
+    /// Executed steps per task (thesis 50).
+    #[arg(long, default_value_t = 50)]
+    steps: usize,
+    /// Longest planning horizon (thesis 30; it shrinks to the steps left).
+    #[arg(long, default_value_t = 30)]
+    horizon: usize,
+    /// CEM candidates per iteration (thesis 1000; the default trades it for time on a CPU).
+    #[arg(long, default_value_t = 300)]
+    candidates: usize,
+    /// CEM elites (thesis 50).
+    #[arg(long, default_value_t = 30)]
+    elites: usize,
+    /// CEM iterations (thesis 20).
+    #[arg(long, default_value_t = 10)]
+    iters: usize,
+    /// Length of the random rollout per task whose open-loop prediction is scored (thesis 50).
+    #[arg(long, default_value_t = 50)]
+    prediction_steps: usize,
+    /// Report directory.
+    #[arg(long, default_value = "reports/tradyn")]
+    out: PathBuf,
+}
+
+fn eval_tradyn(global: &GlobalArgs, provenance: &Provenance, a: TradynArgs) -> anyhow::Result<()> {
+    use mbrl::eval::tradyn::{evaluate, variant_name, TradynEvalModels, TradynEvalSettings, VARIANTS};
+    use mbrl::models::tradyn::navigation::NavigationSettings;
+    if !(2..=100_000).contains(&a.tasks)
+        || !(1..=10_000).contains(&a.steps)
+        || !(1..=10_000).contains(&a.prediction_steps)
+    {
+        bail!("--tasks must be 2..=100000, --steps and --prediction-steps 1..=10000");
+    }
+    if !(1..=1000).contains(&a.transitions) {
+        bail!("--transitions must be 1..=1000");
+    }
+    for (flag, dir) in [("--model-terrain", &a.model_terrain), ("--model-no-terrain", &a.model_no_terrain)] {
+        if !dir.is_dir() {
+            bail!("{flag} {}: no such checkpoint directory", dir.display());
+        }
+    }
+    let models = TradynEvalModels {
+        terrain: mbrl::models::tradyn::TradynModel::load(&a.model_terrain)?,
+        no_terrain: mbrl::models::tradyn::TradynModel::load(&a.model_no_terrain)?,
+    };
+    models.check()?;
+    let maps = mbrl::data::terrain_set::read_terrain_set(&a.maps, Some(mbrl::envs::terrain::TerrainSplit::Test))?;
+    let mut navigation = NavigationSettings::thesis();
+    navigation.steps = a.steps;
+    navigation.horizon = a.horizon;
+    navigation.cem.candidates = a.candidates;
+    navigation.cem.elites = a.elites;
+    navigation.cem.iterations = a.iters;
+    let settings = TradynEvalSettings {
+        tasks: a.tasks,
+        calibration_transitions: a.transitions,
+        navigation,
+        prediction_steps: a.prediction_steps,
+        example_tasks: 3,
+    };
+    settings.validate()?;
+    let summary =
+        run_job(global, "eval tradyn", |monitor| evaluate(&models, maps, &settings, provenance, &a.out, monitor))?;
+    for (v, variant) in VARIANTS.iter().enumerate() {
+        say!(
+            "{:<6} median energy {:.4}, median final distance {:.2} mm, failed {}/{}, mean position error {:.4} m",
+            variant_name(*variant),
+            summary.median_energy[v],
+            summary.median_distance[v] * 1000.0,
+            summary.failures[v],
+            summary.tasks,
+            summary.mean_position_error[v]
+        );
+    }
+    for (r, c, p) in &summary.energy_tests {
+        if r > c {
+            say!(
+                "Wilcoxon: {} less energy than {}: p = {p:.3e}",
+                variant_name(VARIANTS[*r]),
+                variant_name(VARIANTS[*c])
+            );
+        }
+    }
+    say!("report: {}", a.out.join("report.md").display());
     Ok(())
 }
 

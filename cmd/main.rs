@@ -20,6 +20,7 @@ mod export;
 mod filter;
 mod model_args;
 mod plan;
+mod plan_unicycle;
 mod predict;
 mod solve_board;
 mod train;

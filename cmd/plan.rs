@@ -23,6 +23,8 @@ Examples:
   mbrl plan --env pendulum:quadrant --model models/context-pendulum-quadrant --context calib.mcap --instance-seed 3
   mbrl collect --env pendulum:inverted --rollouts 20 --steps 29 --images --out datasets/evidence-inverted.mcap
   mbrl plan --env pendulum:inverted --model models/dlgpd-medium --evidence datasets/evidence-inverted.mcap
+  mbrl plan --env unicycle --model models/tradyn-terrain --map datasets/terrain/map050.png --start 0.2,0.3,1.57 --goal 0.7,0.6 --context calib-uni.mcap --instance-seed 4
+  mbrl plan --env unicycle --model true --map datasets/terrain/map050.png --start 0.2,0.3,1.57 --goal 0.7,0.6
 
 A DLGPD model plans from its observations (rendered frames, or pole angles for the small preset) in its
 latent space, on GPs conditioned on --evidence: rollouts of the system at hand (`collect --rollouts N`,
@@ -30,15 +32,30 @@ with --images for image models), encoded without retraining. Its CEM also stops 
 std is ≤ 0.01; `--iters 30 --no-warm-start` is the authors' planner.
 
 The pendulum starts hanging (θ ~ U[π-0.05, π+0.05], θ̇ ~ U[-0.05, 0.05]); success means each of the
-last 25 rewards is above -1 (thesis 3.5.2).")]
+last 25 rewards is above -1 (thesis 3.5.2).
+
+The unicycle (TRADYN, thesis 5.4.3) drives from --start x,y,φ at rest to --goal x,y on --map for 50 steps,
+minimizing ½Σ throttle² plus the terminal squared distance normalized over the candidates (eq. 5.13);
+success means a final distance of at most 5 cm. The robot is the one --instance-seed draws (Table 5.1),
+or the nominal robot (mass 2.5, gains 750 and 3π/16) without it. `--model true` plans on the simulator
+itself (an oracle); a TRADYN model plans with the mean of q(β | --context), the prior's mean without it.")]
 pub struct PlanArgs {
-    #[arg(long, help = concat!("Environment: ", mbrl::pendulum_envs!()))]
+    #[arg(long, help = concat!("Environment: ", mbrl::pendulum_envs!(), " or unicycle"))]
     env: String,
     #[command(flatten)]
     model: ModelArgs,
-    /// Steps to execute.
-    #[arg(long, default_value_t = 150)]
-    steps: usize,
+    /// Steps to execute (pendulum 150; unicycle 50).
+    #[arg(long)]
+    steps: Option<usize>,
+    /// Unicycle: the terrain map (PNG) to drive on.
+    #[arg(long)]
+    map: Option<PathBuf>,
+    /// Unicycle: start pose x,y,φ (position in [0, 1]², heading in radians; the robot starts at rest).
+    #[arg(long)]
+    start: Option<String>,
+    /// Unicycle: goal position x,y in [0, 1]².
+    #[arg(long)]
+    goal: Option<String>,
     #[command(flatten)]
     cem: CemArgs,
     /// DLGPD models: rollouts to condition the GPs on (a dataset written by `collect`).
@@ -52,22 +69,42 @@ pub struct PlanArgs {
     out: Option<PathBuf>,
 }
 
+impl PlanArgs {
+    fn unicycle(&self) -> crate::plan_unicycle::UnicycleTask {
+        crate::plan_unicycle::UnicycleTask {
+            map: self.map.clone(),
+            start: self.start.clone(),
+            goal: self.goal.clone(),
+            evidence: self.evidence.is_some(),
+            instance_seed: self.instance_seed,
+            out: self.out.clone(),
+        }
+    }
+}
+
 /// Generous bytes kept per executed step (state, action, reward, planner statistics).
 pub const STEP_RECORD_BYTES: usize = 512;
 
 pub fn run(global: &GlobalArgs, args: PlanArgs) -> anyhow::Result<()> {
-    let variant = pendulum_variant(&args.env)?;
-    if args.steps == 0 {
+    if args.steps == Some(0) {
         bail!("--steps must be at least 1");
     }
+    let steps = args.steps.unwrap_or(if args.env == "unicycle" { 50 } else { 150 });
     // The executed rollout and per-step planner records are kept until the file is written.
-    budget::check(
-        &format!("--steps {}", args.steps),
-        budget::times(&[args.steps], STEP_RECORD_BYTES),
-        "plan fewer steps",
-    )?;
+    budget::check(&format!("--steps {steps}"), budget::times(&[steps], STEP_RECORD_BYTES), "plan fewer steps")?;
+    if args.env == "unicycle" {
+        return crate::plan_unicycle::run(global, &args.model, &args.cem, steps, args.unicycle());
+    }
+    for (flag, given) in
+        [("--map", args.map.is_some()), ("--start", args.start.is_some()), ("--goal", args.goal.is_some())]
+    {
+        if given {
+            bail!("{flag} sets a unicycle navigation task (--env unicycle); '{}' has none", args.env);
+        }
+    }
+    let variant = pendulum_variant(&args.env)?;
     let mut settings = SwingupSettings::thesis(variant);
-    settings.steps = args.steps;
+    settings.steps = steps;
     settings.instance_seed = args.instance_seed;
     settings.cem = args.cem.config(&settings.cem.action_low, &settings.cem.action_high);
     settings.cem.validate()?;

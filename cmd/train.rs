@@ -13,6 +13,7 @@ use mbrl::models::dlgpd::config::{DlgpdConfig, Preset as DlgpdPreset};
 use mbrl::models::dlgpd::job as dlgpd;
 use mbrl::models::pets::{self, PetsConfig, Preset, RewardSource};
 use mbrl::models::seads::{self, EmbodiedGame, SeadsConfig};
+use mbrl::models::tradyn;
 use mbrl::run::dir::{Provenance, METRICS_FILE};
 use mbrl::train::config::apply_toml_file;
 use mbrl::train::data_file::scalar_history;
@@ -32,6 +33,10 @@ pub enum Method {
     /// Context-conditional GRU dynamics with a context encoder (Explore the Context, thesis ch. 4), trained
     /// on instance-pair datasets (`collect --instances N`); calibrate with `mbrl calibrate`.
     Context,
+    /// TRADYN (thesis ch. 5): the context model on the unicycle's observation with the terrain under the robot
+    /// as input, read from the map at predicted positions; --no-terrain trains the ablation that predicts it.
+    /// Data: `collect --env unicycle --maps DIR --split train --instances N --steps 100`.
+    Tradyn,
     /// SEADS (thesis ch. 7): skill policies (SAC) and a symbolic forward model learned without reward in an
     /// embodied board game (--env lightsout:cursor|tileswap:cursor|lightsout:reacher|tileswap:reacher); needs no
     /// --data, it collects its own episodes.
@@ -97,7 +102,7 @@ pub struct TrainArgs {
     #[arg(long)]
     out: Option<PathBuf>,
     /// Continue the stopped run in this checkpoint directory.
-    #[arg(long, conflicts_with_all = ["method", "data", "env", "out", "config", "preset", "ensemble", "steps", "batch", "lr", "reward", "launcher_prior", "skills", "env_steps", "no_relabel", "no_second_best", "no_novelty"])]
+    #[arg(long, conflicts_with_all = ["method", "data", "env", "out", "config", "preset", "ensemble", "steps", "batch", "lr", "reward", "launcher_prior", "skills", "env_steps", "no_relabel", "no_second_best", "no_novelty", "no_terrain"])]
     resume: Option<PathBuf>,
     /// Hyperparameters from a TOML file (pets, context), over the preset's.
     #[arg(long)]
@@ -142,6 +147,9 @@ pub struct TrainArgs {
     /// Ablation: no novelty bonus in the reward (seads).
     #[arg(long)]
     no_novelty: bool,
+    /// Ablation: no terrain lookup (tradyn "−T"): the terrain features become part of the predicted state.
+    #[arg(long)]
+    no_terrain: bool,
 }
 
 pub fn run(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
@@ -155,6 +163,7 @@ pub fn run(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
         Method::Pets => train_pets(global, args),
         Method::BallEkf => train_ball(global, args),
         Method::Context => train_context(global, args),
+        Method::Tradyn => train_tradyn(global, args),
         Method::Seads => train_seads(global, args),
         Method::Dlgpd => train_dlgpd(global, args),
     }
@@ -175,6 +184,10 @@ fn resume(global: &GlobalArgs, dir: &Path) -> anyhow::Result<()> {
             let report = run_job(global, "train context (resumed)", |monitor| context::resume(dir, monitor))?;
             print_context_report(&report, dir)
         }
+        tradyn::METHOD => {
+            let report = run_job(global, "train tradyn (resumed)", |monitor| context::resume(dir, monitor))?;
+            print_context_report(&report, dir)
+        }
         seads::METHOD => {
             let report = run_job(global, "train seads (resumed)", |monitor| seads::resume(dir, monitor))?;
             print_seads_report(&report, dir)
@@ -184,11 +197,12 @@ fn resume(global: &GlobalArgs, dir: &Path) -> anyhow::Result<()> {
             print_dlgpd_report(&report, dir)
         }
         other => bail!(
-            "{}: '{other}' runs cannot be resumed; resumable methods: {}, {}, {}, {}, {}",
+            "{}: '{other}' runs cannot be resumed; resumable methods: {}, {}, {}, {}, {}, {}",
             dir.display(),
             pets::METHOD,
             ball_job::METHOD,
             context::METHOD,
+            tradyn::METHOD,
             seads::METHOD,
             dlgpd::METHOD
         ),
@@ -328,14 +342,22 @@ fn train_context(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
     let [data] = args.data.as_slice() else {
         bail!("context trains on one --data file (a `collect --instances N` dataset), got {}", args.data.len());
     };
+    if args.no_terrain {
+        bail!("--no-terrain is the TRADYN ablation (--method tradyn)");
+    }
     let env_name = match &args.env {
         Some(env) => env.clone(),
         None => mbrl::data::read_dataset(data)?.meta.env,
     };
     let env = mbrl::envs::parse_env(&env_name)?;
+    if matches!(env, mbrl::envs::EnvName::Unicycle(_)) {
+        bail!("{}: unicycle data trains TRADYN, which reads the terrain: `mbrl train --method tradyn`", data.display());
+    }
     let config = context_config(&args, &env)?;
     let out = args.out.clone().unwrap_or_else(|| PathBuf::from(format!("models/context-{}", file_stem(&env_name))));
     let request = context::TrainRequest {
+        method: context::METHOD.into(),
+        space: context::StateSpace::EnvState,
         out: out.clone(),
         data: data.clone(),
         env: args.env.clone(),
@@ -347,12 +369,57 @@ fn train_context(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
     print_context_report(&report, &out)
 }
 
+fn train_tradyn(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
+    let [data] = args.data.as_slice() else {
+        bail!(
+            "tradyn trains on one --data file (`collect --env unicycle --maps DIR --split train --instances N`), got {}",
+            args.data.len()
+        );
+    };
+    let env_name = mbrl::data::read_dataset(data)?.meta.env;
+    let env = mbrl::envs::parse_env(&env_name)?;
+    if !matches!(env, mbrl::envs::EnvName::Unicycle(_)) {
+        bail!(
+            "{}: holds '{env_name}' data; TRADYN learns the unicycle on terrain (`mbrl collect --env unicycle --maps DIR --instances N`)",
+            data.display()
+        );
+    }
+    if args.env.as_deref().is_some_and(|e| e != "unicycle") {
+        bail!("--env: TRADYN models the unicycle; got '{}'", args.env.as_deref().unwrap_or_default());
+    }
+    let config = context_config(&args, &env)?;
+    let variant = if args.no_terrain { "no-terrain" } else { "terrain" };
+    let out = args.out.clone().unwrap_or_else(|| PathBuf::from(format!("models/tradyn-{variant}")));
+    let request = context::TrainRequest {
+        method: tradyn::METHOD.into(),
+        space: tradyn::state_space(!args.no_terrain),
+        out: out.clone(),
+        data: data.clone(),
+        env: None,
+        config,
+        seed: global.seed,
+        provenance: Provenance::new(command_line(), global.seed, global.thread_count()),
+    };
+    let report = run_job(global, "train tradyn", |monitor| context::train(&request, false, monitor))?;
+    print_context_report(&report, &out)
+}
+
 fn print_context_report(report: &context::TrainReport, out: &Path) -> anyhow::Result<()> {
-    write_loss_report(out, "Context-model training loss (eq. 4.32)", "loss")?;
     let run = &report.run;
+    let (what, loss) = if run.method == tradyn::METHOD {
+        let lookup = if run.model.local_dim > 0 {
+            "with terrain lookup"
+        } else {
+            "without terrain lookup (−T: terrain predicted)"
+        };
+        (format!("a TRADYN model {lookup}"), "TRADYN training loss (eq. 4.32 with terrain input)")
+    } else {
+        ("a context model".to_string(), "Context-model training loss (eq. 4.32)")
+    };
+    write_loss_report(out, loss, "loss")?;
     let c = &run.config;
     say!(
-        "trained a context model (embedding {}, D_F {}, D_β {}, {} parameters) on {} instances of {} ({} held out), batch {} × {} states",
+        "trained {what} (embedding {}, D_F {}, D_β {}, {} parameters) on {} instances of {} ({} held out), batch {} × {} states",
         c.embedding,
         c.transition_features,
         c.latent_dim,

@@ -208,7 +208,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__calibrate)
-            opts="-q -h -V --model --env --instance-seed --strategy --transitions --horizon --candidates --elites --iters --beta-samples --init-state --out --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --model --env --map --instance-seed --strategy --transitions --horizon --candidates --elites --iters --beta-samples --init-state --out --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -219,6 +219,10 @@ _mbrl() {
                     return 0
                     ;;
                 --env)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --map)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
@@ -1456,7 +1460,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__plan)
-            opts="-q -h -V --env --model --particles --propagation --context --steps --horizon --candidates --elites --iters --noise --beta --no-warm-start --evidence --instance-seed --out --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --env --model --particles --propagation --context --steps --map --start --goal --horizon --candidates --elites --iters --noise --beta --no-warm-start --evidence --instance-seed --out --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1483,6 +1487,18 @@ _mbrl() {
                     return 0
                     ;;
                 --steps)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --map)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --start)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --goal)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
@@ -1662,14 +1678,14 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__train)
-            opts="-q -h -V --method --data --env --out --resume --config --preset --ensemble --steps --batch --lr --reward --chunk --launcher-prior --skills --env-steps --no-relabel --no-second-best --no-novelty --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --method --data --env --out --resume --config --preset --ensemble --steps --batch --lr --reward --chunk --launcher-prior --skills --env-steps --no-relabel --no-second-best --no-novelty --no-terrain --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
             fi
             case "${prev}" in
                 --method)
-                    COMPREPLY=($(compgen -W "pets ball-ekf context seads dlgpd" -- "${cur}"))
+                    COMPREPLY=($(compgen -W "pets ball-ekf context tradyn seads dlgpd" -- "${cur}"))
                     return 0
                     ;;
                 --data)

@@ -73,21 +73,24 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l no-tui -d 'Print p
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -s V -l version -d 'Print version'
-complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l env -d 'Environment: pendulum[:light|heavy|mass=<m>|inverted|quadrant]' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l env -d 'Environment: pendulum[:light|heavy|mass=<m>|inverted|quadrant] or unicycle' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l model -d 'Dynamics the planner uses: `true` (the simulator\'s equations) or a checkpoint directory written by `mbrl train` (e.g. models/pets-pendulum)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l particles -d 'Particles per candidate for stochastic learned models (PETS: trajectory sampling)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l propagation -d 'How particles use the ensemble members' -r -f -a "ts1\t'TS-1: each particle draws an ensemble member anew at every step'
 tsinf\t'TS-∞: each particle keeps one member for the whole horizon'
 expectation\t'Each member\'s mean prediction, no sampling'"
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l context -d 'Calibration transitions (`mbrl calibrate --out`) a context model is conditioned on; without it the model plans with its prior mean context' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l steps -d 'Steps to execute' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l horizon -d 'Planning horizon in steps' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l candidates -d 'Candidate action sequences per iteration' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l elites -d 'Elite candidates used to refit the sampling distribution' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l iters -d 'CEM iterations per planning call' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l noise -d 'Sampling noise' -r -f -a "white\t'Independent Gaussian samples (thesis Algorithm 1)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l steps -d 'Steps to execute (pendulum 150; unicycle 50)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l map -d 'Unicycle: the terrain map (PNG) to drive on' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l start -d 'Unicycle: start pose x,y,φ (position in [0, 1]², heading in radians; the robot starts at rest)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l goal -d 'Unicycle: goal position x,y in [0, 1]²' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l horizon -d 'Planning horizon in steps (pendulum 20; unicycle 30, shrinking to the steps left)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l candidates -d 'Candidate action sequences per iteration (1000)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l elites -d 'Elite candidates used to refit the sampling distribution (pendulum 100; unicycle 50)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l iters -d 'CEM iterations per planning call (pendulum 10; unicycle 20)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l noise -d 'Sampling noise (pendulum white; unicycle colored)' -r -f -a "white\t'Independent Gaussian samples (thesis Algorithm 1)'
 colored\t'Power spectral density ∝ 1/f^β along time (iCEM)'"
-complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l beta -d 'Exponent β of colored noise (used with --noise colored)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l beta -d 'Exponent β of colored noise (0.5; used with --noise colored)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l evidence -d 'DLGPD models: rollouts to condition the GPs on (a dataset written by `collect`)' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l instance-seed -d 'Plan in the instance (hidden parameters) this seed names, as `calibrate --instance-seed` does' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l out -d 'Where to save the executed rollout (default: datasets/plan-<env>.mcap)' -r -F
@@ -103,6 +106,7 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -s V -l version -d 'Prin
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l method -d 'What to train' -r -f -a "pets\t'Probabilistic ensemble of MLPs on (state, action) → state change (PETS, Chua et al. 2018), for any env that `collect` rolls out; plan with it via `mbrl plan --model DIR`'
 ball-ekf\t'Gray-box table-tennis ball EKF: learn the impact matrix, noise levels and initial values by maximizing the filter\'s marginal likelihood (thesis 6.4.4, eq. 6.24)'
 context\t'Context-conditional GRU dynamics with a context encoder (Explore the Context, thesis ch. 4), trained on instance-pair datasets (`collect --instances N`); calibrate with `mbrl calibrate`'
+tradyn\t'TRADYN (thesis ch. 5): the context model on the unicycle\'s observation with the terrain under the robot as input, read from the map at predicted positions; --no-terrain trains the ablation that predicts it. Data: `collect --env unicycle --maps DIR --split train --instances N --steps 100`'
 seads\t'SEADS (thesis ch. 7): skill policies (SAC) and a symbolic forward model learned without reward in an embodied board game (--env lightsout:cursor|tileswap:cursor|lightsout:reacher|tileswap:reacher); needs no --data, it collects its own episodes'
 dlgpd\t'DLGPD (thesis ch. 3): a VAE on pendulum frames (`collect --images`) with Gaussian-process latent dynamics and reward; plan with `mbrl plan --model DIR --evidence E.mcap`. The small preset learns from the pole angle instead of frames'"
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l data -d 'Training data (repeatable). pets: rollout datasets (.mcap) of one env; ball-ekf: a ball dataset (.mcap) or a .csv recording. SEADS collects its own episodes and takes none' -r -F
@@ -129,24 +133,26 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l launcher-prior -d 'L
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l no-relabel -d 'Ablation: no relabelling of skill labels (seads)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l no-second-best -d 'Ablation: no second-best normalization of the reward (seads)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l no-novelty -d 'Ablation: no novelty bonus in the reward (seads)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l no-terrain -d 'Ablation: no terrain lookup (tradyn "−T"): the terrain features become part of the predicted state'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -s V -l version -d 'Print version'
-complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l model -d 'A context-model checkpoint (`mbrl train --method context`)' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l env -d 'Environment the model was trained on, e.g. toy:inner, pendulum:quadrant, mountaincar' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l model -d 'A context-model checkpoint (`mbrl train --method context`, or `--method tradyn` for the unicycle)' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l env -d 'Environment the model was trained on, e.g. toy:inner, pendulum:quadrant, mountaincar, unicycle' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l map -d 'For --env unicycle: the terrain map (PNG) the robot calibrates on' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l instance-seed -d 'Which instance (hidden parameters) to calibrate in' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l strategy -r -f -a "random\t'Uniformly random actions (the baseline)'
 open-loop\t'One action sequence maximizing the expected information gain, planned at the start (eq. 4.36)'
 mpc\t'Replan the EIG-optimal sequence after every transition, horizon min(H_max, N − n) (eq. 4.37)'"
-complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l transitions -d 'Calibration transitions N' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l transitions -d 'Calibration transitions N (default 30; TRADYN 10)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l horizon -d 'H_max: the longest planning horizon of MPC calibration' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l candidates -d 'CEM candidates per iteration' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l elites -d 'CEM elites' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l iters -d 'CEM iterations' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l beta-samples -d 'β samples of the Monte Carlo information gain' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l init-state -d 'Start state, comma-separated in the env\'s state order (pendulum: θ,θ̇). Default: the thesis\' start (toy x = 0; MountainCar x = ẋ = 0; pendulum:quadrant hanging down, |θ − π|, |θ̇| ≤ 0.05, drawn from --seed), elsewhere a reset drawn from --seed' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l init-state -d 'Start state, comma-separated in the env\'s state order (pendulum: θ,θ̇; unicycle: x,y,v,φ). Default: the thesis\' start (toy x = 0; MountainCar x = ẋ = 0; pendulum:quadrant hanging down, |θ − π|, |θ̇| ≤ 0.05, drawn from --seed), elsewhere a reset drawn from --seed' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l out -d 'Where to write the calibration transitions (default: datasets/calib-<env>-<strategy>-i<S>.mcap)' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l threads -d 'Worker threads (0 = one per core)' -r
@@ -349,13 +355,13 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l episodes -d 'Number of episodes (each with its own start state)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l env -d 'Environment variant: pendulum[:light|heavy|mass=<m>|inverted|quadrant]' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l steps -d 'Steps per episode' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l horizon -d 'Planning horizon in steps' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l candidates -d 'Candidate action sequences per iteration' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l elites -d 'Elite candidates used to refit the sampling distribution' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l iters -d 'CEM iterations per planning call' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l noise -d 'Sampling noise' -r -f -a "white\t'Independent Gaussian samples (thesis Algorithm 1)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l horizon -d 'Planning horizon in steps (pendulum 20; unicycle 30, shrinking to the steps left)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l candidates -d 'Candidate action sequences per iteration (1000)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l elites -d 'Elite candidates used to refit the sampling distribution (pendulum 100; unicycle 50)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l iters -d 'CEM iterations per planning call (pendulum 10; unicycle 20)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l noise -d 'Sampling noise (pendulum white; unicycle colored)' -r -f -a "white\t'Independent Gaussian samples (thesis Algorithm 1)'
 colored\t'Power spectral density ∝ 1/f^β along time (iCEM)'"
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l beta -d 'Exponent β of colored noise (used with --noise colored)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l beta -d 'Exponent β of colored noise (0.5; used with --noise colored)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l out -d 'Report directory' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l threads -d 'Worker threads (0 = one per core)' -r

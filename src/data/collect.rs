@@ -201,6 +201,19 @@ fn random_rollout(env: &mut dyn Env, spec: &EnvSpec, rng: &mut ChaCha8Rng, steps
     rollout
 }
 
+/// `steps` random actions as the env explores when collecting data (uniform, or colored noise).
+pub fn exploration_actions(env: &dyn Env, rng: &mut ChaCha8Rng, steps: usize) -> Vec<Vec<f64>> {
+    let spec = env.spec();
+    match env.exploration() {
+        Exploration::Colored { beta, std, min_len } => colored_actions(&spec, rng, steps, beta, std, min_len),
+        Exploration::Uniform => (0..steps)
+            .map(|_| {
+                spec.action_low.iter().zip(&spec.action_high).map(|(&lo, &hi)| rng.random_range(lo..=hi)).collect()
+            })
+            .collect(),
+    }
+}
+
 /// `steps` actions of Gaussian colored noise, one sequence per action dimension (at least `min_len` long, of
 /// which the first `steps` are used, so the spectrum does not depend on the rollout length), clipped.
 fn colored_actions(

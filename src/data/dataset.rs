@@ -167,6 +167,36 @@ fn layout(meta: &DatasetMeta) -> Layout<'static> {
     }
 }
 
+impl Dataset {
+    /// Rollouts of `spec`'s env as a dataset (rollout ids 0, 1, …; `instances` per rollout), for the rollouts a
+    /// planner or an evaluation executed.
+    pub fn of_rollouts(
+        spec: &crate::envs::EnvSpec,
+        instances: Vec<serde_json::Value>,
+        rollouts: &[Rollout],
+        seed: u64,
+        command_line: &str,
+    ) -> Dataset {
+        Dataset {
+            meta: DatasetMeta {
+                format_version: FORMAT_VERSION,
+                env: spec.name.clone(),
+                seed,
+                mbrl_version: crate::VERSION.to_string(),
+                command_line: command_line.to_string(),
+                instances,
+                state_names: spec.state_names.clone(),
+                action_dim: spec.action_dim(),
+                dt: spec.dt,
+                layout: DatasetLayout::Rollouts,
+                frames: None,
+            },
+            steps: rollouts.iter().enumerate().flat_map(|(i, r)| r.timesteps(i as u32)).collect(),
+            frames: Vec::new(),
+        }
+    }
+}
+
 /// Writes the dataset atomically: the file appears complete or not at all.
 pub fn write_dataset(path: &Path, dataset: &Dataset) -> Result<()> {
     let layout = layout(&dataset.meta);

@@ -151,6 +151,25 @@ impl<T: Dynamics> BatchDynamics for T {
     }
 }
 
+/// A simulator's dynamics behind a box (what `Env::dynamics` hands out) plan like the dynamics themselves.
+impl Dynamics for Box<dyn Dynamics> {
+    fn state_dim(&self) -> usize {
+        self.as_ref().state_dim()
+    }
+
+    fn action_dim(&self) -> usize {
+        self.as_ref().action_dim()
+    }
+
+    fn step(&self, state: &mut [f64], action: &[f64]) -> f64 {
+        self.as_ref().step(state, action)
+    }
+
+    fn rollout_returns(&self, init: &[f64], actions: &[f64], horizon: usize, returns: &mut [f64]) {
+        self.as_ref().rollout_returns(init, actions, horizon, returns)
+    }
+}
+
 /// A reward known in closed form, so a learned dynamics model need not learn it.
 pub trait RewardFn: Sync + Send {
     fn reward(&self, state: &[f64], action: &[f64], next_state: &[f64]) -> f64;

@@ -115,6 +115,7 @@ fn prediction_errors(model: &LoadedModel, beta: &[f32], rollout: &Rollout) -> Ve
         beta,
         1,
         horizon,
+        None,
         &mut predicted,
         &mut RolloutScratch::default(),
     );
@@ -163,7 +164,7 @@ pub fn entropy_after_one_action(model: &LoadedModel, actions: &[f64], samples: u
         .map(|&a| {
             let acts = vec![a as f32; samples];
             let mut next = vec![0.0; samples * fast.state_dim];
-            fast.rollout_means(&init, &acts, &betas, samples, 1, &mut next, &mut RolloutScratch::default());
+            fast.rollout_means(&init, &acts, &betas, samples, 1, None, &mut next, &mut RolloutScratch::default());
             let mut entropies = vec![0.0; samples];
             fast.entropy_after(&zero, &init, &acts, &next, samples, 1, &mut entropies, &mut RolloutScratch::default());
             entropies.iter().sum::<f64>() / samples as f64
@@ -264,7 +265,7 @@ pub fn evaluate(
             for (n, entropy) in calibration.entropies.iter().enumerate() {
                 monitor.scalar("calibration/entropy", n as u64, *entropy);
             }
-            let rows = context_rows(model, &calibration.rollout);
+            let rows = context_rows(model, &calibration.rollout)?;
             let beta = model.fast.belief(&model.fast.pool(&rows), 1).mean;
             let mse_by_horizon = mse_by_horizon(model, &beta, &validation, settings.validation_steps);
             let response = action_response(model, &beta, &probe);
@@ -348,7 +349,7 @@ fn action_response(model: &LoadedModel, beta: &[f32], probe: &ActionProbe) -> f6
     let mut scratch = RolloutScratch::default();
     let (mut along, mut norm) = (0.0, 0.0);
     for (start, true_delta) in probe.starts.iter().zip(probe.true_deltas.chunks_exact(s)) {
-        model.fast.rollout_means(start, &probe.actions, &betas, 2, 1, &mut predicted, &mut scratch);
+        model.fast.rollout_means(start, &probe.actions, &betas, 2, 1, None, &mut predicted, &mut scratch);
         for (d, t) in true_delta.iter().enumerate() {
             along += ((predicted[d] - predicted[s + d]) * t) as f64;
             norm += (t * t) as f64;
@@ -703,6 +704,8 @@ mod tests {
         config.steps = 1000;
         let provenance = Provenance::new(String::new(), 3, 1);
         let request = context::TrainRequest {
+            method: context::METHOD.into(),
+            space: context::StateSpace::EnvState,
             out: dir.path().join("model"),
             data,
             env: None,

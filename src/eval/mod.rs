@@ -10,3 +10,4 @@ pub mod quick;
 pub mod seads;
 pub mod stats;
 pub mod swingup;
+pub mod tradyn;

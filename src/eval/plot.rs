@@ -434,6 +434,80 @@ pub fn histogram(path: &Path, title: &str, x_label: &str, values: &[f64], bins: 
     })
 }
 
+/// A square colour grid drawn under paths: `rgb[3 (i n + j)..]` is the colour of the i-th x slice and j-th y
+/// slice of [0, 1]² (a terrain map, coarsened).
+pub struct ColorGrid {
+    pub cells: usize,
+    pub rgb: Vec<u8>,
+}
+
+/// One panel of [`map_paths`]: a map, named paths on it, and the start and goal crosses.
+pub struct MapPanel {
+    pub title: String,
+    pub grid: ColorGrid,
+    pub paths: Vec<Series>,
+    pub start: (f64, f64),
+    pub goal: (f64, f64),
+}
+
+/// Paths over maps on [0, 1]² (x right, y up), one panel per map side by side; path k has the same colour in
+/// every panel and the legend of the first panel names them. Start: white cross; goal: black cross.
+pub fn map_paths(path: &Path, title: &str, panels: &[MapPanel]) -> Result<()> {
+    let columns = panels.len().clamp(1, 3);
+    let rows = panels.len().div_ceil(columns).max(1);
+    let size = (460 * columns as u32, 60 + 460 * rows as u32);
+    render_atomic(path, |tmp| {
+        let root = BitMapBackend::new(tmp, size).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| plot_err(path, e))?;
+        let root = root.titled(title, ("sans-serif", 24)).map_err(|e| plot_err(path, e))?;
+        for (k, (panel, area)) in panels.iter().zip(root.split_evenly((rows, columns))).enumerate() {
+            let mut chart = ChartBuilder::on(&area)
+                .caption(&panel.title, ("sans-serif", 16))
+                .margin(8)
+                .x_label_area_size(30)
+                .y_label_area_size(36)
+                .build_cartesian_2d(0.0..1.0, 0.0..1.0)
+                .map_err(|e| plot_err(path, e))?;
+            chart
+                .configure_mesh()
+                .disable_mesh()
+                .x_desc("x [m]")
+                .y_desc("y [m]")
+                .draw()
+                .map_err(|e| plot_err(path, e))?;
+            let n = panel.grid.cells;
+            if n > 0 && panel.grid.rgb.len() == n * n * 3 {
+                let step = 1.0 / n as f64;
+                let cells = (0..n).flat_map(|i| (0..n).map(move |j| (i, j))).map(|(i, j)| {
+                    let at = (i * n + j) * 3;
+                    let [r, g, b] = [panel.grid.rgb[at], panel.grid.rgb[at + 1], panel.grid.rgb[at + 2]];
+                    let (x, y) = (i as f64 * step, j as f64 * step);
+                    Rectangle::new([(x, y), (x + step, y + step)], RGBColor(r, g, b).filled())
+                });
+                chart.draw_series(cells).map_err(|e| plot_err(path, e))?;
+            }
+            for (i, s) in panel.paths.iter().enumerate() {
+                let look = LineLook { width: 3, labelled: k == 0, mark_lone_points: false };
+                draw_line(&mut chart, path, s, series_color(i), look)?;
+            }
+            let cross = |(x, y): (f64, f64), color: RGBColor| {
+                let d = 0.02;
+                vec![
+                    PathElement::new(vec![(x - d, y - d), (x + d, y + d)], color.stroke_width(4)),
+                    PathElement::new(vec![(x - d, y + d), (x + d, y - d)], color.stroke_width(4)),
+                ]
+            };
+            chart.draw_series(cross(panel.start, WHITE)).map_err(|e| plot_err(path, e))?;
+            chart.draw_series(cross(panel.goal, BLACK)).map_err(|e| plot_err(path, e))?;
+            if k == 0 {
+                draw_legend(&mut chart, path, SeriesLabelPosition::UpperLeft, None)?;
+            }
+        }
+        root.present().map_err(|e| plot_err(path, e))?;
+        Ok(())
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

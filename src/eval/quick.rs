@@ -234,6 +234,8 @@ fn context_slice(squash: Squash, provenance: &Provenance, out_dir: &Path, monito
     let config = ContextConfig::preset(ContextPreset::Small, EnvFamily::Toy);
     let steps = config.steps;
     let request = context::TrainRequest {
+        method: context::METHOD.into(),
+        space: context::StateSpace::EnvState,
         out: dir.join("model"),
         data: data_path,
         env: None,

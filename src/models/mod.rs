@@ -4,6 +4,7 @@ pub mod dlgpd;
 pub mod gp;
 pub mod pets;
 pub mod seads;
+pub mod tradyn;
 
 use std::path::Path;
 

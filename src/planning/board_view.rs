@@ -30,7 +30,13 @@ pub fn layout(title: &str, side: usize, with_search: bool) -> Event {
         x_label: "x".into(),
         series: vec!["effector/x".into(), "effector/y".into()],
         restart_on_rewind: false,
-        path: Some(PathView { x: [0.0, 1.0], y: [0.0, 1.0], grid: u32::try_from(side).unwrap_or(0), y_down: true }),
+        path: Some(PathView {
+            x: [0.0, 1.0],
+            y: [0.0, 1.0],
+            grid: u32::try_from(side).unwrap_or(0),
+            y_down: true,
+            background: None,
+        }),
     });
     Event::Layout { title: title.to_string(), panels }
 }

@@ -47,6 +47,31 @@ pub struct PathView {
     pub grid: u32,
     /// Whether y grows downwards, as the rows of a board printed as text do.
     pub y_down: bool,
+    /// Colours under the path (a terrain map), coarse enough to send in a layout.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub background: Option<Background>,
+}
+
+/// An n × n grid of colours over a path panel's plane: cell (i, j), at `rgb[3 (i n + j)..]`, covers the i-th
+/// slice of the plane's x range and the j-th of its y range.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Background {
+    pub cells: u32,
+    pub rgb: Vec<u8>,
+}
+
+impl Background {
+    /// The colour at fractions (u, v) ∈ [0, 1]² of the plane's x and y ranges; `None` for a grid whose bytes do
+    /// not match its size (a corrupt replayed file).
+    pub fn color_at(&self, u: f64, v: f64) -> Option<[u8; 3]> {
+        let n = self.cells as usize;
+        if n == 0 || self.rgb.len() != n.checked_mul(n)?.checked_mul(3)? {
+            return None;
+        }
+        let index = |f: f64| ((f.clamp(0.0, 1.0) * n as f64) as usize).min(n - 1);
+        let at = (index(u) * n + index(v)) * 3;
+        Some([self.rgb[at], self.rgb[at + 1], self.rgb[at + 2]])
+    }
 }
 
 impl Event {
@@ -99,7 +124,13 @@ mod tests {
                     x_label: "x".into(),
                     series: vec!["effector/x".into(), "effector/y".into()],
                     restart_on_rewind: false,
-                    path: Some(PathView { x: [0.0, 1.0], y: [0.0, 1.0], grid: 5, y_down: true }),
+                    path: Some(PathView {
+                        x: [0.0, 1.0],
+                        y: [0.0, 1.0],
+                        grid: 5,
+                        y_down: true,
+                        background: Some(Background { cells: 1, rgb: vec![1, 2, 3] }),
+                    }),
                 }],
             },
             Event::scalar("loss", 3, 0.5),

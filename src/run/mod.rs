@@ -5,5 +5,5 @@ pub mod event;
 pub mod follow;
 pub mod monitor;
 
-pub use event::{Event, PanelSpec, PathView};
+pub use event::{Background, Event, PanelSpec, PathView};
 pub use monitor::{ChannelMonitor, ConsoleMonitor, Fanout, JsonlMonitor, Monitor, NullMonitor, Tee};

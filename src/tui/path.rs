@@ -1,5 +1,6 @@
 //! A path panel: the (x, y) pairs of two series drawn on a fixed plane over an optional grid, such as
-//! an effector's path over the board it plays on.
+//! an effector's path over the board it plays on; a second pair of series is a second path (a robot's plan
+//! beside the path it drove).
 
 use ratatui::style::{Color, Style};
 use ratatui::symbols::Marker;
@@ -18,17 +19,24 @@ pub(crate) struct PathPlot {
     x: [f64; 2],
     y: [f64; 2],
     points: Vec<(f64, f64)>,
+    second: Vec<(f64, f64)>,
     grid: Vec<(f64, f64)>,
 }
 
 impl PathPlot {
-    pub(crate) fn new(xs: &Series, ys: &Series, view: &PathView) -> Self {
+    pub(crate) fn new(xs: &Series, ys: &Series, second: Option<(&Series, &Series)>, view: &PathView) -> Self {
         let x = plane(view.x, xs);
         let y = plane(view.y, ys);
-        PathPlot { x, y, points: path_points(xs, ys, view.y_down, y), grid: grid_polyline(x, y, view.grid) }
+        PathPlot {
+            x,
+            y,
+            points: path_points(xs, ys, view.y_down, y),
+            second: second.map_or_else(Vec::new, |(sx, sy)| path_points(sx, sy, view.y_down, y)),
+            grid: grid_polyline(x, y, view.grid),
+        }
     }
 
-    /// The grid in grey, the path in cyan, its newest point as a yellow block.
+    /// The grid in grey, the path in cyan, its newest point as a yellow block, a second path in magenta.
     pub(crate) fn chart<'a>(&'a self, block: Block<'a>) -> Chart<'a> {
         let line = |points: &'a [(f64, f64)], color: Color| {
             Dataset::default()
@@ -37,7 +45,11 @@ impl PathPlot {
                 .style(Style::default().fg(color))
                 .data(points)
         };
-        let mut datasets = vec![line(&self.grid, Color::DarkGray), line(&self.points, Color::Cyan)];
+        let mut datasets = vec![
+            line(&self.grid, Color::DarkGray),
+            line(&self.second, Color::Magenta),
+            line(&self.points, Color::Cyan),
+        ];
         if let Some(last) = self.points.len().checked_sub(1) {
             datasets.push(
                 Dataset::default()
@@ -116,15 +128,15 @@ mod tests {
     }
 
     fn board(y_down: bool) -> PathView {
-        PathView { x: [0.0, 1.0], y: [0.0, 1.0], grid: 5, y_down }
+        PathView { x: [0.0, 1.0], y: [0.0, 1.0], grid: 5, y_down, background: None }
     }
 
     #[test]
     fn points_pair_by_step_and_mirror_a_downward_y() {
         let xs = series(&[(1, 0.1), (2, 0.2), (3, 0.3)]);
         let ys = series(&[(2, 0.9), (3, 0.7)]);
-        assert_eq!(PathPlot::new(&xs, &ys, &board(false)).points, vec![(0.2, 0.9), (0.3, 0.7)]);
-        let flipped = PathPlot::new(&xs, &ys, &board(true)).points;
+        assert_eq!(PathPlot::new(&xs, &ys, None, &board(false)).points, vec![(0.2, 0.9), (0.3, 0.7)]);
+        let flipped = PathPlot::new(&xs, &ys, None, &board(true)).points;
         assert!((flipped[0].1 - 0.1).abs() < 1e-12 && (flipped[1].1 - 0.3).abs() < 1e-12, "{flipped:?}");
     }
 

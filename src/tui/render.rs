@@ -125,6 +125,13 @@ fn render_body(app: &App, frame: &mut Frame, area: Rect) {
         return;
     }
     let [curves, method] = Layout::horizontal([Constraint::Percentage(50); 2]).areas(area);
+    // A map under a path is the view's main picture: it takes the Curves panel's place.
+    if let Some(first) = app.panels().first().filter(|p| p.spec().path.as_ref().is_some_and(|v| v.background.is_some()))
+    {
+        render_panel(first, frame, curves);
+        render_panels(&app.panels()[1..], app, frame, method);
+        return;
+    }
     render_curves(app, frame, curves);
     render_method(app, frame, method);
 }
@@ -158,10 +165,15 @@ fn text_heights(app: &App) -> Vec<u16> {
 
 /// The chart panels, then the text panels sized to their text.
 fn render_method(app: &App, frame: &mut Frame, area: Rect) {
-    let heights = method_rows(app.panels().len(), &text_heights(app), area.height);
+    render_panels(app.panels(), app, frame, area);
+}
+
+/// These chart panels, then the app's text panels sized to their text.
+fn render_panels(panels: &[Panel], app: &App, frame: &mut Frame, area: Rect) {
+    let heights = method_rows(panels.len(), &text_heights(app), area.height);
     let rows = stack(area, &heights);
-    let (chart_rows, text_rows) = rows.split_at(app.panels().len());
-    for (panel, row) in app.panels().iter().zip(chart_rows) {
+    let (chart_rows, text_rows) = rows.split_at(panels.len());
+    for (panel, row) in panels.iter().zip(chart_rows) {
         render_panel(panel, frame, *row);
     }
     for (panel, row) in app.text_panels().iter().zip(text_rows) {
@@ -187,7 +199,13 @@ fn render_panel(panel: &Panel, frame: &mut Frame, area: Rect) {
     if let Some(view) = &spec.path {
         let mut series = panel.series().map(|(_, s)| s);
         if let (Some(xs), Some(ys)) = (series.next(), series.next()) {
-            frame.render_widget(PathPlot::new(xs, ys, view).chart(block), area);
+            let second = series.next().zip(series.next());
+            let inner = block.inner(area);
+            frame.render_widget(PathPlot::new(xs, ys, second, view).chart(block), area);
+            // After the chart, whose canvas resets the background: only the cells' background changes.
+            if let Some(background) = &view.background {
+                paint_background(frame, inner, background, view.y_down);
+            }
             return;
         }
     }
@@ -199,6 +217,23 @@ fn render_panel(panel: &Panel, frame: &mut Frame, area: Rect) {
         .map(|(i, (label, (_, series)))| Trace { name: label.to_string(), points: series.points(), color: color(i) })
         .collect();
     frame.render_widget(line_chart(traces, &spec.x_label, block), area);
+}
+
+/// Colours each cell of a path panel's plot area from the panel's background grid, under the path.
+fn paint_background(frame: &mut Frame, area: Rect, background: &crate::run::Background, y_down: bool) {
+    let buffer = frame.buffer_mut();
+    for row in 0..area.height {
+        for col in 0..area.width {
+            let u = (f64::from(col) + 0.5) / f64::from(area.width);
+            let from_top = (f64::from(row) + 0.5) / f64::from(area.height);
+            let v = if y_down { from_top } else { 1.0 - from_top };
+            if let Some([r, g, b]) = background.color_at(u, v) {
+                if let Some(cell) = buffer.cell_mut((area.x + col, area.y + row)) {
+                    cell.set_bg(Color::Rgb(r, g, b));
+                }
+            }
+        }
+    }
 }
 
 /// The text verbatim. No wrapping: a wrapped row would break a board's grid, so long lines are cut at
@@ -546,7 +581,7 @@ mod tests {
                     x_label: "x".into(),
                     series: vec!["p/x".into(), "p/y".into()],
                     restart_on_rewind: false,
-                    path: Some(PathView { x, y, grid, y_down: true }),
+                    path: Some(PathView { x, y, grid, y_down: true, background: None }),
                 }],
             });
             for step in 0..3 {

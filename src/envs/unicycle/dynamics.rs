@@ -119,7 +119,7 @@ impl UnicycleDynamics {
 }
 
 /// NaN becomes 0 (no input) rather than poisoning the state.
-fn clip_action(a: f64) -> f64 {
+pub fn clip_action(a: f64) -> f64 {
     if a.is_nan() {
         0.0
     } else {

@@ -10,7 +10,7 @@ use std::sync::Arc;
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
-pub use dynamics::{UnicycleDynamics, DT, MAX_SPEED};
+pub use dynamics::{clip_action, UnicycleDynamics, DT, MAX_SPEED};
 pub use params::RobotParams;
 
 use super::terrain::TerrainMap;
@@ -34,6 +34,17 @@ impl PartialEq for UnicycleTerrain {
         self.maps.len() == other.maps.len()
             && self.maps.iter().zip(&other.maps).all(|(a, b)| a.crc32 == b.crc32 && a.name == b.name)
     }
+}
+
+/// Names of the observation's features: the robot's, then the terrain's (`TERRAIN_FEATURES` of them).
+pub const OBSERVATION_NAMES: [&str; 8] = ["x", "y", "v_over_5", "cos_phi", "sin_phi", "tau_r", "tau_g", "tau_b"];
+pub const TERRAIN_FEATURES: usize = 3;
+
+/// What the robot observes in state [x, y, v, φ] on `map`: [x, y, v/5, cos φ, sin φ, τ(x, y)].
+pub fn observation(state: &[f64], map: &TerrainMap) -> Vec<f64> {
+    let [x, y, v, phi] = [state[0], state[1], state[2], state[3]];
+    let tau = map.feature_at(x, y);
+    vec![x, y, v / MAX_SPEED, phi.cos(), phi.sin(), tau[0], tau[1], tau[2]]
 }
 
 /// Exploration noise of the authors' data: Gaussian colored noise, β = 0.5, std 0.5, drawn as one
@@ -68,7 +79,7 @@ impl Env for Unicycle {
         EnvSpec {
             name: "unicycle".into(),
             state_names: names(&["x", "y", "v", "phi"]),
-            obs_names: names(&["x", "y", "v_over_5", "cos_phi", "sin_phi", "tau_r", "tau_g", "tau_b"]),
+            obs_names: names(&OBSERVATION_NAMES),
             action_low: vec![-1.0, -1.0],
             action_high: vec![1.0, 1.0],
             dt: DT,
@@ -108,9 +119,7 @@ impl Env for Unicycle {
     }
 
     fn observe(&self) -> Vec<f64> {
-        let [x, y, v, phi] = self.state;
-        let tau = self.dynamics.map.feature_at(x, y);
-        vec![x, y, v / MAX_SPEED, phi.cos(), phi.sin(), tau[0], tau[1], tau[2]]
+        observation(&self.state, &self.dynamics.map)
     }
 
     fn params(&self) -> serde_json::Value {

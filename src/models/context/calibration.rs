@@ -3,7 +3,6 @@
 //! once by maximizing the EIG; MPC calibration replans after every transition with the horizon
 //! min(H_max, N − n).
 
-use rand::Rng;
 use serde::{Deserialize, Serialize};
 
 use super::eig::EigObjective;
@@ -105,14 +104,14 @@ pub struct Calibration {
 }
 
 /// Model-space rows [s, a, s'] of a rollout's transitions.
-pub fn context_rows(model: &LoadedModel, rollout: &Rollout) -> Vec<f32> {
+pub fn context_rows(model: &LoadedModel, rollout: &Rollout) -> Result<Vec<f32>> {
     let mut rows = Vec::new();
     for t in 0..rollout.len() {
-        rows.extend(model.features(&rollout.states[t]));
+        rows.extend(model.model_state(&rollout.states[t], rollout.observations.get(t))?);
         rows.extend(rollout.actions[t].iter().map(|a| *a as f32));
-        rows.extend(model.features(&rollout.states[t + 1]));
+        rows.extend(model.model_state(&rollout.states[t + 1], rollout.observations.get(t + 1))?);
     }
-    rows
+    Ok(rows)
 }
 
 /// Runs `settings.strategy` in `env` from its current state. `seed` keys random actions, β samples and CEM.
@@ -125,6 +124,12 @@ pub fn calibrate(
     mut on_step: impl FnMut(&CalibrationStep),
 ) -> Result<Calibration> {
     settings.validate()?;
+    if model.run.model.observations && settings.strategy != Strategy::Random {
+        return Err(Error::config(format!(
+            "a {} model calibrates with random actions (thesis 5.4.2); supported: --strategy random",
+            model.run.method
+        )));
+    }
     let spec = env.spec();
     let fast = &model.fast;
     let n = settings.transitions;
@@ -143,7 +148,11 @@ pub fn calibrate(
         warm_start: false,
         stop_std: None,
     };
-    let mut random = rng_for(seed, &[0]);
+    let random_actions = match settings.strategy {
+        Strategy::Random => crate::data::collect::exploration_actions(env, &mut rng_for(seed, &[0]), n),
+        _ => Vec::new(),
+    };
+    let mut observation = env.observe();
     let mut open_loop_plan: Vec<f64> = Vec::new();
     for t in 0..n {
         if monitor.is_cancelled() {
@@ -151,9 +160,7 @@ pub fn calibrate(
         }
         let state = env.state();
         let action: Vec<f64> = match settings.strategy {
-            Strategy::Random => {
-                spec.action_low.iter().zip(&spec.action_high).map(|(&l, &h)| random.random_range(l..=h)).collect()
-            }
+            Strategy::Random => random_actions.get(t).cloned().unwrap_or_default(),
             Strategy::OpenLoop | Strategy::Mpc => {
                 let replan = settings.strategy == Strategy::Mpc || t == 0;
                 if replan {
@@ -179,9 +186,10 @@ pub fn calibrate(
         };
         let step = env.step(&action);
         let next_state = env.state();
-        let mut row = model.features(&state);
+        let mut row = model.model_state(&state, Some(&observation))?;
         row.extend(action.iter().map(|a| *a as f32));
-        row.extend(model.features(&next_state));
+        row.extend(model.model_state(&next_state, Some(&step.obs))?);
+        observation = step.obs.clone();
         max_into(&mut pooled, &fast.pool(&row));
         let entropy = gaussian_entropy(&fast.belief(&pooled, 1).std);
         entropies.push(entropy);
@@ -321,8 +329,8 @@ pub fn read_context(model: &LoadedModel, path: &std::path::Path) -> Result<Vec<f
             format!("holds transitions of '{}'; the model is of '{}'", dataset.meta.env, model.run.env),
         ));
     }
-    if dataset.meta.state_names != model.run.model.state_names || dataset.meta.action_dim != model.run.model.action_dim
-    {
+    let names_match = model.run.model.observations || dataset.meta.state_names == model.run.model.state_names;
+    if !names_match || dataset.meta.action_dim != model.run.model.action_dim {
         return Err(Error::bad_file(
             path,
             format!(
@@ -336,5 +344,9 @@ pub fn read_context(model: &LoadedModel, path: &std::path::Path) -> Result<Vec<f
     }
     let rollouts = Rollout::group(&dataset.steps)
         .map_err(|i| Error::bad_file(path, format!("message {i} does not continue its rollout")))?;
-    Ok(rollouts.iter().flat_map(|(_, r)| context_rows(model, r)).collect())
+    let mut rows = Vec::new();
+    for (_, rollout) in &rollouts {
+        rows.extend(context_rows(model, rollout).map_err(|e| Error::bad_file(path, e.to_string()))?);
+    }
+    Ok(rows)
 }

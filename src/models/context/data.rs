@@ -31,6 +31,13 @@ impl Episode {
         Episode { states, actions, len: rollout.len() }
     }
 
+    /// The rollout's observations as they are (TRADYN models the unicycle's observation, terrain included).
+    pub fn from_observations(rollout: &Rollout) -> Self {
+        let states = rollout.observations.iter().flatten().map(|&x| x as f32).collect();
+        let actions = rollout.actions.iter().flatten().map(|&a| a as f32).collect();
+        Episode { states, actions, len: rollout.len() }
+    }
+
     /// Transition `t` as the context encoder reads it: [s_t, a_t, s_{t+1}].
     pub fn transition(&self, t: usize, state_dim: usize, action_dim: usize, out: &mut Vec<f32>) {
         out.extend_from_slice(&self.states[t * state_dim..(t + 1) * state_dim]);
@@ -50,6 +57,8 @@ pub struct InstancePair {
 pub struct ContextData {
     pub state_dim: usize,
     pub action_dim: usize,
+    /// Trailing state features the model reads from the world instead of predicting (TRADYN's terrain).
+    pub local_dim: usize,
     pub pairs: Vec<InstancePair>,
 }
 
@@ -59,6 +68,8 @@ pub struct Batch {
     pub size: usize,
     /// States per chunk (N); the chunk has N − 1 transitions.
     pub chunk: usize,
+    /// The states' trailing features that are model input, not prediction targets.
+    pub local_dim: usize,
     /// [B, N, S].
     pub states: Vec<f32>,
     /// [B, N − 1, A].
@@ -120,10 +131,10 @@ impl ContextData {
                 train.push(pair)
             }
         }
-        let (s, a) = (self.state_dim, self.action_dim);
+        let (s, a, l) = (self.state_dim, self.action_dim, self.local_dim);
         (
-            ContextData { state_dim: s, action_dim: a, pairs: train },
-            ContextData { state_dim: s, action_dim: a, pairs: valid },
+            ContextData { state_dim: s, action_dim: a, local_dim: l, pairs: train },
+            ContextData { state_dim: s, action_dim: a, local_dim: l, pairs: valid },
         )
     }
 
@@ -142,6 +153,7 @@ impl ContextData {
         let mut batch = Batch {
             size,
             chunk,
+            local_dim: self.local_dim,
             states: Vec::with_capacity(size * chunk * s),
             actions: Vec::with_capacity(size * transitions * a),
             chunk_transitions: Vec::with_capacity(size * transitions * tdim),
@@ -198,6 +210,7 @@ mod tests {
         let data = ContextData {
             state_dim: 2,
             action_dim: 1,
+            local_dim: 0,
             pairs: vec![InstancePair { target: episode(0.0, 20), source: episode(1000.0, 20) }],
         };
         let mut rng = ChaCha8Rng::seed_from_u64(1);

@@ -94,7 +94,7 @@ impl BatchDynamics for ContextDynamics {
             let betas = self.beta.repeat(rows);
             let mut predicted = vec![0.0; rows * horizon * f];
             let mut scratch = RolloutScratch::default();
-            fast.rollout_means(&init_features, &actions32, &betas, rows, horizon, &mut predicted, &mut scratch);
+            fast.rollout_means(&init_features, &actions32, &betas, rows, horizon, None, &mut predicted, &mut scratch);
             let mut prev = vec![0.0; d];
             let mut next = vec![0.0; d];
             for r in 0..rows {

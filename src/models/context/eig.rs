@@ -64,7 +64,7 @@ impl<'a> EigObjective<'a> {
                 }
                 let mut scratch = RolloutScratch::default();
                 let mut states = vec![0.0; rows * horizon * s];
-                self.model.rollout_means(&self.init, &actions, &betas, rows, horizon, &mut states, &mut scratch);
+                self.model.rollout_means(&self.init, &actions, &betas, rows, horizon, None, &mut states, &mut scratch);
                 let mut entropies = vec![0.0; rows];
                 self.model.entropy_after(
                     &self.base_pool,

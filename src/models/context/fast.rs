@@ -8,9 +8,18 @@ use crate::nn::activation::fast_softplus;
 use crate::nn::dense::{DenseGru, DenseLayer, DenseStack, StackScratch};
 use crate::nn::{Activation, ParamSet};
 
+/// Reads the world's features (TRADYN: the terrain under the robot) at a predicted state.
+pub trait LocalFeatures: Sync {
+    /// `predicted` holds the model's predicted features of one row; `out` gets the local ones.
+    fn at(&self, predicted: &[f32], out: &mut [f32]);
+}
+
 #[derive(Clone)]
 pub struct FastContextModel {
+    /// Model-space state: the predicted features, then the `local_dim` ones read from the world.
     pub state_dim: usize,
+    pub predicted_dim: usize,
+    pub local_dim: usize,
     pub action_dim: usize,
     pub latent_dim: usize,
     pub embedding: usize,
@@ -18,6 +27,7 @@ pub struct FastContextModel {
     state_encoder: DenseStack,
     action_encoder: DenseStack,
     context_embedding: DenseStack,
+    terrain_embedding: Option<DenseStack>,
     gru: DenseGru,
     mean_decoder: DenseStack,
     transition_encoder: DenseStack,
@@ -42,6 +52,8 @@ pub struct RolloutScratch {
     gh: Vec<f32>,
     act_in: Vec<f32>,
     act_emb: Vec<f32>,
+    local: Vec<f32>,
+    local_emb: Vec<f32>,
     state: Vec<f32>,
     ctx_emb: Vec<f32>,
     transitions: Vec<f32>,
@@ -67,19 +79,28 @@ impl FastContextModel {
         let state_encoder = two_layer(params, "state_encoder", Activation::Tanh, false)?;
         let action_encoder = two_layer(params, "action_encoder", Activation::Relu, false)?;
         let context_embedding = two_layer(params, "context_embedding", Activation::Relu, false)?;
+        let terrain_embedding = if params.tensors.iter().any(|t| t.name.starts_with("terrain_embedding.")) {
+            Some(two_layer(params, "terrain_embedding", Activation::Relu, false)?)
+        } else {
+            None
+        };
         let gru = DenseGru::from_params(params, "gru")?;
         let mean_decoder = two_layer(params, "mean_decoder", Activation::Identity, false)?;
         let transition_encoder = two_layer(params, "transition_encoder", Activation::Relu, false)?;
         let context_mean = two_layer(params, "context_mean", Activation::Identity, false)?;
         let context_std = two_layer(params, "context_std", Activation::Identity, true)?;
-        let (s, a, e) = (mean_decoder.d_out(), action_encoder.d_in(), gru.d_hidden);
+        let (p, a, e) = (mean_decoder.d_out(), action_encoder.d_in(), gru.d_hidden);
         let (f, b) = (transition_encoder.d_out(), context_mean.d_out());
-        let consistent = state_encoder.d_in() == s
+        let local = terrain_embedding.as_ref().map_or(0, |t| t.d_in());
+        let s = p + local;
+        let inputs = if terrain_embedding.is_some() { 3 } else { 2 };
+        let consistent = state_encoder.d_in() == p
             && state_encoder.d_out() == e
             && action_encoder.d_out() == e
             && context_embedding.d_in() == b
             && context_embedding.d_out() == e
-            && gru.d_input == 2 * e
+            && terrain_embedding.as_ref().is_none_or(|t| t.d_out() == e)
+            && gru.d_input == inputs * e
             && mean_decoder.d_in() == e
             && transition_encoder.d_in() == 2 * s + a
             && context_mean.d_in() == f
@@ -90,6 +111,8 @@ impl FastContextModel {
         }
         Ok(FastContextModel {
             state_dim: s,
+            predicted_dim: p,
+            local_dim: local,
             action_dim: a,
             latent_dim: b,
             embedding: e,
@@ -97,6 +120,7 @@ impl FastContextModel {
             state_encoder,
             action_encoder,
             context_embedding,
+            terrain_embedding,
             gru,
             mean_decoder,
             transition_encoder,
@@ -142,7 +166,9 @@ impl FastContextModel {
     }
 
     /// Mean predictions s_1..s_H of `rows` rollouts from one start: `actions` is rows × H × A, `betas` rows × D_β;
-    /// `out` gets rows × H × S.
+    /// `out` gets rows × H × S. A model with local features reads them with `local` at the start and at every
+    /// predicted state (eq. 5.12); without a reader they stay those of the start.
+    #[allow(clippy::too_many_arguments)]
     pub fn rollout_means(
         &self,
         init: &[f32],
@@ -150,18 +176,27 @@ impl FastContextModel {
         betas: &[f32],
         rows: usize,
         horizon: usize,
+        local: Option<&dyn LocalFeatures>,
         out: &mut [f32],
         w: &mut RolloutScratch,
     ) {
-        let (s, a, e) = (self.state_dim, self.action_dim, self.embedding);
+        let (s, p, l, a, e) = (self.state_dim, self.predicted_dim, self.local_dim, self.action_dim, self.embedding);
+        debug_assert_eq!(init.len(), s);
         debug_assert_eq!(actions.len(), rows * horizon * a);
         debug_assert_eq!(out.len(), rows * horizon * s);
         // Every row starts from the same state: embed it once.
         let mut h0 = Vec::new();
-        self.state_encoder.forward(init, 1, &mut h0, &mut w.stack);
+        self.state_encoder.forward(&init[..p], 1, &mut h0, &mut w.stack);
         w.h.clear();
+        w.local.clear();
         for _ in 0..rows {
             w.h.extend_from_slice(&h0);
+            w.local.extend_from_slice(&init[p..]);
+        }
+        if let Some(reader) = local {
+            for r in 0..rows {
+                reader.at(&init[..p], &mut w.local[r * l..(r + 1) * l]);
+            }
         }
         self.context_embedding.forward(betas, rows, &mut w.ctx_emb, &mut w.stack);
         w.ctx_gates = self.gru.input_gates_block(&w.ctx_emb, rows, 0..e, true);
@@ -175,11 +210,20 @@ impl FastContextModel {
             w.gates.clear();
             w.gates.extend_from_slice(&w.ctx_gates);
             self.gru.add_input_gates(&w.act_emb, rows, e..2 * e, &mut w.gates);
+            if let Some(terrain) = &self.terrain_embedding {
+                terrain.forward(&w.local, rows, &mut w.local_emb, &mut w.stack);
+                self.gru.add_input_gates(&w.local_emb, rows, 2 * e..3 * e, &mut w.gates);
+            }
             self.gru.step(&w.gates, &mut w.h, rows, &mut w.gh);
             self.mean_decoder.forward(&w.h, rows, &mut w.state, &mut w.stack);
             for r in 0..rows {
+                let predicted = &w.state[r * p..(r + 1) * p];
+                if let (Some(reader), true) = (local, l > 0) {
+                    reader.at(predicted, &mut w.local[r * l..(r + 1) * l]);
+                }
                 let at = (r * horizon + t) * s;
-                out[at..at + s].copy_from_slice(&w.state[r * s..(r + 1) * s]);
+                out[at..at + p].copy_from_slice(predicted);
+                out[at + p..at + s].copy_from_slice(&w.local[r * l..(r + 1) * l]);
             }
         }
     }
@@ -223,7 +267,10 @@ impl FastContextModel {
 
     /// Multiply-adds of one row-step of a rollout (GRU, action encoder, mean decoder), for throughput figures.
     pub fn rollout_flops_per_row_step(&self) -> usize {
-        self.gru.flops_per_row() + self.action_encoder.flops_per_row() + self.mean_decoder.flops_per_row()
+        self.gru.flops_per_row()
+            + self.action_encoder.flops_per_row()
+            + self.mean_decoder.flops_per_row()
+            + self.terrain_embedding.as_ref().map_or(0, |t| t.flops_per_row())
     }
 }
 

@@ -42,6 +42,26 @@ pub struct ModelSpec {
     pub action_dim: usize,
     /// Model-space state size (angles as cos/sin).
     pub feature_dim: usize,
+    /// The model's state is the env's observation (`state_names` then name its features), not its state.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub observations: bool,
+    /// Trailing features read from the world at the predicted state instead of predicted (TRADYN's terrain).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub local_dim: usize,
+}
+
+fn is_zero(n: &usize) -> bool {
+    *n == 0
+}
+
+/// What the model's state is.
+#[derive(Clone, Debug, PartialEq)]
+pub enum StateSpace {
+    /// The env's state, angles as cos/sin (Explore the Context).
+    EnvState,
+    /// The env's observation with these feature names, the last `local_dim` of which are read from the world
+    /// (TRADYN; 0 for its ablation that predicts them).
+    Observation { names: Vec<String>, local_dim: usize },
 }
 
 /// config.json of a context-model checkpoint.
@@ -68,6 +88,9 @@ pub struct InstanceCounts {
 }
 
 pub struct TrainRequest {
+    /// The checkpoint's method name (`context`, or `tradyn` for the terrain-aware variant).
+    pub method: String,
+    pub space: StateSpace,
     pub out: PathBuf,
     pub data: PathBuf,
     pub env: Option<String>,
@@ -92,7 +115,7 @@ pub fn family_of(env: &EnvName) -> EnvFamily {
 }
 
 /// Instance pairs of a context dataset: rollout 2k is instance k's target rollout, 2k + 1 its context source.
-pub fn instance_pairs(dataset: &Dataset, path: &Path, angular: &[bool]) -> Result<ContextData> {
+pub fn instance_pairs(dataset: &Dataset, path: &Path, spec: &ModelSpec) -> Result<ContextData> {
     if dataset.meta.layout != crate::data::DatasetLayout::InstancePairs {
         return Err(Error::bad_file(
             path,
@@ -109,15 +132,34 @@ pub fn instance_pairs(dataset: &Dataset, path: &Path, angular: &[bool]) -> Resul
             format!("holds no instance pairs (make some with `mbrl collect --env {} --instances N`)", dataset.meta.env),
         ));
     }
-    let pairs: Vec<InstancePair> = grouped
+    let episode = |rollout: &crate::data::Rollout| -> Result<Episode> {
+        if !spec.observations {
+            return Ok(Episode::from_rollout(rollout, &spec.angular));
+        }
+        let width_ok = rollout.observations.len() == rollout.states.len()
+            && rollout.observations.iter().all(|o| o.len() == spec.feature_dim && o.iter().all(|x| x.is_finite()));
+        if !width_ok {
+            return Err(Error::bad_file(
+                path,
+                format!(
+                    "observations: expected {} finite features at every state ({})",
+                    spec.feature_dim,
+                    spec.state_names.join(", ")
+                ),
+            ));
+        }
+        Ok(Episode::from_observations(rollout))
+    };
+    let pairs = grouped
         .iter()
-        .map(|(a, b)| InstancePair {
-            target: Episode::from_rollout(a, angular),
-            source: Episode::from_rollout(b, angular),
-        })
-        .collect();
-    let state_dim = pairs[0].target.states.len() / (pairs[0].target.len + 1);
-    Ok(ContextData { state_dim, action_dim: dataset.meta.action_dim, pairs })
+        .map(|(a, b)| Ok(InstancePair { target: episode(a)?, source: episode(b)? }))
+        .collect::<Result<Vec<InstancePair>>>()?;
+    Ok(ContextData {
+        state_dim: spec.feature_dim,
+        action_dim: dataset.meta.action_dim,
+        local_dim: spec.local_dim,
+        pairs,
+    })
 }
 
 /// Trains (or, with `resume`, continues) a context model into `request.out`.
@@ -126,28 +168,16 @@ pub fn train(request: &TrainRequest, resume: bool, monitor: &dyn Monitor) -> Res
     let file = DataFile::fingerprint(&request.data)?;
     let dataset = read_dataset(&request.data)?;
     let env = crate::models::pets::env_of(&dataset, request.env.as_deref(), &request.data)?;
-    let spec = env.build()?.spec();
-    if dataset.meta.state_names.len() != spec.angular.len() || dataset.meta.action_dim != spec.action_dim() {
-        return Err(Error::bad_file(
-            &request.data,
-            format!("state or action sizes differ from env '{}'", env.canonical()),
-        ));
-    }
-    let all = instance_pairs(&dataset, &request.data, &spec.angular)?;
+    let model = model_spec(&request.space, &env, &dataset, &request.data)?;
+    let all = instance_pairs(&dataset, &request.data, &model)?;
     let (train_data, valid_data) = all.split(request.config.validation_fraction, request.seed);
-    let feature_dim = train_data.state_dim;
     let chunk_states = train_data.chunk_states(request.config.chunk_states)?;
     let run = ContextRun {
-        method: METHOD.into(),
+        method: request.method.clone(),
         env: env.canonical(),
         data: vec![file],
         seed: request.seed,
-        model: ModelSpec {
-            state_names: dataset.meta.state_names.clone(),
-            angular: spec.angular.clone(),
-            action_dim: dataset.meta.action_dim,
-            feature_dim,
-        },
+        model,
         config: request.config.clone(),
         instances: InstanceCounts { train: train_data.len(), valid: valid_data.len() },
         chunk_states,
@@ -156,14 +186,14 @@ pub fn train(request: &TrainRequest, resume: bool, monitor: &dyn Monitor) -> Res
     let mut trainer = ContextTrainer::new(request.config.clone(), request.seed, train_data, valid_data)?;
     let parameters = trainer.parameter_count();
     let settings = FitSettings {
-        method: METHOD.into(),
+        method: request.method.clone(),
         env: Some(run.env.clone()),
         total_steps: request.config.steps,
         validate_every: request.config.validate_every,
         checkpoint_every: request.config.checkpoint_every,
     };
     let config = serde_json::to_value(&run).map_err(|e| Error::config(e.to_string()))?;
-    let title = format!("train context model on {}", run.env);
+    let title = format!("train {} model on {}", run.method, run.env);
     let c = &request.config;
     let schedule = c.context_from_target;
     let view = training_view(
@@ -187,6 +217,39 @@ pub fn train(request: &TrainRequest, resume: bool, monitor: &dyn Monitor) -> Res
     );
     let outcome = run_training(&request.out, &config, &settings, &mut trainer, resume, &view, monitor)?;
     Ok(TrainReport { run, outcome, parameters })
+}
+
+/// The model's state space for `env`'s data, checked against the dataset's sizes.
+fn model_spec(space: &StateSpace, env: &EnvName, dataset: &Dataset, path: &Path) -> Result<ModelSpec> {
+    let action_dim = dataset.meta.action_dim;
+    match space {
+        StateSpace::EnvState => {
+            let spec = env.build()?.spec();
+            if dataset.meta.state_names.len() != spec.angular.len() || action_dim != spec.action_dim() {
+                return Err(Error::bad_file(
+                    path,
+                    format!("state or action sizes differ from env '{}'", env.canonical()),
+                ));
+            }
+            let feature_dim = spec.angular.iter().map(|&a| if a { 2 } else { 1 }).sum();
+            Ok(ModelSpec {
+                state_names: dataset.meta.state_names.clone(),
+                angular: spec.angular.clone(),
+                action_dim,
+                feature_dim,
+                observations: false,
+                local_dim: 0,
+            })
+        }
+        StateSpace::Observation { names, local_dim } => Ok(ModelSpec {
+            state_names: names.clone(),
+            angular: vec![false; names.len()],
+            action_dim,
+            feature_dim: names.len(),
+            observations: true,
+            local_dim: *local_dim,
+        }),
+    }
 }
 
 pub fn read_run(opened: &OpenedCheckpoint) -> Result<ContextRun> {
@@ -222,6 +285,15 @@ impl ModelSpec {
                 self.feature_dim
             )));
         }
+        if self.observations && self.angular.iter().any(|&a| a) {
+            return Err(Error::config("a model of observations has no angular features"));
+        }
+        if self.local_dim >= self.feature_dim {
+            return Err(Error::config(format!(
+                "local_dim {} leaves nothing to predict of {} features",
+                self.local_dim, self.feature_dim
+            )));
+        }
         Ok(())
     }
 }
@@ -234,7 +306,14 @@ pub fn resume(dir: &Path, monitor: &dyn Monitor) -> Result<TrainReport> {
     for file in &run.data {
         file.verify_unchanged()?;
     }
+    let space = if run.model.observations {
+        StateSpace::Observation { names: run.model.state_names.clone(), local_dim: run.model.local_dim }
+    } else {
+        StateSpace::EnvState
+    };
     let request = TrainRequest {
+        method: run.method.clone(),
+        space,
         out: dir.to_path_buf(),
         data: run.data[0].path.clone(),
         env: Some(run.env.clone()),
@@ -254,7 +333,26 @@ pub struct LoadedModel {
 }
 
 impl LoadedModel {
-    /// Model-space features of an env state.
+    /// The model's state for an env state and its observation: the observation itself for a model of
+    /// observations (which must then be given, with the model's width), else the state's features.
+    pub fn model_state(&self, state: &[f64], observation: Option<&Vec<f64>>) -> Result<Vec<f32>> {
+        let spec = &self.run.model;
+        if !spec.observations {
+            return Ok(self.features(state));
+        }
+        match observation {
+            Some(o) if o.len() == spec.feature_dim && o.iter().all(|x| x.is_finite()) => {
+                Ok(o.iter().map(|x| *x as f32).collect())
+            }
+            _ => Err(Error::data(format!(
+                "the model reads observations of {} finite features ({}) at every state",
+                spec.feature_dim,
+                spec.state_names.join(", ")
+            ))),
+        }
+    }
+
+    /// Model-space features of an env state (a model of the env's state; TRADYN models observations).
     pub fn features(&self, state: &[f64]) -> Vec<f32> {
         let mut out = Vec::with_capacity(self.run.model.feature_dim);
         crate::models::pets::data::features(state, &[], &self.run.model.angular, &mut out);
@@ -264,17 +362,22 @@ impl LoadedModel {
 
 /// Loads a finished context-model checkpoint for `env` (which must be the env it was trained on).
 pub fn load(dir: &Path, env: &EnvName) -> Result<LoadedModel> {
+    load_method(dir, env, METHOD)
+}
+
+/// Loads a finished checkpoint of this module's network made by `method` (`context` or `tradyn`).
+pub fn load_method(dir: &Path, env: &EnvName, method: &str) -> Result<LoadedModel> {
     let opened = OpenedCheckpoint::open(dir)?;
-    if opened.manifest.method != METHOD {
+    if opened.manifest.method != method {
         return Err(Error::bad_file(
             dir,
             format!(
-                "is a '{}' checkpoint; this needs a context model (`mbrl train --method context`)",
+                "is a '{}' checkpoint; this needs a {method} model (`mbrl train --method {method}`)",
                 opened.manifest.method
             ),
         ));
     }
-    opened.expect_finished(METHOD)?;
+    opened.expect_finished(method)?;
     let run = read_run(&opened)?;
     if run.env != env.canonical() {
         return Err(Error::bad_file(dir, format!("is a model of '{}', not of '{}'", run.env, env.canonical())));
@@ -283,7 +386,8 @@ pub fn load(dir: &Path, env: &EnvName) -> Result<LoadedModel> {
     run.config.validate().map_err(|e| Error::bad_file(&config_path, e.to_string()))?;
     let model_path = opened.dir.file(MODEL_FILE);
     let device = crate::nn::tensor::inference_device();
-    let layout_net = train::init_net(&run.config, run.model.feature_dim, run.model.action_dim, 0, &device);
+    let m = &run.model;
+    let layout_net = train::init_net(&run.config, m.feature_dim, m.action_dim, m.local_dim, 0, &device);
     let layout = crate::nn::ParamSet::<f32>::from_module(&layout_net, net::param_name);
     let params = to_params(&model_path, &opened.tensors(MODEL_FILE)?, &layout)?;
     let fast = FastContextModel::from_params(&params).map_err(|e| Error::bad_file(&model_path, e.to_string()))?;

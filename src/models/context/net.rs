@@ -51,6 +51,8 @@ pub struct ContextNet {
     pub state_encoder: TwoLayer,
     pub action_encoder: TwoLayer,
     pub context_embedding: TwoLayer,
+    /// TRADYN's terrain embedding (eq. 5.11): the features read from the map under the robot, a third GRU input.
+    pub terrain_embedding: Option<TwoLayer>,
     pub gru: GruCell,
     pub mean_decoder: TwoLayer,
     pub variance_decoder: Option<TwoLayer>,
@@ -80,24 +82,31 @@ pub struct LossParts {
 }
 
 impl ContextNet {
+    /// A network over model-space states of `state_dim` features whose last `local_dim` are read from the world
+    /// (TRADYN's terrain features) rather than predicted: the state encoder and decoders see the first
+    /// `state_dim − local_dim`, the context encoder's transitions all of them.
     pub fn init<R: Rng + ?Sized>(
         config: &ContextConfig,
         state_dim: usize,
         action_dim: usize,
+        local_dim: usize,
         device: &Device,
         rng: &mut R,
     ) -> Self {
         let (e, h) = (config.embedding, config.hidden_units);
         let (f, b) = (config.transition_features, config.latent_dim);
-        let state_encoder = TwoLayer::init(state_dim, h, e, device, rng);
+        let predicted = state_dim - local_dim;
+        let state_encoder = TwoLayer::init(predicted, h, e, device, rng);
         let action_encoder = TwoLayer::init(action_dim, h, e, device, rng);
         let context_embedding = TwoLayer::init(b, h, e, device, rng);
-        let gru = GruCellConfig::new(2 * e, e).init(device, rng);
-        let mean_decoder = TwoLayer::init(e, h, state_dim, device, rng);
+        let terrain_embedding = (local_dim > 0).then(|| TwoLayer::init(local_dim, h, e, device, rng));
+        let inputs = if local_dim > 0 { 3 } else { 2 };
+        let gru = GruCellConfig::new(inputs * e, e).init(device, rng);
+        let mean_decoder = TwoLayer::init(e, h, predicted, device, rng);
         let (variance_decoder, constant_variance) = if config.constant_variance {
-            (None, Some(Param::from_tensor(zeros([state_dim], device))))
+            (None, Some(Param::from_tensor(zeros([predicted], device))))
         } else {
-            (Some(TwoLayer::init(e, h, state_dim, device, rng)), None)
+            (Some(TwoLayer::init(e, h, predicted, device, rng)), None)
         };
         let transition_encoder = TwoLayer::init(2 * state_dim + action_dim, h, f, device, rng);
         let context_mean = TwoLayer::init(f, h, b, device, rng);
@@ -109,6 +118,7 @@ impl ContextNet {
             state_encoder,
             action_encoder,
             context_embedding,
+            terrain_embedding,
             gru,
             mean_decoder,
             variance_decoder,
@@ -129,6 +139,11 @@ impl ContextNet {
 
     pub fn embed_context(&self, beta: Tensor<2>) -> Tensor<2> {
         relu(self.context_embedding.forward(beta))
+    }
+
+    /// The terrain features' part of the GRU input (None for a model without terrain input).
+    pub fn embed_terrain(&self, tau: Tensor<2>) -> Option<Tensor<2>> {
+        self.terrain_embedding.as_ref().map(|net| relu(net.forward(tau)))
     }
 
     /// Mean and variance of the state given GRU states `h` ([rows, E]).
@@ -166,6 +181,9 @@ impl ContextNet {
         let (b, n) = (batch.size, batch.chunk);
         let t = n - 1;
         let s = batch.states.len() / (b * n);
+        // The predicted part of the state; the rest (terrain features) is input, taken from the data at every
+        // step as the authors trained (lookup at predicted positions is for prediction, not training).
+        let sp = s - batch.local_dim;
         let a = batch.actions.len() / (b * t);
         let tdim = 2 * s + a;
         let (e, latent) = (config.embedding, config.latent_dim);
@@ -191,11 +209,18 @@ impl ContextNet {
         let kl_per_dim = kl_gaussians(&posterior, &prior).clamp_min(config.kl_floor as f32);
         let kl_context = kl_per_dim.sum_dim(1).mean();
 
-        // The GRU input is [context embedding, action embedding]: the action part of the input gates is shared by
-        // the single-step and multi-step predictions, and the multi-step context part is one row per chunk.
-        let h_all = self.embed_state(states.clone().reshape([b * n, s]));
+        // The GRU input is [context embedding, action embedding (, terrain embedding)]: the per-step parts of the
+        // input gates are shared by the single-step and multi-step predictions, and the multi-step context part
+        // is one row per chunk.
+        let predicted = if sp < s { states.clone().slice([0..b, 0..n, 0..sp]) } else { states.clone() };
+        let h_all = self.embed_state(predicted.clone().reshape([b * n, sp]));
         let actions = tensor(batch.actions.clone(), [b * t, a], device);
-        let action_gates = self.gru.input_gates_part(self.embed_action(actions), e..2 * e) + self.gru.input_bias();
+        let mut action_gates = self.gru.input_gates_part(self.embed_action(actions), e..2 * e) + self.gru.input_bias();
+        if sp < s {
+            let tau = states.clone().slice([0..b, 0..t, sp..s]).reshape([b * t, s - sp]);
+            let terrain = self.embed_terrain(tau).expect("a batch with local features needs a terrain embedding");
+            action_gates = action_gates + self.gru.input_gates_part(terrain, 2 * e..3 * e);
+        }
 
         // Single-step predictions from every chunk state, each with a fresh β sample.
         let post_mean = posterior.mean.clone().unsqueeze_dim::<3>(1).expand([b, t, latent]);
@@ -226,10 +251,12 @@ impl ContextNet {
         if steps > 0 {
             decoded.push(Tensor::stack::<3>(open_loop, 1).reshape([b * steps, e]));
         }
-        let mut targets =
-            vec![states.clone().reshape([b * n, s]), states.clone().slice([0..b, 1..n, 0..s]).reshape([b * t, s])];
+        let mut targets = vec![
+            predicted.clone().reshape([b * n, sp]),
+            predicted.clone().slice([0..b, 1..n, 0..sp]).reshape([b * t, sp]),
+        ];
         if steps > 0 {
-            targets.push(states.slice([0..b, 2..n, 0..s]).reshape([b * steps, s]));
+            targets.push(predicted.slice([0..b, 2..n, 0..sp]).reshape([b * steps, sp]));
         }
         let likelihood = log_likelihood(self.decode(Tensor::cat(decoded, 0)), Tensor::cat(targets, 0));
         let rows = |start: usize, len: usize| likelihood.clone().slice([start..start + len, 0..1]);

@@ -26,7 +26,7 @@ fn tiny_config() -> ContextConfig {
 fn random_net(config: &ContextConfig, s: usize, a: usize, seed: u64) -> (ContextNet, ParamSet) {
     let device = inference_device();
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let net = ContextNet::init(config, s, a, &device, &mut rng);
+    let net = ContextNet::init(config, s, a, 0, &device, &mut rng);
     let mut params = ParamSet::<f32>::from_module(&net, param_name);
     params.tensors.iter_mut().flat_map(|t| t.values.iter_mut()).for_each(|v| *v = rng.random_range(-0.5..0.5));
     (params.load_into(net, &device).unwrap(), params)
@@ -64,7 +64,7 @@ fn fast_path_matches_the_burn_network() {
     let actions = sample(rows * horizon * a);
     let betas = sample(rows * config.latent_dim);
     let mut out = vec![0.0; rows * horizon * s];
-    fast.rollout_means(&init, &actions, &betas, rows, horizon, &mut out, &mut Default::default());
+    fast.rollout_means(&init, &actions, &betas, rows, horizon, None, &mut out, &mut Default::default());
     let ctx = net.embed_context(tensor(betas.clone(), [rows, config.latent_dim], &device));
     let mut h = net.embed_state(tensor(init.repeat(rows), [rows, s], &device));
     for t in 0..horizon {
@@ -148,7 +148,7 @@ fn toy_like(instances: usize, len: usize, seed: u64) -> ContextData {
             InstancePair { target: episode(alpha, &mut rng), source: episode(alpha, &mut rng) }
         })
         .collect();
-    ContextData { state_dim: 2, action_dim: 1, pairs }
+    ContextData { state_dim: 2, action_dim: 1, local_dim: 0, pairs }
 }
 
 #[test]
@@ -194,6 +194,8 @@ fn model_spec_sizes_must_agree_and_be_plausible() {
         angular: vec![true, false],
         action_dim: 1,
         feature_dim: 3,
+        observations: false,
+        local_dim: 0,
     };
     assert!(spec.validate().is_ok());
     let flipped = super::ModelSpec { angular: vec![true, true], ..spec.clone() };

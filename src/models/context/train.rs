@@ -34,9 +34,16 @@ pub struct ContextTrainer {
 }
 
 /// A fresh network of this shape (the weights of a seeded initialization).
-pub fn init_net(config: &ContextConfig, state_dim: usize, action_dim: usize, seed: u64, device: &Device) -> ContextNet {
+pub fn init_net(
+    config: &ContextConfig,
+    state_dim: usize,
+    action_dim: usize,
+    local_dim: usize,
+    seed: u64,
+    device: &Device,
+) -> ContextNet {
     let mut rng = ChaCha8Rng::seed_from_u64(derive_seed(seed, &[INIT_STREAM]));
-    ContextNet::init(config, state_dim, action_dim, device, &mut rng)
+    ContextNet::init(config, state_dim, action_dim, local_dim, device, &mut rng)
 }
 
 impl ContextTrainer {
@@ -47,7 +54,7 @@ impl ContextTrainer {
         }
         let chunk = train.chunk_states(config.chunk_states)?;
         let device = training_device();
-        let net = init_net(&config, train.state_dim, train.action_dim, seed, &device);
+        let net = init_net(&config, train.state_dim, train.action_dim, train.local_dim, seed, &device);
         let params = ParamSet::<f32>::from_module(&net, param_name);
         let sizes: Vec<usize> = params.tensors.iter().map(|t| t.values.len()).collect();
         let adam = Adam::new(config.optimizer, &sizes);
