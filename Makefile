@@ -4,7 +4,7 @@
 MBRL := target/release/mbrl
 SEED ?= 0
 
-.PHONY: build test bench completions repro-quick repro-swingup repro-pendulum-data repro-boards repro-ball repro-pets repro-pets-loop repro-context repro-seads repro-dlgpd clean-reports
+.PHONY: build test bench completions repro-quick repro-swingup repro-pendulum-data repro-boards repro-ball repro-pets repro-pets-loop repro-context repro-tradyn repro-seads repro-dlgpd clean-reports
 
 build:
 	cargo build --release
@@ -88,6 +88,26 @@ repro-context: build
 	$(MBRL) train --method context --data datasets/context/mountaincar.mcap --preset $(CONTEXT_PRESET) --seed $(SEED) --no-tui -q --out models/context/mountaincar
 	$(MBRL) eval context --model models/context/mountaincar --env mountaincar --transitions 50 --horizon 30 \
 		--contexts $(CONTEXT_CONTEXTS) $(CONTEXT_CEM) --seed $(SEED) --no-tui -q --out reports/context/mountaincar
+
+# TRADYN (thesis 5.5) at the medium scale these two cores allow: the thesis' map set and data (100 maps,
+# 10 000 instance pairs of 100 colored-noise steps on the 50 train maps), the small-preset network (64 units,
+# batch 64) trained for $(TRADYN_STEPS) steps with and without terrain lookup (≈ 45 min each, run side by side),
+# then the four variants on $(TRADYN_TASKS) tasks on the test maps with CEM $(TRADYN_CEM) (the thesis:
+# 5 models × 150 tasks, 200 units, batch 512, 100k steps, CEM 1000 × 50 elites × 20 iterations on a GPU).
+TRADYN_STEPS ?= 15000
+TRADYN_TASKS ?= 50
+TRADYN_CEM ?= --candidates 300 --elites 30 --iters 10
+repro-tradyn: build
+	test -f datasets/tradyn/maps/terrain.json || \
+		$(MBRL) collect --env terrain --maps 100 --seed $(SEED) --no-tui -q --out datasets/tradyn/maps
+	$(MBRL) collect --env unicycle --maps datasets/tradyn/maps --split train --instances 10000 --steps 100 \
+		--seed $(SEED) --no-tui -q --out datasets/tradyn/train.mcap
+	$(MBRL) train --method tradyn --data datasets/tradyn/train.mcap --preset small --steps $(TRADYN_STEPS) \
+		--seed $(SEED) --no-tui -q --out models/tradyn/terrain & \
+	$(MBRL) train --method tradyn --no-terrain --data datasets/tradyn/train.mcap --preset small --steps $(TRADYN_STEPS) \
+		--seed $(SEED) --no-tui -q --out models/tradyn/no-terrain; wait
+	$(MBRL) eval tradyn --model-terrain models/tradyn/terrain --model-no-terrain models/tradyn/no-terrain \
+		--maps datasets/tradyn/maps --tasks $(TRADYN_TASKS) $(TRADYN_CEM) --seed $(SEED) --no-tui --out reports/tradyn
 
 # Thesis chapter 7: SEADS skills and forward model on both Cursor games, then skill coverage and boards solved
 # per depth with and without replanning (Table 7.3, Fig. 7.9/7.10 analogues).

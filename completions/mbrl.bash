@@ -82,6 +82,9 @@ _mbrl() {
             mbrl__subcmd__eval,seads)
                 cmd="mbrl__subcmd__eval__subcmd__seads"
                 ;;
+            mbrl__subcmd__eval,tradyn)
+                cmd="mbrl__subcmd__eval__subcmd__tradyn"
+                ;;
             mbrl__subcmd__eval__subcmd__help,ball)
                 cmd="mbrl__subcmd__eval__subcmd__help__subcmd__ball"
                 ;;
@@ -111,6 +114,9 @@ _mbrl() {
                 ;;
             mbrl__subcmd__eval__subcmd__help,seads)
                 cmd="mbrl__subcmd__eval__subcmd__help__subcmd__seads"
+                ;;
+            mbrl__subcmd__eval__subcmd__help,tradyn)
+                cmd="mbrl__subcmd__eval__subcmd__help__subcmd__tradyn"
                 ;;
             mbrl__subcmd__help,calibrate)
                 cmd="mbrl__subcmd__help__subcmd__calibrate"
@@ -174,6 +180,9 @@ _mbrl() {
                 ;;
             mbrl__subcmd__help__subcmd__eval,seads)
                 cmd="mbrl__subcmd__help__subcmd__eval__subcmd__seads"
+                ;;
+            mbrl__subcmd__help__subcmd__eval,tradyn)
+                cmd="mbrl__subcmd__help__subcmd__eval__subcmd__tradyn"
                 ;;
             *)
                 ;;
@@ -410,7 +419,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval)
-            opts="-q -h -V --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version quick dataset boards embodied ball context seads dlgpd pendulum-swingup help"
+            opts="-q -h -V --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version quick dataset boards embodied ball context tradyn seads dlgpd pendulum-swingup help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -748,7 +757,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__help)
-            opts="quick dataset boards embodied ball context seads dlgpd pendulum-swingup help"
+            opts="quick dataset boards embodied ball context tradyn seads dlgpd pendulum-swingup help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -888,6 +897,20 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__help__subcmd__seads)
+            opts=""
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 4 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mbrl__subcmd__eval__subcmd__help__subcmd__tradyn)
             opts=""
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 4 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
@@ -1071,6 +1094,80 @@ _mbrl() {
             COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
             return 0
             ;;
+        mbrl__subcmd__eval__subcmd__tradyn)
+            opts="-q -h -V --model-terrain --model-no-terrain --maps --tasks --transitions --steps --horizon --candidates --elites --iters --prediction-steps --out --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                --model-terrain)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --model-no-terrain)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --maps)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --tasks)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --transitions)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --steps)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --horizon)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --candidates)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --elites)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --iters)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --prediction-steps)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --out)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --seed)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --max-memory-gib)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
         mbrl__subcmd__export)
             opts="-q -h -V --input --out --format --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
@@ -1208,7 +1305,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__help__subcmd__eval)
-            opts="quick dataset boards embodied ball context seads dlgpd pendulum-swingup"
+            opts="quick dataset boards embodied ball context tradyn seads dlgpd pendulum-swingup"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1334,6 +1431,20 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__help__subcmd__eval__subcmd__seads)
+            opts=""
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 4 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mbrl__subcmd__help__subcmd__eval__subcmd__tradyn)
             opts=""
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 4 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )

@@ -163,6 +163,20 @@ fn targets() -> Vec<Target> {
             mcap("quad.mcap"),
             concat!("plan --env pendulum:quadrant --model quad-model --context {in} --out {out}", cheap_plan!()),
         ),
+        target(
+            "pairs-train-tradyn",
+            mcap("uni.mcap"),
+            "train --method tradyn --data {in} --config context.toml --steps 1 --out {out}",
+        ),
+        target(
+            "calib-plan-tradyn",
+            mcap("calib-uni.mcap"),
+            concat!(
+                "plan --env unicycle --model tradyn-model --map map.png --start 0.3,0.4,1 --goal 0.5,0.5 --horizon 3 ",
+                "--context {in} --out {out}",
+                cheap_plan!()
+            ),
+        ),
         Target {
             seed_is_refused: true,
             ..target("boardset-eval", mcap("boards.mcap"), "eval dataset --input {in} --out {out}")
@@ -252,6 +266,14 @@ fn targets() -> Vec<Target> {
             "context-calibrate",
             Input::Checkpoint { dir: "context-model", files: MODEL_FILES },
             "calibrate --model {in} --env toy:inner --instance-seed 1 --strategy random --transitions 2 --out {out}",
+        ),
+        target(
+            "tradyn-plan",
+            Input::Checkpoint { dir: "tradyn-model", files: MODEL_FILES },
+            concat!(
+                "plan --env unicycle --model {in} --map map.png --start 0.3,0.4,1 --goal 0.5,0.5 --horizon 3 --out {out}",
+                cheap_plan!()
+            ),
         ),
         target(
             "context-resume",
@@ -372,6 +394,13 @@ fn generate_seeds(dir: &Path) {
     make(dir, "train --method pets --data roll.mcap --config pets.toml --ensemble 2 --steps 5 --out pets");
     make(dir, "train --method context --data ctx.mcap --config context.toml --steps 5 --out context-model");
     make(dir, "train --method context --data quad.mcap --config context.toml --steps 3 --out quad-model");
+    make(dir, "collect --env unicycle --map map.png --instances 4 --steps 12 --out uni.mcap");
+    make(dir, "train --method tradyn --data uni.mcap --config context.toml --steps 3 --out tradyn-model");
+    make(
+        dir,
+        "calibrate --model tradyn-model --env unicycle --map map.png --instance-seed 1 --strategy random --transitions 3 \
+         --out calib-uni.mcap",
+    );
     make(dir, "train --method dlgpd --data roll.mcap --steps 5 --batch 16 --out dlgpd");
     make(dir, "train --method ball-ekf --data ball.mcap --launcher-prior --steps 3 --batch 8 --out ekf");
     make(dir, "train --method seads --env tileswap:cursor --config seads.toml --env-steps 100 --out seads");

@@ -63,6 +63,13 @@ pub const QUICK_DLGPD_EVIDENCE_ROLLOUTS: usize = 20;
 pub const QUICK_DLGPD_SWINGUP_STEPS: usize = 150;
 pub const QUICK_DLGPD_CANDIDATES: usize = 200;
 
+/// The TRADYN slice: a few maps, unicycle pairs, tiny ±terrain models and a handful of navigation tasks with a
+/// small CEM; `make repro-tradyn` runs the medium scale.
+pub const QUICK_TRADYN_MAPS: usize = 6;
+pub const QUICK_TRADYN_INSTANCES: usize = 400;
+pub const QUICK_TRADYN_TRAIN_STEPS: u64 = 600;
+pub const QUICK_TRADYN_TASKS: usize = 4;
+
 pub struct QuickSummary {
     pub lines: Vec<String>,
 }
@@ -109,6 +116,7 @@ pub fn run_quick(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor)
     }
     lines.push(seads_slice(provenance, out_dir, monitor)?);
     lines.push(dlgpd_slice(provenance, out_dir, monitor)?);
+    lines.push(tradyn_slice(provenance, out_dir, monitor)?);
     let mut md = String::from("# mbrl quick reproduction\n\nSmall-scale runs of each implemented method.\n\n");
     for line in &lines {
         md.push_str(&format!("- {line}\n"));
@@ -366,5 +374,95 @@ fn dlgpd_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) -
         QUICK_DLGPD_EVIDENCE_ROLLOUTS,
         describe("matching"),
         describe("mismatching")
+    ))
+}
+
+/// TRADYN: maps → unicycle instance pairs → tiny models with and without terrain lookup → the four variants on a
+/// few navigation tasks on test maps.
+fn tradyn_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) -> Result<String> {
+    use super::tradyn::{evaluate, variant_name, TradynEvalModels, TradynEvalSettings, VARIANTS};
+    use crate::data::terrain_set::{read_terrain_set, write_terrain_set};
+    use crate::envs::terrain::TerrainSplit;
+    use crate::envs::unicycle::UnicycleTerrain;
+    use crate::models::tradyn::{self, navigation::NavigationSettings, TradynModel};
+    let dir = out_dir.join("tradyn");
+    let maps_dir = dir.join("maps");
+    let data_seed = derive_seed(provenance.seed, &[u64::from_le_bytes(*b"tradyn-d")]);
+    if maps_dir.exists() {
+        std::fs::remove_dir_all(&maps_dir).map_err(|e| Error::io(&maps_dir, e))?;
+    }
+    write_terrain_set(&maps_dir, QUICK_TRADYN_MAPS, data_seed, &provenance.command_line, monitor)?;
+    let train_maps = read_terrain_set(&maps_dir, Some(TerrainSplit::Train))?;
+    let data_path = dir.join("unicycle-pairs.mcap");
+    let collect = InstancePairSettings {
+        env: EnvName::Unicycle(Some(std::sync::Arc::new(UnicycleTerrain::new(train_maps)))),
+        instances: QUICK_TRADYN_INSTANCES,
+        steps: 50,
+        seed: data_seed,
+        command_line: provenance.command_line.clone(),
+    };
+    write_dataset(&data_path, &collect_instance_pairs(&collect, monitor)?)?;
+    let mut config = ContextConfig::preset(ContextPreset::Small, EnvFamily::Control);
+    (config.embedding, config.hidden_units, config.transition_features, config.latent_dim) = (32, 32, 32, 8);
+    (config.batch_size, config.chunk_states, config.context_max) = (32, 20, 20);
+    config.steps = QUICK_TRADYN_TRAIN_STEPS;
+    config.context_from_target = config.context_from_target.rescaled(5_000, config.steps);
+    (config.validate_every, config.checkpoint_every) = (200, 600);
+    let mut models = Vec::new();
+    for terrain in [true, false] {
+        let out = dir.join(if terrain { "model-terrain" } else { "model-no-terrain" });
+        let request = context::TrainRequest {
+            method: tradyn::METHOD.into(),
+            space: tradyn::state_space(terrain),
+            out: out.clone(),
+            data: data_path.clone(),
+            env: None,
+            config: config.clone(),
+            seed: provenance.seed,
+            provenance: provenance.clone(),
+        };
+        context::train(&request, false, monitor)?;
+        models.push(TradynModel::load(&out)?);
+    }
+    let no_terrain = models.pop().expect("two models trained");
+    let terrain = models.pop().expect("two models trained");
+    let mut navigation = NavigationSettings::thesis();
+    (navigation.steps, navigation.horizon) = (30, 15);
+    (navigation.cem.candidates, navigation.cem.elites, navigation.cem.iterations) = (100, 10, 4);
+    let settings = TradynEvalSettings {
+        tasks: QUICK_TRADYN_TASKS,
+        calibration_transitions: 10,
+        navigation,
+        prediction_steps: 30,
+        example_tasks: 3,
+    };
+    let test_maps = read_terrain_set(&maps_dir, Some(TerrainSplit::Test))?;
+    let summary = evaluate(
+        &TradynEvalModels { terrain, no_terrain },
+        test_maps,
+        &settings,
+        provenance,
+        &dir.join("eval"),
+        monitor,
+    )?;
+    let per_variant: Vec<String> = VARIANTS
+        .iter()
+        .enumerate()
+        .map(|(v, variant)| {
+            format!(
+                "{} energy {:.2} / distance {:.0} mm / failed {}",
+                variant_name(*variant),
+                summary.median_energy[v],
+                summary.median_distance[v] * 1000.0,
+                summary.failures[v]
+            )
+        })
+        .collect();
+    Ok(format!(
+        "TRADYN: tiny models with and without terrain lookup ({QUICK_TRADYN_TRAIN_STEPS} steps on {QUICK_TRADYN_INSTANCES} \
+         unicycle pairs over {} train maps), {QUICK_TRADYN_TASKS} navigation tasks on test maps, 30 steps, CEM 100×4 \
+         (medians): {}; a smoke test of the pipeline, not the thesis' claim (`make repro-tradyn`); see tradyn/eval/report.md",
+        QUICK_TRADYN_MAPS.div_ceil(2),
+        per_variant.join("; ")
     ))
 }

@@ -15,7 +15,7 @@ pub use dynamics::TradynDynamics;
 use crate::envs::terrain::TerrainMap;
 use crate::envs::unicycle::{OBSERVATION_NAMES, TERRAIN_FEATURES};
 use crate::envs::EnvName;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::models::context::fast::LocalFeatures;
 use crate::models::context::{self, LoadedModel, StateSpace};
 
@@ -39,6 +39,18 @@ pub struct TradynModel {
 impl TradynModel {
     pub fn load(dir: &Path) -> Result<Self> {
         let loaded = context::load_method(dir, &EnvName::Unicycle(None), METHOD)?;
+        let spec = &loaded.run.model;
+        let names_fit = spec.observations && spec.state_names.iter().map(String::as_str).eq(OBSERVATION_NAMES);
+        if !names_fit || spec.action_dim != 2 || ![0, TERRAIN_FEATURES].contains(&spec.local_dim) {
+            return Err(Error::bad_file(
+                &dir.join("config.json"),
+                format!(
+                    "model: a TRADYN model reads the unicycle's observation ({}) and 2 actions, with 0 or {TERRAIN_FEATURES} \
+                     features read from the map",
+                    OBSERVATION_NAMES.join(", ")
+                ),
+            ));
+        }
         Ok(TradynModel { loaded })
     }
 
