@@ -4,7 +4,7 @@
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
-use super::{Dataset, DatasetLayout, DatasetMeta, Rollout, Timestep, FORMAT_VERSION};
+use super::{Dataset, DatasetLayout, DatasetMeta, Rollout, Timestep};
 use crate::envs::{instance_env, Env, EnvName, EnvSpec, Exploration};
 use crate::error::{Error, Result};
 use crate::run::Monitor;
@@ -47,7 +47,7 @@ pub fn collect_random(settings: &CollectSettings, monitor: &dyn Monitor) -> Resu
         monitor.progress("collect rollouts", k as u64 + 1, settings.rollouts as u64);
     }
     Ok(Dataset {
-        meta: meta(&spec, settings.seed, &settings.command_line, instances, DatasetLayout::Rollouts),
+        meta: DatasetMeta::for_env(&spec, settings.seed, &settings.command_line, instances, DatasetLayout::Rollouts),
         steps,
         frames: Vec::new(),
     })
@@ -93,7 +93,7 @@ pub fn collect_instance_pairs(settings: &InstancePairSettings, monitor: &dyn Mon
     }
     let layout = DatasetLayout::InstancePairs;
     Ok(Dataset {
-        meta: meta(&spec, settings.seed, &settings.command_line, instances, layout),
+        meta: DatasetMeta::for_env(&spec, settings.seed, &settings.command_line, instances, layout),
         steps,
         frames: Vec::new(),
     })
@@ -143,7 +143,13 @@ pub fn replay(settings: &ReplaySettings) -> Result<Dataset> {
     }
     let steps = timesteps(&spec, &rollout, 0).collect();
     Ok(Dataset {
-        meta: meta(&spec, settings.seed, &settings.command_line, vec![env.params()], DatasetLayout::Rollouts),
+        meta: DatasetMeta::for_env(
+            &spec,
+            settings.seed,
+            &settings.command_line,
+            vec![env.params()],
+            DatasetLayout::Rollouts,
+        ),
         steps,
         frames: Vec::new(),
     })
@@ -254,28 +260,6 @@ pub(super) fn timesteps<'a>(spec: &EnvSpec, rollout: &'a Rollout, id: u32) -> im
         }
         step
     })
-}
-
-pub(super) fn meta(
-    spec: &EnvSpec,
-    seed: u64,
-    command_line: &str,
-    instances: Vec<serde_json::Value>,
-    layout: DatasetLayout,
-) -> DatasetMeta {
-    DatasetMeta {
-        format_version: FORMAT_VERSION,
-        env: spec.name.clone(),
-        seed,
-        mbrl_version: crate::VERSION.to_string(),
-        command_line: command_line.to_string(),
-        instances,
-        state_names: spec.state_names.clone(),
-        action_dim: spec.action_dim(),
-        dt: spec.dt,
-        layout,
-        frames: None,
-    }
 }
 
 /// A transition in memory: the struct, its vectors' heap blocks, and the f64s in them.

@@ -9,7 +9,7 @@
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
-use super::collect::{check_size, meta, timesteps, REPLAY_STREAM};
+use super::collect::{check_size, timesteps, REPLAY_STREAM};
 use super::{Dataset, DatasetLayout, Rollout, Timestep};
 use crate::envs::boards::{BoardGame, GameSpec, LightsOut, TileSwap};
 use crate::envs::embodiments::embodied::EmbodiedBoard;
@@ -204,7 +204,7 @@ impl Episodes {
 
     fn into_dataset(self, spec: &EnvSpec, seed: u64, command_line: &str) -> Dataset {
         Dataset {
-            meta: meta(spec, seed, command_line, self.instances, DatasetLayout::Rollouts),
+            meta: crate::data::DatasetMeta::for_env(spec, seed, command_line, self.instances, DatasetLayout::Rollouts),
             steps: self.steps,
             frames: Vec::new(),
         }

@@ -167,6 +167,31 @@ fn layout(meta: &DatasetMeta) -> Layout<'static> {
     }
 }
 
+impl DatasetMeta {
+    /// The metadata of a dataset of `spec`'s env made now by this build.
+    pub fn for_env(
+        spec: &crate::envs::EnvSpec,
+        seed: u64,
+        command_line: &str,
+        instances: Vec<serde_json::Value>,
+        layout: DatasetLayout,
+    ) -> Self {
+        DatasetMeta {
+            format_version: FORMAT_VERSION,
+            env: spec.name.clone(),
+            seed,
+            mbrl_version: crate::VERSION.to_string(),
+            command_line: command_line.to_string(),
+            instances,
+            state_names: spec.state_names.clone(),
+            action_dim: spec.action_dim(),
+            dt: spec.dt,
+            layout,
+            frames: None,
+        }
+    }
+}
+
 impl Dataset {
     /// Rollouts of `spec`'s env as a dataset (rollout ids 0, 1, …; `instances` per rollout), for the rollouts a
     /// planner or an evaluation executed.
@@ -178,19 +203,7 @@ impl Dataset {
         command_line: &str,
     ) -> Dataset {
         Dataset {
-            meta: DatasetMeta {
-                format_version: FORMAT_VERSION,
-                env: spec.name.clone(),
-                seed,
-                mbrl_version: crate::VERSION.to_string(),
-                command_line: command_line.to_string(),
-                instances,
-                state_names: spec.state_names.clone(),
-                action_dim: spec.action_dim(),
-                dt: spec.dt,
-                layout: DatasetLayout::Rollouts,
-                frames: None,
-            },
+            meta: DatasetMeta::for_env(spec, seed, command_line, instances, DatasetLayout::Rollouts),
             steps: rollouts.iter().enumerate().flat_map(|(i, r)| r.timesteps(i as u32)).collect(),
             frames: Vec::new(),
         }

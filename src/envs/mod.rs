@@ -107,6 +107,26 @@ pub trait BatchDynamics: Sync + Send {
     fn describe(&self) -> String;
 }
 
+/// Splits a batch rollout into blocks of `block` candidates run in parallel: each call of `run` gets the blocks'
+/// returns, action sequences (`per_actions` values per candidate) and, when asked for, predicted states
+/// (`per_states` per candidate). Learned models roll a block out as one matrix batch.
+pub fn par_candidate_blocks(
+    returns: &mut [f64],
+    actions: &[f64],
+    states: Option<&mut [f64]>,
+    (per_actions, per_states): (usize, usize),
+    block: usize,
+    run: impl Fn(&mut [f64], &[f64], Option<&mut [f64]>) + Sync,
+) {
+    let blocks = returns.par_chunks_mut(block).zip(actions.par_chunks(per_actions * block));
+    match states {
+        None => blocks.for_each(|(ret, cands)| run(ret, cands, None)),
+        Some(states) => blocks
+            .zip(states.par_chunks_mut(per_states * block))
+            .for_each(|((ret, cands), out)| run(ret, cands, Some(out))),
+    }
+}
+
 impl<T: Dynamics> BatchDynamics for T {
     fn state_dim(&self) -> usize {
         Dynamics::state_dim(self)

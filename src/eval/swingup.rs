@@ -7,7 +7,7 @@ use serde::Serialize;
 
 use super::plot::{histogram, line_plot, Series};
 use super::stats::{mean, quantile};
-use crate::data::{write_dataset, Dataset, DatasetLayout, DatasetMeta, Rollout, FORMAT_VERSION};
+use crate::data::{write_dataset, Dataset, DatasetLayout, DatasetMeta, Rollout};
 use crate::envs::pendulum::{angle_normalize, Pendulum, PendulumVariant, StartDistribution};
 use crate::envs::{BatchDynamics, Env};
 use crate::error::Result;
@@ -155,19 +155,13 @@ pub fn episodes_dataset(
     let env = Pendulum::new(settings.variant.clone());
     let spec = env.spec();
     Dataset {
-        meta: DatasetMeta {
-            format_version: FORMAT_VERSION,
-            env: spec.name.clone(),
+        meta: DatasetMeta::for_env(
+            &spec,
             seed,
-            mbrl_version: crate::VERSION.to_string(),
-            command_line: command_line.to_string(),
-            instances: episodes.iter().map(|e| e.instance.clone()).collect(),
-            state_names: spec.state_names.clone(),
-            action_dim: spec.action_dim(),
-            dt: spec.dt,
-            layout: DatasetLayout::Rollouts,
-            frames: None,
-        },
+            command_line,
+            episodes.iter().map(|e| e.instance.clone()).collect(),
+            DatasetLayout::Rollouts,
+        ),
         steps: episodes.iter().flat_map(|e| e.rollout.timesteps(e.episode as u32)).collect(),
         frames: Vec::new(),
     }

@@ -301,23 +301,13 @@ pub fn calibration_dataset(
     command_line: &str,
 ) -> Result<crate::data::Dataset> {
     let spec = env.build()?.spec();
-    Ok(crate::data::Dataset {
-        meta: crate::data::DatasetMeta {
-            format_version: crate::data::FORMAT_VERSION,
-            env: env.canonical(),
-            seed,
-            mbrl_version: crate::VERSION.to_string(),
-            command_line: command_line.to_string(),
-            instances: vec![instance],
-            state_names: spec.state_names.clone(),
-            action_dim: spec.action_dim(),
-            dt: spec.dt,
-            layout: crate::data::DatasetLayout::Rollouts,
-            frames: None,
-        },
-        steps: calibration.rollout.timesteps(0).collect(),
-        frames: Vec::new(),
-    })
+    Ok(crate::data::Dataset::of_rollouts(
+        &spec,
+        vec![instance],
+        std::slice::from_ref(&calibration.rollout),
+        seed,
+        command_line,
+    ))
 }
 
 /// Model-space context rows from a context file (any rollout dataset of the model's env).

@@ -1,12 +1,10 @@
 //! A calibrated context model as a planner's dynamics: mean rollouts under the context mean β of the
 //! calibration transitions, states mapped back from model space (cos/sin → angle) for the reward.
 
-use rayon::prelude::*;
-
 use super::fast::RolloutScratch;
 use super::LoadedModel;
 use crate::envs::pendulum::dynamics::{NominalPendulumReward, PendulumReward};
-use crate::envs::{BatchDynamics, EnvName, RewardFn};
+use crate::envs::{par_candidate_blocks, BatchDynamics, EnvName, RewardFn};
 use crate::error::{Error, Result};
 
 const CANDIDATES_PER_BLOCK: usize = 64;
@@ -111,17 +109,7 @@ impl BatchDynamics for ContextDynamics {
                 }
             }
         };
-        match states {
-            None => returns
-                .par_chunks_mut(CANDIDATES_PER_BLOCK)
-                .zip(actions.par_chunks(per * CANDIDATES_PER_BLOCK))
-                .for_each(|(ret, cands)| run_block(ret, cands, None)),
-            Some(states) => returns
-                .par_chunks_mut(CANDIDATES_PER_BLOCK)
-                .zip(actions.par_chunks(per * CANDIDATES_PER_BLOCK))
-                .zip(states.par_chunks_mut(horizon * d * CANDIDATES_PER_BLOCK))
-                .for_each(|((ret, cands), out)| run_block(ret, cands, Some(out))),
-        }
+        par_candidate_blocks(returns, actions, states, (per, horizon * d), CANDIDATES_PER_BLOCK, run_block);
     }
 
     fn describe(&self) -> String {

@@ -4,12 +4,10 @@
 
 use std::sync::Arc;
 
-use rayon::prelude::*;
-
 use super::{MapLookup, TradynModel};
 use crate::envs::terrain::TerrainMap;
 use crate::envs::unicycle::{clip_action, observation, MAX_SPEED};
-use crate::envs::BatchDynamics;
+use crate::envs::{par_candidate_blocks, BatchDynamics};
 use crate::models::context::fast::{LocalFeatures, RolloutScratch};
 
 const CANDIDATES_PER_BLOCK: usize = 64;
@@ -88,17 +86,7 @@ impl BatchDynamics for TradynDynamics {
                 }
             }
         };
-        match states {
-            None => returns
-                .par_chunks_mut(CANDIDATES_PER_BLOCK)
-                .zip(actions.par_chunks(per * CANDIDATES_PER_BLOCK))
-                .for_each(|(ret, cands)| run_block(ret, cands, None)),
-            Some(states) => returns
-                .par_chunks_mut(CANDIDATES_PER_BLOCK)
-                .zip(actions.par_chunks(per * CANDIDATES_PER_BLOCK))
-                .zip(states.par_chunks_mut(horizon * 4 * CANDIDATES_PER_BLOCK))
-                .for_each(|((ret, cands), out)| run_block(ret, cands, Some(out))),
-        }
+        par_candidate_blocks(returns, actions, states, (per, horizon * 4), CANDIDATES_PER_BLOCK, run_block);
     }
 
     fn describe(&self) -> String {
