@@ -110,7 +110,7 @@ pub fn run(
     let title = format!("plan: unicycle navigation with {}", dynamics.describe());
     let seed = global.seed;
     let episode = run_job(global, "plan: unicycle navigation", |monitor| {
-        monitor.emit(&layout(&title, &map));
+        monitor.emit(&layout(&title, &map, task.goal));
         let mut env = make_env()?;
         let episode = navigate(env.as_mut(), dynamics.as_ref(), &task, &settings, seed, monitor, |_| {})?;
         let spec = env.spec();

@@ -148,7 +148,7 @@ pub fn map_background(map: &TerrainMap) -> Background {
 
 /// The live view of a navigation: the robot's path and its current plan over the map, the distance to the
 /// goal, and the CEM costs of the current step.
-pub fn layout(title: &str, map: &TerrainMap) -> Event {
+pub fn layout(title: &str, map: &TerrainMap, goal: [f64; 2]) -> Event {
     let panel = |title: &str, x_label: &str, series: &[&str], restart: bool| PanelSpec {
         title: title.into(),
         x_label: x_label.into(),
@@ -156,12 +156,9 @@ pub fn layout(title: &str, map: &TerrainMap) -> Event {
         restart_on_rewind: restart,
         path: None,
     };
-    let mut map_panel = panel(
-        "map: driven path (cyan), current plan (magenta); x right, y up",
-        "x",
-        &["robot/x", "robot/y", "plan/x", "plan/y"],
-        true,
-    );
+    let map_title =
+        format!("map, goal ({:.2}, {:.2}): driven path (cyan), plan (magenta); x right, y up", goal[0], goal[1]);
+    let mut map_panel = panel(&map_title, "x", &["robot/x", "robot/y", "plan/x", "plan/y"], true);
     map_panel.path =
         Some(PathView { x: [0.0, 1.0], y: [0.0, 1.0], grid: 0, y_down: false, background: Some(map_background(map)) });
     Event::Layout {
