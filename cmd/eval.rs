@@ -418,6 +418,11 @@ fn eval_tradyn(global: &GlobalArgs, provenance: &Provenance, a: TradynArgs) -> a
             summary.mean_position_error[v]
         );
     }
+    say!(
+        "Wilcoxon: terrain lookup lowers the mean position error: p = {:.3e} without calibration, {:.3e} with it",
+        summary.prediction_tests[0],
+        summary.prediction_tests[1]
+    );
     for (r, c, p) in &summary.energy_tests {
         if r > c {
             say!(

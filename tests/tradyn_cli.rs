@@ -123,6 +123,20 @@ fn train_calibrate_and_navigate_with_and_without_terrain_lookup() {
         assert_eq!(plan.meta.instances[0], calib.meta.instances[0], "the same robot");
         std::fs::remove_file(d.join("plan.mcap")).unwrap();
     }
+
+    let mut args = vec!["eval", "tradyn", "--model-terrain", "models/t", "--model-no-terrain", "models/nt"];
+    args.extend_from_slice(&["--maps", "maps", "--tasks", "2", "--steps", "4", "--horizon", "3", "--candidates", "16"]);
+    args.extend_from_slice(&["--elites", "4", "--iters", "1", "--prediction-steps", "5", "--out", "report"]);
+    let text = run_ok(d, &args);
+    assert!(text.contains("+T,+C") && text.contains("Wilcoxon"), "{text}");
+    let tasks = std::fs::read_to_string(d.join("report/tasks.csv")).unwrap();
+    assert_eq!(tasks.lines().count(), 1 + 2 * 4, "two tasks × four variants:\n{tasks}");
+    for file in ["report.md", "table_5_2.csv", "energy_wilcoxon.csv", "prediction.csv", "prediction.png", "paths.png"] {
+        assert!(d.join("report").join(file).is_file(), "{file} missing");
+    }
+    let swapped =
+        ["eval", "tradyn", "--model-terrain", "models/nt", "--model-no-terrain", "models/t", "--maps", "maps"];
+    fails_with(d, &swapped, "--no-terrain");
 }
 
 #[test]
