@@ -77,6 +77,13 @@ struct Outcome {
     prediction: Vec<[f64; 3]>,
 }
 
+impl Outcome {
+    /// Mean position error over the prediction horizon.
+    fn mean_position_error(&self) -> f64 {
+        self.prediction.iter().map(|e| e[0]).sum::<f64>() / self.prediction.len().max(1) as f64
+    }
+}
+
 struct Task {
     map: Arc<TerrainMap>,
     task: NavigationTask,
@@ -328,7 +335,7 @@ fn write_report(run: &RunDir, settings: &TradynEvalSettings, tasks: &[Task]) -> 
                 format!("{:.6}", o.energy),
                 format!("{:.6}", o.final_distance),
                 o.success.to_string(),
-                format!("{:.6}", o.prediction.iter().map(|e| e[0]).sum::<f64>() / o.prediction.len().max(1) as f64),
+                format!("{:.6}", o.mean_position_error()),
             ]);
         }
     }
@@ -361,14 +368,10 @@ fn write_report(run: &RunDir, settings: &TradynEvalSettings, tasks: &[Task]) -> 
         prediction_tests: [f64::NAN; 2],
         tasks: tasks.len(),
     };
-    let task_position_error = |t: &Task, v: usize| -> f64 {
-        let errors = &t.outcomes[v].prediction;
-        errors.iter().map(|e| e[0]).sum::<f64>() / errors.len().max(1) as f64
-    };
     // +T against −T with the same calibration: VARIANTS[2] vs [0] and [3] vs [1].
     for (slot, (with, without)) in summary.prediction_tests.iter_mut().zip([(2, 0), (3, 1)]) {
-        let a: Vec<f64> = tasks.iter().map(|t| task_position_error(t, with)).collect();
-        let b: Vec<f64> = tasks.iter().map(|t| task_position_error(t, without)).collect();
+        let a = column(with, &|o| o.mean_position_error());
+        let b = column(without, &|o| o.mean_position_error());
         *slot = wilcoxon_signed_rank(&a, &b, Alternative::Less).map(|w| w.p_value).unwrap_or(f64::NAN);
     }
     let mut table = Vec::new();
@@ -376,7 +379,7 @@ fn write_report(run: &RunDir, settings: &TradynEvalSettings, tasks: &[Task]) -> 
         let distance = column(v, &|o| o.final_distance * 1000.0);
         let energy = column(v, &|o| o.energy);
         let failures = tasks.iter().filter(|t| !t.outcomes[v].success).count();
-        let position: Vec<f64> = tasks.iter().flat_map(|t| t.outcomes[v].prediction.iter().map(|e| e[0])).collect();
+        let position = column(v, &|o| o.mean_position_error());
         let mean_position = position.iter().sum::<f64>() / position.len().max(1) as f64;
         summary.median_energy.push(q(&energy, 0.5));
         summary.median_distance.push(q(&distance, 0.5) / 1000.0);
@@ -486,7 +489,7 @@ fn write_report(run: &RunDir, settings: &TradynEvalSettings, tasks: &[Task]) -> 
                 t.map.name,
                 t.outcomes.iter().map(|o| format!("{:.2}", o.energy)).collect::<Vec<_>>().join(" / ")
             ),
-            grid: color_grid(&t.map),
+            grid: ColorGrid { cells: PLOT_CELLS, rgb: t.map.coarse_rgb(PLOT_CELLS) },
             paths: t
                 .outcomes
                 .iter()
@@ -504,13 +507,6 @@ fn write_report(run: &RunDir, settings: &TradynEvalSettings, tasks: &[Task]) -> 
         &markdown(settings, &names, &table, &pairs, summary.prediction_tests, tasks.len()),
     )?;
     Ok(summary)
-}
-
-fn color_grid(map: &TerrainMap) -> ColorGrid {
-    let centre = |k: usize| (k as f64 + 0.5) / PLOT_CELLS as f64;
-    let rgb =
-        (0..PLOT_CELLS).flat_map(|i| (0..PLOT_CELLS).flat_map(move |j| map.color_at(centre(i), centre(j)))).collect();
-    ColorGrid { cells: PLOT_CELLS, rgb }
 }
 
 fn markdown(

@@ -75,6 +75,13 @@ impl TerrainMap {
         [self.rgb[i], self.rgb[i + 1], self.rgb[i + 2]]
     }
 
+    /// The colours at the centres of an n × n grid over [0, 1]², cell (i, j) at `3 (i n + j)`: the map coarsened
+    /// for drawing (plots, the live view).
+    pub fn coarse_rgb(&self, cells: usize) -> Vec<u8> {
+        let centre = |k: usize| (k as f64 + 0.5) / cells as f64;
+        (0..cells).flat_map(|i| (0..cells).flat_map(move |j| self.color_at(centre(i), centre(j)))).collect()
+    }
+
     /// The observed terrain feature τ = 1 − colour/255 ∈ [0, 1]³ at a position.
     pub fn feature_at(&self, x: f64, y: f64) -> [f64; 3] {
         self.color_at(x, y).map(|c| 1.0 - c as f64 / 255.0)

@@ -140,10 +140,7 @@ const VIEW_CELLS: u32 = 64;
 
 /// The map as a coarse colour grid (cell centres), x along the first index as on the map.
 pub fn map_background(map: &TerrainMap) -> Background {
-    let n = VIEW_CELLS;
-    let centre = |k: u32| (f64::from(k) + 0.5) / f64::from(n);
-    let rgb = (0..n).flat_map(|i| (0..n).flat_map(move |j| map.color_at(centre(i), centre(j)))).collect();
-    Background { cells: n, rgb }
+    Background { cells: VIEW_CELLS, rgb: map.coarse_rgb(VIEW_CELLS as usize) }
 }
 
 /// The live view of a navigation: the robot's path and its current plan over the map, the distance to the
