@@ -8,6 +8,7 @@ pub mod data;
 pub mod dynamics;
 pub mod eig;
 pub mod fast;
+pub mod grad;
 pub mod net;
 pub mod train;
 

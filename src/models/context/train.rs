@@ -1,5 +1,5 @@
 //! Training the context model on the shared loop: one step = one batch of (chunk, context set) pairs through
-//! eq. 4.32 with burn's autodiff, then our Adam.
+//! eq. 4.32 and its hand-written gradient (`grad.rs`, held to burn's autodiff by a test), then our Adam.
 
 use burn::tensor::Device;
 use rand::SeedableRng;
@@ -7,9 +7,10 @@ use rand_chacha::ChaCha8Rng;
 
 use super::config::ContextConfig;
 use super::data::{Batch, ContextData};
+use super::grad::loss_and_gradients;
 use super::net::{param_name, ContextNet};
 use crate::error::{Error, Result};
-use crate::nn::tensor::{scalar, training_device};
+use crate::nn::tensor::training_device;
 use crate::nn::{Adam, ParamSet};
 use crate::train::{state, StoredTensor, TrainingMethod};
 use crate::util::seeding::{derive_seed, rng_for};
@@ -21,8 +22,6 @@ const VALID_STREAM: u64 = 4;
 pub struct ContextTrainer {
     config: ContextConfig,
     seed: u64,
-    device: Device,
-    net: Option<ContextNet>,
     params: ParamSet,
     adam: Adam<f32>,
     train: ContextData,
@@ -53,8 +52,7 @@ impl ContextTrainer {
             return Err(Error::data("no training instances"));
         }
         let chunk = train.chunk_states(config.chunk_states)?;
-        let device = training_device();
-        let net = init_net(&config, train.state_dim, train.action_dim, train.local_dim, seed, &device);
+        let net = init_net(&config, train.state_dim, train.action_dim, train.local_dim, seed, &training_device());
         let params = ParamSet::<f32>::from_module(&net, param_name);
         let sizes: Vec<usize> = params.tensors.iter().map(|t| t.values.len()).collect();
         let adam = Adam::new(config.optimizer, &sizes);
@@ -76,28 +74,7 @@ impl ContextTrainer {
                 })
                 .collect()
         };
-        Ok(ContextTrainer {
-            config,
-            seed,
-            device,
-            net: Some(net),
-            params,
-            adam,
-            train,
-            chunk,
-            valid_batches,
-            last_terms: Vec::new(),
-        })
-    }
-
-    fn net(&self) -> &ContextNet {
-        self.net.as_ref().expect("the network is only taken out while loading new weights")
-    }
-
-    fn load_params(&mut self) -> Result<()> {
-        let net = self.net.take().expect("network present");
-        self.net = Some(self.params.load_into(net, &self.device)?);
-        Ok(())
+        Ok(ContextTrainer { config, seed, params, adam, train, chunk, valid_batches, last_terms: Vec::new() })
     }
 
     pub fn parameter_count(&self) -> usize {
@@ -116,25 +93,22 @@ impl TrainingMethod for ContextTrainer {
         let from_target = c.context_from_target.at(step - 1);
         let batch =
             self.train.sample_batch(&mut rng, c.batch_size, self.chunk, c.context_max, from_target, c.latent_dim);
-        let net = self.net();
-        let parts = net.loss(&batch, &self.config, &self.device);
-        let value = scalar(&parts.loss);
-        if !value.is_finite() {
-            return Ok(value);
+        let (parts, grads) = loss_and_gradients(&self.params, &batch, &self.config, true)?;
+        if !parts.loss.is_finite() {
+            return Ok(parts.loss);
         }
-        let mut grads = ParamSet::<f32>::gradients(net, &parts.loss.backward());
+        let mut grads = grads.expect("gradients were asked for");
         self.adam.update(&mut self.params.values_mut(), &mut grads)?;
         self.last_terms = vec![
-            ("context/loglik_reconstruction", scalar(&parts.reconstruction)),
-            ("context/loglik_single_step", scalar(&parts.single_step)),
-            ("context/loglik_multi_step", scalar(&parts.multi_step)),
-            ("context/kl_weighted", scalar(&parts.kl)),
-            ("context/posterior_std", scalar(&parts.posterior_std)),
-            ("context/context_std", scalar(&parts.context_std)),
+            ("context/loglik_reconstruction", parts.reconstruction),
+            ("context/loglik_single_step", parts.single_step),
+            ("context/loglik_multi_step", parts.multi_step),
+            ("context/kl_weighted", parts.kl),
+            ("context/posterior_std", parts.posterior_std),
+            ("context/context_std", parts.context_std),
             ("context/p_context_from_target", from_target),
         ];
-        self.load_params()?;
-        Ok(value)
+        Ok(parts.loss)
     }
 
     fn step_scalars(&self) -> Vec<(&'static str, f64)> {
@@ -145,8 +119,10 @@ impl TrainingMethod for ContextTrainer {
         if self.valid_batches.is_empty() {
             return Ok(None);
         }
-        let net = self.net();
-        let total: f64 = self.valid_batches.iter().map(|b| scalar(&net.loss(b, &self.config, &self.device).loss)).sum();
+        let mut total = 0.0;
+        for batch in &self.valid_batches {
+            total += loss_and_gradients(&self.params, batch, &self.config, false)?.0.loss;
+        }
         Ok(Some(total / self.valid_batches.len() as f64))
     }
 
@@ -159,7 +135,6 @@ impl TrainingMethod for ContextTrainer {
     }
 
     fn restore(&mut self, saved: &[StoredTensor]) -> Result<()> {
-        state::restore(saved, &mut self.params, &mut self.adam)?;
-        self.load_params()
+        state::restore(saved, &mut self.params, &mut self.adam)
     }
 }

@@ -1,0 +1,645 @@
+//! Eq. 4.32 and its gradient written out by hand: the training step of the context model (and TRADYN's) without
+//! burn's autodiff. One batch-64 step is a few hundred small tensors; on two cores autodiff's bookkeeping,
+//! copies and fresh pages cost more than the arithmetic. `net.rs` stays the reference: a test holds the loss and
+//! every gradient here to burn's.
+
+use faer::Accum;
+
+use super::config::ContextConfig;
+use super::data::Batch;
+use super::net::{STD_FLOOR, STD_SCALE, STD_SHIFT, VARIANCE_FLOOR};
+use crate::error::{Error, Result};
+use crate::nn::backprop::{
+    add_column_sums, matmul, relu_backward, relu_in_place, sigmoid, softplus, tanh, tensor_index, view, view_mut,
+    zero_gradients, TwoLayer, TwoLayerTape,
+};
+use crate::nn::ParamSet;
+
+/// The loss and its parts (batch means), as [`super::net::LossParts`] reports them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LossValues {
+    pub loss: f64,
+    pub reconstruction: f64,
+    pub single_step: f64,
+    pub multi_step: f64,
+    pub kl: f64,
+    pub posterior_std: f64,
+    pub context_std: f64,
+}
+
+/// The context network's layers as views of a parameter set.
+struct Net<'a> {
+    state_encoder: TwoLayer<'a>,
+    action_encoder: TwoLayer<'a>,
+    context_embedding: TwoLayer<'a>,
+    terrain_embedding: Option<TwoLayer<'a>>,
+    gru: Gru<'a>,
+    mean_decoder: TwoLayer<'a>,
+    variance: Variance<'a>,
+    transition_encoder: TwoLayer<'a>,
+    context_mean: TwoLayer<'a>,
+    context_std: TwoLayer<'a>,
+}
+
+enum Variance<'a> {
+    Decoder(TwoLayer<'a>),
+    /// The raw constant (softplus + floor gives the variance) and its index.
+    Constant(&'a [f32], usize),
+}
+
+struct Gru<'a> {
+    e: usize,
+    inputs: usize,
+    weight_ih: &'a [f32],
+    weight_hh: &'a [f32],
+    bias_ih: &'a [f32],
+    bias_hh: &'a [f32],
+    index: [usize; 4],
+}
+
+/// What one GRU step keeps for its backward pass (rows × E each).
+struct GruTape {
+    r: Vec<f32>,
+    z: Vec<f32>,
+    n: Vec<f32>,
+    /// W_hn h + b_hn, which the reset gate scales.
+    hn: Vec<f32>,
+}
+
+impl<'a> Gru<'a> {
+    fn new(params: &'a ParamSet, e: usize, inputs: usize) -> Result<Self> {
+        let ix = [
+            tensor_index(params, "gru.weight_ih", &[3 * e, inputs * e])?,
+            tensor_index(params, "gru.weight_hh", &[3 * e, e])?,
+            tensor_index(params, "gru.bias_ih", &[3 * e])?,
+            tensor_index(params, "gru.bias_hh", &[3 * e])?,
+        ];
+        let v = |k: usize| params.tensors[ix[k]].values.as_slice();
+        Ok(Gru { e, inputs, weight_ih: v(0), weight_hh: v(1), bias_ih: v(2), bias_hh: v(3), index: ix })
+    }
+
+    /// gates (rows × 3E) += x · W_ih[:, block]ᵀ for input block `block` (0 context, 1 action, 2 terrain).
+    fn add_input_gates(&self, x: &[f32], rows: usize, block: usize, gates: &mut [f32]) {
+        let (e, g) = (self.e, 3 * self.e);
+        matmul(
+            view_mut(gates, rows, g),
+            Accum::Add,
+            view(x, rows, e),
+            view(self.weight_ih, g, self.inputs * e).subcols(block * e, e).transpose(),
+        );
+    }
+
+    /// The input-gate gradients `d_gates` (rows × 3E) of block `block`'s input `x`: adds to W_ih's gradient and
+    /// returns dx.
+    fn input_backward(
+        &self,
+        x: &[f32],
+        d_gates: &[f32],
+        rows: usize,
+        block: usize,
+        grads: &mut [Vec<f32>],
+    ) -> Vec<f32> {
+        let (e, g, width) = (self.e, 3 * self.e, self.inputs * self.e);
+        matmul(
+            view_mut(&mut grads[self.index[0]], g, width).subcols_mut(block * e, e),
+            Accum::Add,
+            view(d_gates, rows, g).transpose(),
+            view(x, rows, e),
+        );
+        let mut dx = vec![0.0; rows * e];
+        matmul(
+            view_mut(&mut dx, rows, e),
+            Accum::Replace,
+            view(d_gates, rows, g),
+            view(self.weight_ih, g, width).subcols(block * e, e),
+        );
+        dx
+    }
+
+    /// h ← GRU(h) from complete input gates `gi` (rows × 3E, b_ih included).
+    fn step(&self, gi: &[f32], h: &mut [f32], rows: usize) -> GruTape {
+        let (e, g) = (self.e, 3 * self.e);
+        let mut gh = Vec::with_capacity(rows * g);
+        for _ in 0..rows {
+            gh.extend_from_slice(self.bias_hh);
+        }
+        matmul(view_mut(&mut gh, rows, g), Accum::Add, view(h, rows, e), view(self.weight_hh, g, e).transpose());
+        let mut tape =
+            GruTape { r: vec![0.0; rows * e], z: vec![0.0; rows * e], n: vec![0.0; rows * e], hn: vec![0.0; rows * e] };
+        for row in 0..rows {
+            let (gi, gh) = (&gi[row * g..(row + 1) * g], &gh[row * g..(row + 1) * g]);
+            for k in 0..e {
+                let at = row * e + k;
+                let r = sigmoid(gi[k] + gh[k]);
+                let z = sigmoid(gi[e + k] + gh[e + k]);
+                let n = tanh(gi[2 * e + k] + r * gh[2 * e + k]);
+                tape.r[at] = r;
+                tape.z[at] = z;
+                tape.n[at] = n;
+                tape.hn[at] = gh[2 * e + k];
+                h[at] = (1.0 - z) * n + z * h[at];
+            }
+        }
+        tape
+    }
+
+    /// Backward of one step: from dh' (rows × E) and the previous state, the input-gate gradients (written to
+    /// `d_gi`), the hidden-gate gradients (written to `d_gh`, for one W_hh GEMM over all steps later) and dh.
+    fn step_backward(
+        &self,
+        tape: &GruTape,
+        h_prev: &[f32],
+        dh_next: &[f32],
+        rows: usize,
+        d_gi: &mut [f32],
+        d_gh: &mut [f32],
+    ) -> Vec<f32> {
+        let (e, g) = (self.e, 3 * self.e);
+        let mut dh = vec![0.0; rows * e];
+        for row in 0..rows {
+            let (d_gi, d_gh) = (&mut d_gi[row * g..(row + 1) * g], &mut d_gh[row * g..(row + 1) * g]);
+            for k in 0..e {
+                let at = row * e + k;
+                let (r, z, n, hn) = (tape.r[at], tape.z[at], tape.n[at], tape.hn[at]);
+                let d = dh_next[at];
+                let dn = d * (1.0 - z) * (1.0 - n * n);
+                let dz = d * (h_prev[at] - n) * z * (1.0 - z);
+                let dr = dn * hn * r * (1.0 - r);
+                d_gi[k] = dr;
+                d_gi[e + k] = dz;
+                d_gi[2 * e + k] = dn;
+                d_gh[k] = dr;
+                d_gh[e + k] = dz;
+                d_gh[2 * e + k] = dn * r;
+                dh[at] = d * z;
+            }
+        }
+        matmul(view_mut(&mut dh, rows, e), Accum::Add, view(d_gh, rows, g), view(self.weight_hh, g, e));
+        dh
+    }
+
+    /// W_hh's and b_hh's gradients from all steps' hidden-gate gradients and previous states at once.
+    fn hidden_weight_backward(&self, h_prev: &[f32], d_gh: &[f32], rows: usize, grads: &mut [Vec<f32>]) {
+        let (e, g) = (self.e, 3 * self.e);
+        matmul(
+            view_mut(&mut grads[self.index[1]], g, e),
+            Accum::Add,
+            view(d_gh, rows, g).transpose(),
+            view(h_prev, rows, e),
+        );
+        add_column_sums(&mut grads[self.index[3]], d_gh);
+    }
+}
+
+impl<'a> Net<'a> {
+    fn new(params: &'a ParamSet, config: &ContextConfig, s: usize, local: usize, a: usize) -> Result<Self> {
+        let (e, h) = (config.embedding, config.hidden_units);
+        let (f, b) = (config.transition_features, config.latent_dim);
+        let p = s - local;
+        let two = |name: &str, d_in: usize, d_out: usize| TwoLayer::new(params, name, d_in, h, d_out, false);
+        let variance = if config.constant_variance {
+            let index = tensor_index(params, "constant_variance", &[p])?;
+            Variance::Constant(&params.tensors[index].values, index)
+        } else {
+            Variance::Decoder(two("variance_decoder", e, p)?)
+        };
+        Ok(Net {
+            state_encoder: two("state_encoder", p, e)?,
+            action_encoder: two("action_encoder", a, e)?,
+            context_embedding: two("context_embedding", b, e)?,
+            terrain_embedding: if local > 0 { Some(two("terrain_embedding", local, e)?) } else { None },
+            gru: Gru::new(params, e, if local > 0 { 3 } else { 2 })?,
+            mean_decoder: two("mean_decoder", e, p)?,
+            variance,
+            transition_encoder: two("transition_encoder", 2 * s + a, f)?,
+            context_mean: two("context_mean", f, b)?,
+            context_std: TwoLayer::new(params, "context_std", f, h, b, true)?,
+        })
+    }
+}
+
+/// A belief's forward values and tapes.
+struct BeliefTape {
+    mean: Vec<f32>,
+    std: Vec<f32>,
+    mean_tape: TwoLayerTape,
+    std_tape: TwoLayerTape,
+    /// −0.3·enc + 0.5, the softplus argument.
+    std_arg: Vec<f32>,
+}
+
+fn belief(net: &Net, pooled: &[f32], sets: usize) -> BeliefTape {
+    let (mean, mean_tape) = net.context_mean.forward(pooled, sets);
+    let (enc, std_tape) = net.context_std.forward(pooled, sets);
+    let std_arg: Vec<f32> = enc.iter().map(|x| STD_SCALE * x + STD_SHIFT).collect();
+    let std = std_arg.iter().map(|x| softplus(*x) + STD_FLOOR).collect();
+    BeliefTape { mean, std, mean_tape, std_tape, std_arg }
+}
+
+/// Adds the belief heads' gradients and returns d pooled.
+fn belief_backward(
+    net: &Net,
+    pooled: &[f32],
+    tape: &BeliefTape,
+    d_mean: &[f32],
+    d_std: &[f32],
+    sets: usize,
+    grads: &mut [Vec<f32>],
+) -> Vec<f32> {
+    let mut d_pooled = net.context_mean.backward(pooled, &tape.mean_tape, d_mean, sets, grads, true);
+    let d_enc: Vec<f32> = d_std.iter().zip(&tape.std_arg).map(|(d, x)| d * sigmoid(*x) * STD_SCALE).collect();
+    let from_std = net.context_std.backward(pooled, &tape.std_tape, &d_enc, sets, grads, true);
+    d_pooled.iter_mut().zip(&from_std).for_each(|(a, b)| *a += b);
+    d_pooled
+}
+
+/// Max pooling of each set's rows with a zero start (absent rows excluded). Returns the pooled features and,
+/// per (set, feature), the row that gave a positive maximum (None where the maximum is the zero start).
+fn max_pool(
+    features: &[f32],
+    sets: usize,
+    size: usize,
+    f: usize,
+    present: Option<&[bool]>,
+) -> (Vec<f32>, Vec<Option<usize>>) {
+    let mut pooled = vec![0.0f32; sets * f];
+    let mut argmax = vec![None; sets * f];
+    for set in 0..sets {
+        for k in 0..size {
+            let row = set * size + k;
+            if present.is_some_and(|p| !p[row]) {
+                continue;
+            }
+            for j in 0..f {
+                let x = features[row * f + j];
+                if x > pooled[set * f + j] {
+                    pooled[set * f + j] = x;
+                    argmax[set * f + j] = Some(row);
+                }
+            }
+        }
+    }
+    (pooled, argmax)
+}
+
+/// KL(p ‖ q) per dimension of diagonal Gaussians.
+fn kl(pm: f32, ps: f32, qm: f32, qs: f32) -> f32 {
+    let ratio = (ps / qs).powi(2);
+    let shift = ((pm - qm) / qs).powi(2);
+    (ratio + shift - 1.0) * 0.5 + (qs / ps).ln()
+}
+
+/// Σ_d log N(x_d | m_d, v_d) per row, and its derivatives with respect to m and v.
+fn gaussian_log_likelihood(x: &[f32], m: &[f32], v: &[f32], d: usize) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
+    let log_2pi = (2.0 * std::f32::consts::PI).ln();
+    let rows = x.len() / d;
+    let mut ll = vec![0.0; rows];
+    let mut dm = vec![0.0; x.len()];
+    let mut dv = vec![0.0; x.len()];
+    for (row, out) in ll.iter_mut().enumerate() {
+        let mut sum = 0.0;
+        for k in row * d..(row + 1) * d {
+            let diff = x[k] - m[k];
+            sum += diff * diff / v[k] + v[k].ln() + log_2pi;
+            dm[k] = diff / v[k];
+            dv[k] = 0.5 * (diff * diff / (v[k] * v[k]) - 1.0 / v[k]);
+        }
+        *out = -0.5 * sum;
+    }
+    (ll, dm, dv)
+}
+
+/// Eq. 4.32 on a batch, as [`super::net::ContextNet::loss`] computes it, and with `want_gradients` the gradient
+/// of the loss with respect to every tensor of `params` (in its order).
+pub fn loss_and_gradients(
+    params: &ParamSet,
+    batch: &Batch,
+    config: &ContextConfig,
+    want_gradients: bool,
+) -> Result<(LossValues, Option<Vec<Vec<f32>>>)> {
+    let (b, n) = (batch.size, batch.chunk);
+    if b == 0 || n < 2 {
+        return Err(Error::config("context loss: a batch needs at least one chunk of two states"));
+    }
+    let t = n - 1;
+    let s = batch.states.len() / (b * n);
+    let l = batch.local_dim;
+    let p = s - l;
+    let a = batch.actions.len() / (b * t);
+    let tdim = 2 * s + a;
+    let m = batch.context_max;
+    let (e, lat, f) = (config.embedding, config.latent_dim, config.transition_features);
+    let net = Net::new(params, config, s, l, a)?;
+    let g = 3 * e;
+    let steps = t - 1;
+
+    // Transition features of the chunk's and the context's transitions in one pass.
+    let mut transitions = Vec::with_capacity((b * t + b * m) * tdim);
+    transitions.extend_from_slice(&batch.chunk_transitions);
+    transitions.extend_from_slice(&batch.context);
+    let enc_rows = b * t + b * m;
+    let (mut features, enc_tape) = net.transition_encoder.forward(&transitions, enc_rows);
+    relu_in_place(&mut features);
+    let (chunk_pool, chunk_arg) = max_pool(&features[..b * t * f], b, t, f, None);
+    let (context_pool, context_arg) = max_pool(&features[b * t * f..], b, m, f, Some(&batch.present));
+    // Max pooling distributes over a union; ties go to the chunk's side, as burn's max_pair does.
+    let union_pool: Vec<f32> = chunk_pool.iter().zip(&context_pool).map(|(c, x)| if c < x { *x } else { *c }).collect();
+    let posterior = belief(&net, &union_pool, b);
+    let prior = belief(&net, &context_pool, b);
+    let zero_pool = vec![0.0; f];
+    let empty = belief(&net, &zero_pool, 1);
+
+    let kl_empty: f32 = (0..lat)
+        .map(|d| {
+            let (mu, sd) = (empty.mean[d], empty.std[d]);
+            (sd * sd + mu * mu - 1.0) * 0.5 - sd.ln()
+        })
+        .sum();
+    let kl_floor = config.kl_floor as f32;
+    let kl_values: Vec<f32> =
+        (0..b * lat).map(|k| kl(posterior.mean[k], posterior.std[k], prior.mean[k], prior.std[k])).collect();
+    let kl_context = kl_values.iter().map(|v| v.max(kl_floor)).sum::<f32>() / b as f32;
+    let kl_weight = config.kl_weight as f32;
+
+    // Embeddings and the GRU input gates shared by the single-step and multi-step predictions.
+    let predicted: Vec<f32> = batch.states.chunks(s).flat_map(|row| &row[..p]).copied().collect();
+    let (mut h_all, state_tape) = net.state_encoder.forward(&predicted, b * n);
+    h_all.iter_mut().for_each(|x| *x = tanh(*x));
+    let (mut act_emb, act_tape) = net.action_encoder.forward(&batch.actions, b * t);
+    relu_in_place(&mut act_emb);
+    let mut action_gates = Vec::with_capacity(b * t * g);
+    for _ in 0..b * t {
+        action_gates.extend_from_slice(net.gru.bias_ih);
+    }
+    net.gru.add_input_gates(&act_emb, b * t, 1, &mut action_gates);
+    let terrain = net.terrain_embedding.as_ref().map(|embedding| {
+        let tau: Vec<f32> = (0..b)
+            .flat_map(|i| (0..t).flat_map(move |k| (i * n + k) * s + p..(i * n + k + 1) * s))
+            .map(|at| batch.states[at])
+            .collect();
+        let (mut emb, tape) = embedding.forward(&tau, b * t);
+        relu_in_place(&mut emb);
+        (tau, emb, tape)
+    });
+    if let Some((_, emb, _)) = &terrain {
+        net.gru.add_input_gates(emb, b * t, 2, &mut action_gates);
+    }
+
+    // Single-step predictions from every chunk state, each with a fresh β sample.
+    let beta_single: Vec<f32> = (0..b * t * lat)
+        .map(|k| {
+            let (i, d) = (k / (t * lat), k % lat);
+            posterior.mean[i * lat + d] + posterior.std[i * lat + d] * batch.noise_single[k]
+        })
+        .collect();
+    let (mut ctx_single, ctx_single_tape) = net.context_embedding.forward(&beta_single, b * t);
+    relu_in_place(&mut ctx_single);
+    let mut gi_single = action_gates.clone();
+    net.gru.add_input_gates(&ctx_single, b * t, 0, &mut gi_single);
+    let h_prev_single: Vec<f32> = (0..b)
+        .flat_map(|i| (0..t).flat_map(move |k| (i * n + k) * e..(i * n + k + 1) * e))
+        .map(|at| h_all[at])
+        .collect();
+    let mut h_single = h_prev_single.clone();
+    let single_tape = net.gru.step(&gi_single, &mut h_single, b * t);
+
+    // Multi-step: one β per chunk, open loop from s_0; the predictions of s_2.. enter the sum.
+    let beta: Vec<f32> = (0..b * lat).map(|k| posterior.mean[k] + posterior.std[k] * batch.noise_sequence[k]).collect();
+    let (mut ctx_seq, ctx_seq_tape) = net.context_embedding.forward(&beta, b);
+    relu_in_place(&mut ctx_seq);
+    let mut ctx_gates = vec![0.0; b * g];
+    net.gru.add_input_gates(&ctx_seq, b, 0, &mut ctx_gates);
+    let mut h: Vec<f32> = (0..b).flat_map(|i| h_all[i * n * e..(i * n + 1) * e].iter().copied()).collect();
+    // Step-major: row k·B + i is chunk i at step k.
+    let mut seq_h_prev = Vec::with_capacity(t * b * e);
+    let mut seq_tapes = Vec::with_capacity(t);
+    let mut open_loop = vec![0.0; b * steps * e];
+    let mut gi = vec![0.0; b * g];
+    for k in 0..t {
+        for i in 0..b {
+            let (src, ctx) = (&action_gates[(i * t + k) * g..(i * t + k + 1) * g], &ctx_gates[i * g..(i + 1) * g]);
+            for ((o, x), c) in gi[i * g..(i + 1) * g].iter_mut().zip(src).zip(ctx) {
+                *o = x + c;
+            }
+        }
+        seq_h_prev.extend_from_slice(&h);
+        seq_tapes.push(net.gru.step(&gi, &mut h, b));
+        if k >= 1 {
+            for i in 0..b {
+                let j = k - 1;
+                open_loop[(i * steps + j) * e..(i * steps + j + 1) * e].copy_from_slice(&h[i * e..(i + 1) * e]);
+            }
+        }
+    }
+
+    // One decoder pass over the reconstruction, single-step and multi-step GRU states.
+    let rows = b * n + b * t + b * steps;
+    let mut decoded = Vec::with_capacity(rows * e);
+    decoded.extend_from_slice(&h_all);
+    decoded.extend_from_slice(&h_single);
+    decoded.extend_from_slice(&open_loop);
+    let mut targets = Vec::with_capacity(rows * p);
+    targets.extend_from_slice(&predicted);
+    for i in 0..b {
+        targets.extend_from_slice(&predicted[(i * n + 1) * p..(i * n + n) * p]);
+    }
+    for i in 0..b {
+        targets.extend_from_slice(&predicted[(i * n + 2) * p..(i * n + n) * p]);
+    }
+    let (mean, mean_tape) = net.mean_decoder.forward(&decoded, rows);
+    let (variance, variance_tape) = match &net.variance {
+        Variance::Decoder(decoder) => {
+            let (raw, tape) = decoder.forward(&decoded, rows);
+            let v = raw.iter().map(|x| softplus(*x) + VARIANCE_FLOOR).collect::<Vec<_>>();
+            (v, Some((raw, tape)))
+        }
+        Variance::Constant(raw, _) => {
+            let row: Vec<f32> = raw.iter().map(|x| softplus(*x) + VARIANCE_FLOOR).collect();
+            (row.iter().cycle().take(rows * p).copied().collect(), None)
+        }
+    };
+    let (ll, dm, dv) = gaussian_log_likelihood(&targets, &mean, &variance, p);
+    let sum = |range: std::ops::Range<usize>| ll[range].iter().map(|x| *x as f64).sum::<f64>();
+    let reconstruction = sum(0..b * n) / (b * n) as f64;
+    let single_step = sum(b * n..b * (n + t)) / (b * t) as f64;
+    let multi_step = sum(b * (n + t)..rows) / b as f64;
+    let kl_total = kl_empty as f64 + kl_context as f64 * config.kl_weight;
+    let mean_of = |v: &[f32]| v.iter().map(|x| *x as f64).sum::<f64>() / v.len() as f64;
+    let values = LossValues {
+        loss: -(reconstruction + single_step + multi_step) + kl_total,
+        reconstruction,
+        single_step,
+        multi_step,
+        kl: kl_total,
+        posterior_std: mean_of(&posterior.std),
+        context_std: mean_of(&prior.std),
+    };
+    if !want_gradients {
+        return Ok((values, None));
+    }
+
+    let mut grads = zero_gradients(params);
+    // ∂loss/∂(row log-likelihood): the three terms are means over rows (the multi-step one a sum over steps).
+    let row_weight = |row: usize| -> f32 {
+        if row < b * n {
+            -1.0 / (b * n) as f32
+        } else if row < b * (n + t) {
+            -1.0 / (b * t) as f32
+        } else {
+            -1.0 / b as f32
+        }
+    };
+    let mut d_mean = dm;
+    let mut d_var = dv;
+    for row in 0..rows {
+        let w = row_weight(row);
+        d_mean[row * p..(row + 1) * p].iter_mut().for_each(|x| *x *= w);
+        d_var[row * p..(row + 1) * p].iter_mut().for_each(|x| *x *= w);
+    }
+    let mut d_decoded = net.mean_decoder.backward(&decoded, &mean_tape, &d_mean, rows, &mut grads, true);
+    match (&net.variance, variance_tape) {
+        (Variance::Decoder(decoder), Some((raw, tape))) => {
+            let d_raw: Vec<f32> = d_var.iter().zip(&raw).map(|(d, x)| d * sigmoid(*x)).collect();
+            let from_var = decoder.backward(&decoded, &tape, &d_raw, rows, &mut grads, true);
+            d_decoded.iter_mut().zip(&from_var).for_each(|(a, b)| *a += b);
+        }
+        (Variance::Constant(raw, index), _) => {
+            let mut sums = vec![0.0; p];
+            add_column_sums(&mut sums, &d_var);
+            for ((gr, sm), x) in grads[*index].iter_mut().zip(&sums).zip(raw.iter()) {
+                *gr += sm * sigmoid(*x);
+            }
+        }
+        (Variance::Decoder(_), None) => unreachable!("a variance decoder's forward pass leaves its tape"),
+    }
+    let mut d_h_all = d_decoded[..b * n * e].to_vec();
+    let d_h_single = &d_decoded[b * n * e..b * (n + t) * e];
+    let d_open = &d_decoded[b * (n + t) * e..];
+
+    // Back through the open loop.
+    let mut d_gi_seq = vec![0.0; b * t * g];
+    let mut seq_d_gh = vec![0.0; t * b * g];
+    let mut dh = vec![0.0; b * e];
+    let mut d_gi_step = vec![0.0; b * g];
+    for k in (0..t).rev() {
+        if k >= 1 {
+            let j = k - 1;
+            for i in 0..b {
+                let src = &d_open[(i * steps + j) * e..(i * steps + j + 1) * e];
+                dh[i * e..(i + 1) * e].iter_mut().zip(src).for_each(|(a, b)| *a += b);
+            }
+        }
+        let h_prev = &seq_h_prev[k * b * e..(k + 1) * b * e];
+        let d_gh = &mut seq_d_gh[k * b * g..(k + 1) * b * g];
+        dh = net.gru.step_backward(&seq_tapes[k], h_prev, &dh, b, &mut d_gi_step, d_gh);
+        for i in 0..b {
+            d_gi_seq[(i * t + k) * g..(i * t + k + 1) * g].copy_from_slice(&d_gi_step[i * g..(i + 1) * g]);
+        }
+    }
+    for i in 0..b {
+        d_h_all[i * n * e..(i * n + 1) * e].iter_mut().zip(&dh[i * e..(i + 1) * e]).for_each(|(a, b)| *a += b);
+    }
+    net.gru.hidden_weight_backward(&seq_h_prev, &seq_d_gh, t * b, &mut grads);
+
+    // Back through the single steps.
+    let mut d_gi_single = vec![0.0; b * t * g];
+    let mut single_d_gh = vec![0.0; b * t * g];
+    let d_h_prev_single =
+        net.gru.step_backward(&single_tape, &h_prev_single, d_h_single, b * t, &mut d_gi_single, &mut single_d_gh);
+    net.gru.hidden_weight_backward(&h_prev_single, &single_d_gh, b * t, &mut grads);
+    for i in 0..b {
+        for k in 0..t {
+            let dst = &mut d_h_all[(i * n + k) * e..(i * n + k + 1) * e];
+            dst.iter_mut().zip(&d_h_prev_single[(i * t + k) * e..(i * t + k + 1) * e]).for_each(|(a, b)| *a += b);
+        }
+    }
+
+    // The input gates: the action (and terrain) part and b_ih are shared by both predictions.
+    let d_action_gates: Vec<f32> = d_gi_single.iter().zip(&d_gi_seq).map(|(a, b)| a + b).collect();
+    add_column_sums(&mut grads[net.gru.index[2]], &d_action_gates);
+    let mut d_act_emb = net.gru.input_backward(&act_emb, &d_action_gates, b * t, 1, &mut grads);
+    relu_backward(&mut d_act_emb, &act_emb);
+    net.action_encoder.backward(&batch.actions, &act_tape, &d_act_emb, b * t, &mut grads, false);
+    if let (Some(embedding), Some((tau, emb, tape))) = (&net.terrain_embedding, &terrain) {
+        let mut d_emb = net.gru.input_backward(emb, &d_action_gates, b * t, 2, &mut grads);
+        relu_backward(&mut d_emb, emb);
+        embedding.backward(tau, tape, &d_emb, b * t, &mut grads, false);
+    }
+    let mut d_ctx_single = net.gru.input_backward(&ctx_single, &d_gi_single, b * t, 0, &mut grads);
+    relu_backward(&mut d_ctx_single, &ctx_single);
+    let d_beta_single =
+        net.context_embedding.backward(&beta_single, &ctx_single_tape, &d_ctx_single, b * t, &mut grads, true);
+    let mut d_ctx_gates = vec![0.0; b * g];
+    for i in 0..b {
+        for k in 0..t {
+            let src = &d_gi_seq[(i * t + k) * g..(i * t + k + 1) * g];
+            d_ctx_gates[i * g..(i + 1) * g].iter_mut().zip(src).for_each(|(a, b)| *a += b);
+        }
+    }
+    let mut d_ctx_seq = net.gru.input_backward(&ctx_seq, &d_ctx_gates, b, 0, &mut grads);
+    relu_backward(&mut d_ctx_seq, &ctx_seq);
+    let d_beta = net.context_embedding.backward(&beta, &ctx_seq_tape, &d_ctx_seq, b, &mut grads, true);
+
+    // The state encoder.
+    let mut d_state = d_h_all;
+    d_state.iter_mut().zip(&h_all).for_each(|(d, y)| *d *= 1.0 - y * y);
+    net.state_encoder.backward(&predicted, &state_tape, &d_state, b * n, &mut grads, false);
+
+    // The beliefs: reparameterized samples and the KL terms.
+    let mut d_post_mean = vec![0.0; b * lat];
+    let mut d_post_std = vec![0.0; b * lat];
+    let mut d_prior_mean = vec![0.0; b * lat];
+    let mut d_prior_std = vec![0.0; b * lat];
+    for (k, d) in d_beta_single.iter().enumerate() {
+        let (i, dim) = (k / (t * lat), k % lat);
+        d_post_mean[i * lat + dim] += d;
+        d_post_std[i * lat + dim] += d * batch.noise_single[k];
+    }
+    for (k, d) in d_beta.iter().enumerate() {
+        d_post_mean[k] += d;
+        d_post_std[k] += d * batch.noise_sequence[k];
+    }
+    let kl_scale = kl_weight / b as f32;
+    for k in 0..b * lat {
+        // The floor's clamp passes no gradient below it.
+        if kl_values[k] < kl_floor {
+            continue;
+        }
+        let (pm, ps, qm, qs) = (posterior.mean[k], posterior.std[k], prior.mean[k], prior.std[k]);
+        let q2 = qs * qs;
+        let diff = pm - qm;
+        d_post_mean[k] += kl_scale * diff / q2;
+        d_prior_mean[k] -= kl_scale * diff / q2;
+        d_post_std[k] += kl_scale * (ps / q2 - 1.0 / ps);
+        d_prior_std[k] += kl_scale * ((q2 - ps * ps - diff * diff) / (q2 * qs));
+    }
+    let d_empty_mean: Vec<f32> = empty.mean.clone();
+    let d_empty_std: Vec<f32> = empty.std.iter().map(|sd| sd - 1.0 / sd).collect();
+    belief_backward(&net, &zero_pool, &empty, &d_empty_mean, &d_empty_std, 1, &mut grads);
+    let d_union = belief_backward(&net, &union_pool, &posterior, &d_post_mean, &d_post_std, b, &mut grads);
+    let mut d_context_pool = belief_backward(&net, &context_pool, &prior, &d_prior_mean, &d_prior_std, b, &mut grads);
+    let mut d_chunk_pool = vec![0.0; b * f];
+    for k in 0..b * f {
+        if chunk_pool[k] < context_pool[k] {
+            d_context_pool[k] += d_union[k];
+        } else {
+            d_chunk_pool[k] += d_union[k];
+        }
+    }
+
+    // Back through the pools to the transition features' maximizing rows.
+    let mut d_features = vec![0.0; enc_rows * f];
+    for k in 0..b * f {
+        let j = k % f;
+        if let Some(row) = chunk_arg[k] {
+            d_features[row * f + j] += d_chunk_pool[k];
+        }
+        if let Some(row) = context_arg[k] {
+            d_features[(b * t + row) * f + j] += d_context_pool[k];
+        }
+    }
+    relu_backward(&mut d_features, &features);
+    net.transition_encoder.backward(&transitions, &enc_tape, &d_features, enc_rows, &mut grads, false);
+
+    Ok((values, Some(grads)))
+}
