@@ -3,6 +3,7 @@
 //! `--resume` continues bit for bit. (burn's own Adam defaults ε to 1e-5 and clips each tensor on its own.)
 
 use num_traits::Float;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
@@ -56,7 +57,7 @@ pub struct Adam<T> {
     pub exp_avg_sq: Vec<Vec<T>>,
 }
 
-impl<T: Float> Adam<T> {
+impl<T: Float + Send + Sync> Adam<T> {
     pub fn new(config: AdamConfig, sizes: &[usize]) -> Self {
         Adam {
             config,
@@ -95,19 +96,25 @@ impl<T: Float> Adam<T> {
         let bias1 = T::one() - beta1.powi(self.step.min(i32::MAX as u64) as i32);
         let bias2_sqrt = (T::one() - beta2.powi(self.step.min(i32::MAX as u64) as i32)).sqrt();
         let step_size = Self::cast(c.learning_rate) / bias1;
-        for (k, (p, g)) in params.iter_mut().zip(grads.iter()).enumerate() {
+        for (k, (p, g)) in params.iter().zip(grads.iter()).enumerate() {
             if p.len() != g.len() || p.len() != self.exp_avg[k].len() {
                 return Err(Error::config(format!("optimizer tensor {k}: sizes of parameter and gradient differ")));
             }
-            let (m, v) = (&mut self.exp_avg[k], &mut self.exp_avg_sq[k]);
-            for i in 0..p.len() {
-                let grad = if wd > T::zero() { g[i] + wd * p[i] } else { g[i] };
-                m[i] = beta1 * m[i] + (T::one() - beta1) * grad;
-                v[i] = beta2 * v[i] + (T::one() - beta2) * grad * grad;
-                let denom = v[i].sqrt() / bias2_sqrt + eps;
-                p[i] = p[i] - step_size * m[i] / denom;
-            }
         }
+        // Tensors update independently, element by element in one order: the bytes do not depend on threads.
+        params
+            .par_iter_mut()
+            .zip(grads.par_iter())
+            .zip(self.exp_avg.par_iter_mut().zip(self.exp_avg_sq.par_iter_mut()))
+            .for_each(|((p, g), (m, v))| {
+                for i in 0..p.len() {
+                    let grad = if wd > T::zero() { g[i] + wd * p[i] } else { g[i] };
+                    m[i] = beta1 * m[i] + (T::one() - beta1) * grad;
+                    v[i] = beta2 * v[i] + (T::one() - beta2) * grad * grad;
+                    let denom = v[i].sqrt() / bias2_sqrt + eps;
+                    p[i] = p[i] - step_size * m[i] / denom;
+                }
+            });
         Ok(norm.to_f64().unwrap_or(f64::NAN))
     }
 }

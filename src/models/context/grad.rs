@@ -4,6 +4,7 @@
 //! every gradient here to burn's.
 
 use faer::Accum;
+use rayon::prelude::*;
 
 use super::config::ContextConfig;
 use super::data::Batch;
@@ -25,6 +26,13 @@ pub struct LossValues {
     pub kl: f64,
     pub posterior_std: f64,
     pub context_std: f64,
+}
+
+/// Rows per parallel task of an element-wise pass over `rows × width` values: one task below ~64k values,
+/// where splitting costs more than it saves.
+fn block_rows(rows: usize, width: usize) -> usize {
+    let tasks = (rows * width / (1 << 16)).clamp(1, rayon::current_num_threads().max(1));
+    rows.div_ceil(tasks).max(1)
 }
 
 /// The context network's layers as views of a parameter set.
@@ -126,20 +134,25 @@ impl<'a> Gru<'a> {
         matmul(view_mut(&mut gh, rows, g), Accum::Add, view(h, rows, e), view(self.weight_hh, g, e).transpose());
         let mut tape =
             GruTape { r: vec![0.0; rows * e], z: vec![0.0; rows * e], n: vec![0.0; rows * e], hn: vec![0.0; rows * e] };
-        for row in 0..rows {
-            let (gi, gh) = (&gi[row * g..(row + 1) * g], &gh[row * g..(row + 1) * g]);
-            for k in 0..e {
-                let at = row * e + k;
-                let r = sigmoid(gi[k] + gh[k]);
-                let z = sigmoid(gi[e + k] + gh[e + k]);
-                let n = tanh(gi[2 * e + k] + r * gh[2 * e + k]);
-                tape.r[at] = r;
-                tape.z[at] = z;
-                tape.n[at] = n;
-                tape.hn[at] = gh[2 * e + k];
-                h[at] = (1.0 - z) * n + z * h[at];
-            }
-        }
+        let (he, hg) = (block_rows(rows, e) * e, block_rows(rows, e) * g);
+        let GruTape { r, z, n, hn } = &mut tape;
+        h.par_chunks_mut(he)
+            .zip(r.par_chunks_mut(he).zip(z.par_chunks_mut(he)))
+            .zip(n.par_chunks_mut(he).zip(hn.par_chunks_mut(he)))
+            .zip(gi.par_chunks(hg).zip(gh.par_chunks(hg)))
+            .for_each(|(((h, (r, z)), (n, hn)), (gi, gh))| {
+                for row in 0..h.len() / e {
+                    let (gi, gh) = (&gi[row * g..(row + 1) * g], &gh[row * g..(row + 1) * g]);
+                    for k in 0..e {
+                        let at = row * e + k;
+                        r[at] = sigmoid(gi[k] + gh[k]);
+                        z[at] = sigmoid(gi[e + k] + gh[e + k]);
+                        n[at] = tanh(gi[2 * e + k] + r[at] * gh[2 * e + k]);
+                        hn[at] = gh[2 * e + k];
+                        h[at] = (1.0 - z[at]) * n[at] + z[at] * h[at];
+                    }
+                }
+            });
         tape
     }
 
@@ -156,24 +169,32 @@ impl<'a> Gru<'a> {
     ) -> Vec<f32> {
         let (e, g) = (self.e, 3 * self.e);
         let mut dh = vec![0.0; rows * e];
-        for row in 0..rows {
-            let (d_gi, d_gh) = (&mut d_gi[row * g..(row + 1) * g], &mut d_gh[row * g..(row + 1) * g]);
-            for k in 0..e {
-                let at = row * e + k;
-                let (r, z, n, hn) = (tape.r[at], tape.z[at], tape.n[at], tape.hn[at]);
-                let d = dh_next[at];
-                let dn = d * (1.0 - z) * (1.0 - n * n);
-                let dz = d * (h_prev[at] - n) * z * (1.0 - z);
-                let dr = dn * hn * r * (1.0 - r);
-                d_gi[k] = dr;
-                d_gi[e + k] = dz;
-                d_gi[2 * e + k] = dn;
-                d_gh[k] = dr;
-                d_gh[e + k] = dz;
-                d_gh[2 * e + k] = dn * r;
-                dh[at] = d * z;
-            }
-        }
+        let (he, hg) = (block_rows(rows, e) * e, block_rows(rows, e) * g);
+        dh.par_chunks_mut(he)
+            .zip(d_gi.par_chunks_mut(hg).zip(d_gh.par_chunks_mut(hg)))
+            .zip(tape.r.par_chunks(he).zip(tape.z.par_chunks(he)))
+            .zip(tape.n.par_chunks(he).zip(tape.hn.par_chunks(he)))
+            .zip(h_prev.par_chunks(he).zip(dh_next.par_chunks(he)))
+            .for_each(|((((dh, (d_gi, d_gh)), (r, z)), (n, hn)), (h_prev, dh_next))| {
+                for row in 0..dh.len() / e {
+                    let (d_gi, d_gh) = (&mut d_gi[row * g..(row + 1) * g], &mut d_gh[row * g..(row + 1) * g]);
+                    for k in 0..e {
+                        let at = row * e + k;
+                        let (r, z, n, hn) = (r[at], z[at], n[at], hn[at]);
+                        let d = dh_next[at];
+                        let dn = d * (1.0 - z) * (1.0 - n * n);
+                        let dz = d * (h_prev[at] - n) * z * (1.0 - z);
+                        let dr = dn * hn * r * (1.0 - r);
+                        d_gi[k] = dr;
+                        d_gi[e + k] = dz;
+                        d_gi[2 * e + k] = dn;
+                        d_gh[k] = dr;
+                        d_gh[e + k] = dz;
+                        d_gh[2 * e + k] = dn * r;
+                        dh[at] = d * z;
+                    }
+                }
+            });
         matmul(view_mut(&mut dh, rows, e), Accum::Add, view(d_gh, rows, g), view(self.weight_hh, g, e));
         dh
     }
