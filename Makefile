@@ -91,7 +91,7 @@ repro-context: build
 
 # TRADYN (thesis 5.5) at the medium scale these two cores allow: the thesis' map set and data (100 maps,
 # 10 000 instance pairs of 100 colored-noise steps on the 50 train maps), the small-preset network (64 units,
-# batch 64) trained for $(TRADYN_STEPS) steps with and without terrain lookup (≈ 45 min each, run side by side),
+# batch 64) trained for $(TRADYN_STEPS) steps with and without terrain lookup (≈ 20 min each, run side by side),
 # then the four variants on $(TRADYN_TASKS) tasks on the test maps with CEM $(TRADYN_CEM) (the thesis:
 # 5 models × 150 tasks, 200 units, batch 512, 100k steps, CEM 1000 × 50 elites × 20 iterations on a GPU).
 TRADYN_STEPS ?= 15000
