@@ -4,7 +4,7 @@
 MBRL := target/release/mbrl
 SEED ?= 0
 
-.PHONY: build test bench completions repro-quick repro-swingup repro-pendulum-data repro-boards repro-ball repro-pets repro-pets-loop repro-context repro-tradyn repro-seads repro-dlgpd clean-reports
+.PHONY: build test bench completions repro-quick repro-swingup repro-pendulum-data repro-boards repro-ball repro-pets repro-pets-loop repro-context repro-context-mountaincar repro-tradyn repro-seads repro-dlgpd clean-reports
 
 build:
 	cargo build --release
@@ -88,6 +88,16 @@ repro-context: build
 	$(MBRL) train --method context --data datasets/context/mountaincar.mcap --preset $(CONTEXT_PRESET) --seed $(SEED) --no-tui -q --out models/context/mountaincar
 	$(MBRL) eval context --model models/context/mountaincar --env mountaincar --transitions 50 --horizon 30 \
 		--contexts $(CONTEXT_CONTEXTS) $(CONTEXT_CEM) --seed $(SEED) --no-tui -q --out reports/context/mountaincar
+
+# Thesis 4.5.4 / Fig. 4.7 (MountainCar) at the scale measured on 2 cores: 10 000 instance pairs, the small
+# preset (64 units, batch 64) for 30 000 steps (≈ 25 min), then 50 unseen contexts of 50 calibration
+# transitions with EIG CEM 300 × 30 elites × 4 iterations and 10 β samples on one thread (≈ 25 min; the
+# figures in the README are this run's, seed 0).
+repro-context-mountaincar: build
+	$(MBRL) collect --env mountaincar --instances 10000 --steps 100 --seed $(SEED) --no-tui -q --out datasets/context/mountaincar-10k.mcap
+	$(MBRL) train --method context --data datasets/context/mountaincar-10k.mcap --preset small --steps 30000 --seed $(SEED) --no-tui -q --out models/context/mountaincar-small
+	$(MBRL) eval context --model models/context/mountaincar-small --env mountaincar --transitions 50 --horizon 30 --contexts 50 \
+		--candidates 300 --elites 30 --iters 4 --beta-samples 10 --threads 1 --seed $(SEED) --no-tui -q --out reports/context/mountaincar-small
 
 # TRADYN (thesis 5.5) at the medium scale these two cores allow: the thesis' map set and data (100 maps,
 # 10 000 instance pairs of 100 colored-noise steps on the 50 train maps), the small-preset network (64 units,
