@@ -11,7 +11,7 @@ use std::path::Path;
 use rand::Rng;
 use serde::Serialize;
 
-use super::plot::{line_plot, Series};
+use super::plot::{line_plot, rising_line_plot, Series};
 use super::stats::{mean, wilcoxon_signed_rank, Alternative};
 use super::swingup::{self, SwingupSettings};
 use crate::data::Rollout;
@@ -477,7 +477,7 @@ fn write_report(
     let mut series: Vec<Series> =
         strategies.iter().zip(&by_horizon).map(|(s, v)| Series { name: s.name().into(), points: curve(v) }).collect();
     series.push(Series { name: "no calibration (empty context)".into(), points: curve(&empty_by_horizon) });
-    line_plot(
+    rising_line_plot(
         &run.file("mse_vs_horizon.png"),
         &format!("{}: prediction MSE after calibration ({} contexts)", env.canonical(), outcomes.len()),
         "prediction horizon [steps]",

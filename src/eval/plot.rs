@@ -119,6 +119,13 @@ pub fn line_plot(path: &Path, title: &str, x_label: &str, y_label: &str, series:
     line_plot_in(path, title, x_label, y_label, series, y)
 }
 
+/// A line plot of curves that rise from the lower left (errors against the prediction horizon): the legend
+/// goes to the upper left, which they leave empty, instead of over their right ends.
+pub fn rising_line_plot(path: &Path, title: &str, x_label: &str, y_label: &str, series: &[Series]) -> Result<()> {
+    let y = bounds(series.iter().flat_map(|s| s.points.iter().map(|p| p.1)));
+    line_plot_legend_at(path, title, (x_label, y_label), series, y, SeriesLabelPosition::UpperLeft)
+}
+
 /// A line plot on a fixed y range: rates in percent read wrong when the axis zooms in on 95-100.
 pub fn line_plot_in(
     path: &Path,
@@ -126,7 +133,18 @@ pub fn line_plot_in(
     x_label: &str,
     y_label: &str,
     series: &[Series],
+    y: (f64, f64),
+) -> Result<()> {
+    line_plot_legend_at(path, title, (x_label, y_label), series, y, SeriesLabelPosition::MiddleRight)
+}
+
+fn line_plot_legend_at(
+    path: &Path,
+    title: &str,
+    (x_label, y_label): (&str, &str),
+    series: &[Series],
     (y0, y1): (f64, f64),
+    legend: SeriesLabelPosition,
 ) -> Result<()> {
     let (x0, x1) = bounds(series.iter().flat_map(|s| s.points.iter().map(|p| p.0)));
     render_atomic(path, |tmp| {
@@ -142,7 +160,7 @@ pub fn line_plot_in(
             )?;
         }
         if series.len() <= PALETTE.len() {
-            draw_legend(&mut chart, path, SeriesLabelPosition::MiddleRight, None)?;
+            draw_legend(&mut chart, path, legend, None)?;
         }
         root.present().map_err(|e| plot_err(path, e))?;
         Ok(())
