@@ -60,8 +60,8 @@ impl Activation {
         match self {
             Activation::Relu => xs.iter_mut().for_each(|x| *x = x.max(0.0)),
             Activation::Silu => xs.iter_mut().for_each(|x| *x /= 1.0 + fast_exp(-*x)),
-            Activation::Tanh => xs.iter_mut().for_each(|x| *x = 1.0 - 2.0 / (fast_exp(2.0 * *x) + 1.0)),
-            Activation::Sigmoid => xs.iter_mut().for_each(|x| *x = 1.0 / (1.0 + fast_exp(-*x))),
+            Activation::Tanh => xs.iter_mut().for_each(|x| *x = fast_tanh(*x)),
+            Activation::Sigmoid => xs.iter_mut().for_each(|x| *x = fast_sigmoid(*x)),
             Activation::Identity => {}
         }
     }
@@ -102,6 +102,18 @@ pub fn fast_exp(x: f32) -> f32 {
     p * f32::from_bits((exponent as u32) << 23)
 }
 
+/// σ(x) from [`fast_exp`] (relative error below 1e-6).
+#[inline(always)]
+pub fn fast_sigmoid(x: f32) -> f32 {
+    1.0 / (1.0 + fast_exp(-x))
+}
+
+/// tanh(x) from [`fast_exp`] (error below 1e-6); exactly ±1 far out.
+#[inline(always)]
+pub fn fast_tanh(x: f32) -> f32 {
+    1.0 - 2.0 / (fast_exp(2.0 * x) + 1.0)
+}
+
 /// ln(1 + e^x) without libm calls: max(x, 0) + ln(1 + e^−|x|), the logarithm of 1 + y ∈ [1, 2] as
 /// 2·atanh(y / (2 + y)) by its odd series to s⁹ (|s| ≤ 1/3, error below 1e-7).
 #[inline(always)]
@@ -129,6 +141,19 @@ mod tests {
         assert!(worst < 5e-7, "worst relative error {worst}");
         assert_eq!(fast_exp(-1000.0), fast_exp(-87.0));
         assert!(fast_exp(1000.0).is_finite());
+    }
+
+    #[test]
+    fn fast_sigmoid_and_tanh_are_accurate_and_saturate_cleanly() {
+        assert_eq!((fast_tanh(50.0), fast_tanh(-50.0)), (1.0, -1.0));
+        assert_eq!(fast_sigmoid(100.0), 1.0);
+        assert!((0.0..1e-37).contains(&fast_sigmoid(-100.0)));
+        assert_eq!(fast_softplus(100.0), 100.0);
+        assert!((0.0..1e-30).contains(&fast_softplus(-100.0)));
+        for x in [-3.0f32, -0.5, 0.0, 0.7, 2.5] {
+            assert!((fast_tanh(x) - x.tanh()).abs() < 1e-6);
+            assert!((fast_sigmoid(x) - 1.0 / (1.0 + (-x).exp())).abs() < 1e-6);
+        }
     }
 
     #[test]

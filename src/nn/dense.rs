@@ -4,7 +4,7 @@
 
 use faer::{Accum, MatMut, MatRef, Par};
 
-use super::activation::{fast_exp, Activation};
+use super::activation::{fast_sigmoid as sigmoid, fast_tanh as tanh, Activation};
 use super::params::{NamedTensor, ParamSet};
 use crate::error::{Error, Result};
 
@@ -228,16 +228,6 @@ impl DenseGru {
     pub fn flops_per_row(&self) -> usize {
         2 * 3 * self.d_hidden * (self.d_input + self.d_hidden)
     }
-}
-
-#[inline(always)]
-fn sigmoid(x: f32) -> f32 {
-    1.0 / (1.0 + fast_exp(-x))
-}
-
-#[inline(always)]
-fn tanh(x: f32) -> f32 {
-    1.0 - 2.0 / (fast_exp(2.0 * x) + 1.0)
 }
 
 #[cfg(test)]

@@ -10,9 +10,10 @@ use super::config::ContextConfig;
 use super::data::Batch;
 use super::net::{STD_FLOOR, STD_SCALE, STD_SHIFT, VARIANCE_FLOOR};
 use crate::error::{Error, Result};
+use crate::nn::activation::{fast_sigmoid as sigmoid, fast_softplus as softplus, fast_tanh as tanh};
 use crate::nn::backprop::{
-    add_column_sums, matmul, relu_backward, relu_in_place, sigmoid, softplus, tanh, tensor_index, view, view_mut,
-    zero_gradients, TwoLayer, TwoLayerTape,
+    add_column_sums, add_into, matmul, relu_backward, relu_in_place, tensor_index, view, view_mut, zero_gradients,
+    TwoLayer, TwoLayerTape,
 };
 use crate::nn::ParamSet;
 
@@ -127,10 +128,7 @@ impl<'a> Gru<'a> {
     /// h ← GRU(h) from complete input gates `gi` (rows × 3E, b_ih included).
     fn step(&self, gi: &[f32], h: &mut [f32], rows: usize) -> GruTape {
         let (e, g) = (self.e, 3 * self.e);
-        let mut gh = Vec::with_capacity(rows * g);
-        for _ in 0..rows {
-            gh.extend_from_slice(self.bias_hh);
-        }
+        let mut gh = self.bias_hh.repeat(rows);
         matmul(view_mut(&mut gh, rows, g), Accum::Add, view(h, rows, e), view(self.weight_hh, g, e).transpose());
         let mut tape =
             GruTape { r: vec![0.0; rows * e], z: vec![0.0; rows * e], n: vec![0.0; rows * e], hn: vec![0.0; rows * e] };
@@ -270,7 +268,7 @@ fn belief_backward(
     let mut d_pooled = net.context_mean.backward(pooled, &tape.mean_tape, d_mean, sets, grads, true);
     let d_enc: Vec<f32> = d_std.iter().zip(&tape.std_arg).map(|(d, x)| d * sigmoid(*x) * STD_SCALE).collect();
     let from_std = net.context_std.backward(pooled, &tape.std_tape, &d_enc, sets, grads, true);
-    d_pooled.iter_mut().zip(&from_std).for_each(|(a, b)| *a += b);
+    add_into(&mut d_pooled, &from_std);
     d_pooled
 }
 
@@ -370,12 +368,7 @@ pub fn loss_and_gradients(
     let zero_pool = vec![0.0; f];
     let empty = belief(&net, &zero_pool, 1);
 
-    let kl_empty: f32 = (0..lat)
-        .map(|d| {
-            let (mu, sd) = (empty.mean[d], empty.std[d]);
-            (sd * sd + mu * mu - 1.0) * 0.5 - sd.ln()
-        })
-        .sum();
+    let kl_empty: f32 = (0..lat).map(|d| kl(empty.mean[d], empty.std[d], 0.0, 1.0)).sum();
     let kl_floor = config.kl_floor as f32;
     let kl_values: Vec<f32> =
         (0..b * lat).map(|k| kl(posterior.mean[k], posterior.std[k], prior.mean[k], prior.std[k])).collect();
@@ -388,10 +381,7 @@ pub fn loss_and_gradients(
     h_all.iter_mut().for_each(|x| *x = tanh(*x));
     let (mut act_emb, act_tape) = net.action_encoder.forward(&batch.actions, b * t);
     relu_in_place(&mut act_emb);
-    let mut action_gates = Vec::with_capacity(b * t * g);
-    for _ in 0..b * t {
-        action_gates.extend_from_slice(net.gru.bias_ih);
-    }
+    let mut action_gates = net.gru.bias_ih.repeat(b * t);
     net.gru.add_input_gates(&act_emb, b * t, 1, &mut action_gates);
     let terrain = net.terrain_embedding.as_ref().map(|embedding| {
         let tau: Vec<f32> = (0..b)
@@ -522,7 +512,7 @@ pub fn loss_and_gradients(
         (Variance::Decoder(decoder), Some((raw, tape))) => {
             let d_raw: Vec<f32> = d_var.iter().zip(&raw).map(|(d, x)| d * sigmoid(*x)).collect();
             let from_var = decoder.backward(&decoded, &tape, &d_raw, rows, &mut grads, true);
-            d_decoded.iter_mut().zip(&from_var).for_each(|(a, b)| *a += b);
+            add_into(&mut d_decoded, &from_var);
         }
         (Variance::Constant(raw, index), _) => {
             let mut sums = vec![0.0; p];
@@ -547,7 +537,7 @@ pub fn loss_and_gradients(
             let j = k - 1;
             for i in 0..b {
                 let src = &d_open[(i * steps + j) * e..(i * steps + j + 1) * e];
-                dh[i * e..(i + 1) * e].iter_mut().zip(src).for_each(|(a, b)| *a += b);
+                add_into(&mut dh[i * e..(i + 1) * e], src);
             }
         }
         let h_prev = &seq_h_prev[k * b * e..(k + 1) * b * e];
@@ -558,7 +548,7 @@ pub fn loss_and_gradients(
         }
     }
     for i in 0..b {
-        d_h_all[i * n * e..(i * n + 1) * e].iter_mut().zip(&dh[i * e..(i + 1) * e]).for_each(|(a, b)| *a += b);
+        add_into(&mut d_h_all[i * n * e..(i * n + 1) * e], &dh[i * e..(i + 1) * e]);
     }
     net.gru.hidden_weight_backward(&seq_h_prev, &seq_d_gh, t * b, &mut grads);
 
@@ -571,7 +561,7 @@ pub fn loss_and_gradients(
     for i in 0..b {
         for k in 0..t {
             let dst = &mut d_h_all[(i * n + k) * e..(i * n + k + 1) * e];
-            dst.iter_mut().zip(&d_h_prev_single[(i * t + k) * e..(i * t + k + 1) * e]).for_each(|(a, b)| *a += b);
+            add_into(dst, &d_h_prev_single[(i * t + k) * e..(i * t + k + 1) * e]);
         }
     }
 
@@ -594,7 +584,7 @@ pub fn loss_and_gradients(
     for i in 0..b {
         for k in 0..t {
             let src = &d_gi_seq[(i * t + k) * g..(i * t + k + 1) * g];
-            d_ctx_gates[i * g..(i + 1) * g].iter_mut().zip(src).for_each(|(a, b)| *a += b);
+            add_into(&mut d_ctx_gates[i * g..(i + 1) * g], src);
         }
     }
     let mut d_ctx_seq = net.gru.input_backward(&ctx_seq, &d_ctx_gates, b, 0, &mut grads);
