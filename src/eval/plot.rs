@@ -119,11 +119,31 @@ pub fn line_plot(path: &Path, title: &str, x_label: &str, y_label: &str, series:
     line_plot_in(path, title, x_label, y_label, series, y)
 }
 
-/// A line plot of curves that rise from the lower left (errors against the prediction horizon): the legend
-/// goes to the upper left, which they leave empty, instead of over their right ends.
+/// A line plot of curves that rise from the lower left and level off (errors against the prediction horizon):
+/// the legend goes to whichever corner the curves cross least, instead of over their right ends.
 pub fn rising_line_plot(path: &Path, title: &str, x_label: &str, y_label: &str, series: &[Series]) -> Result<()> {
     let y = bounds(series.iter().flat_map(|s| s.points.iter().map(|p| p.1)));
-    line_plot_legend_at(path, title, (x_label, y_label), series, y, SeriesLabelPosition::UpperLeft)
+    let x = bounds(series.iter().flat_map(|s| s.points.iter().map(|p| p.0)));
+    // The legend box covers roughly the outer 40 % of the width and 25 % of the height of its corner.
+    let inside = |(px, py): (f64, f64), right: bool, top: bool| {
+        let fx = (px - x.0) / (x.1 - x.0).max(f64::MIN_POSITIVE);
+        let fy = (py - y.0) / (y.1 - y.0).max(f64::MIN_POSITIVE);
+        (if right { fx > 0.6 } else { fx < 0.4 }) && (if top { fy > 0.75 } else { fy < 0.25 })
+    };
+    let corners = [
+        (SeriesLabelPosition::UpperLeft, false, true),
+        (SeriesLabelPosition::UpperRight, true, true),
+        (SeriesLabelPosition::LowerRight, true, false),
+    ];
+    let crossings = |right: bool, top: bool| {
+        series.iter().flat_map(|s| s.points.iter()).filter(|p| inside(**p, right, top)).count()
+    };
+    let legend = corners
+        .into_iter()
+        .min_by_key(|(_, right, top)| crossings(*right, *top))
+        .map(|(position, _, _)| position)
+        .unwrap_or(SeriesLabelPosition::UpperLeft);
+    line_plot_legend_at(path, title, (x_label, y_label), series, y, legend)
 }
 
 /// A line plot on a fixed y range: rates in percent read wrong when the axis zooms in on 95-100.
