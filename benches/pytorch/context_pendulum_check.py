@@ -24,8 +24,8 @@ action response of -0.006..0.006 (posterior std 0.8, context std 0.94), as mbrl'
 the response rises to 0.05 (1000 steps), 0.17 (1500), 0.31 (2500), 0.37 (4000). An earlier draft of this
 script (context source drawn per chunk instead of per transition) also stayed at |response| < 0.01 with
 lr 3e-3 (3000 steps), --encin delta (3500) and --encin delta --nonoise --lr 3e-3 (4000); this script with
---encin delta --nonoise --lr 3e-3 stayed at 0.000..0.015 for 12 000 steps (its sequence term fell to -138
-against the plain run's -152 at 4000: beta carries something, not the sign). The stall is the
+--encin delta --nonoise --lr 3e-3 stayed at 0.000..0.015 for 12 000 steps (its sequence log-likelihood was
+-139 against the plain run's -152 at 4000 steps: beta carries something, not the sign). The stall is the
 encoder's: random symmetric actions make the visited states independent of the torque's sign, so only the
 product of action and velocity change carries it, and at this scale the encoder does not find that feature.
 
