@@ -66,13 +66,20 @@ args = parser.parse_args()
 torch.manual_seed(args.seed)
 torch.set_num_threads(args.threads)
 
-data = np.load(args.data)
-if data["obs"].shape[1] != 3 or data["action"].shape[1] != 1:
-    raise SystemExit(f"{args.data}: expected pendulum observations [cos, sin, theta-dot] and one action")
+try:
+    data = np.load(args.data)
+    missing = [k for k in ("rollout", "obs", "next_obs", "action") if k not in data.files]
+except (OSError, ValueError) as e:
+    raise SystemExit(f"error: {args.data}: not a readable .npz ({e})")
+if missing or data["obs"].ndim != 2 or data["obs"].shape[1] != 3 or data["action"].shape[1] != 1:
+    raise SystemExit(
+        f"error: {args.data}: expected a pendulum export (arrays rollout, obs [N x 3: cos, sin, theta-dot], "
+        f"next_obs, action [N x 1]){'; missing ' + ', '.join(missing) if missing else ''}"
+    )
 rollouts = int(data["rollout"].max()) + 1
 steps_per_rollout = len(data["obs"]) // rollouts
 if rollouts % 2 or rollouts * steps_per_rollout != len(data["obs"]) or steps_per_rollout < CHUNK:
-    raise SystemExit(f"{args.data}: expected instance pairs of equal-length rollouts of >= {CHUNK} steps")
+    raise SystemExit(f"error: {args.data}: expected instance pairs of equal-length rollouts of >= {CHUNK} steps")
 OBS = np.concatenate(
     [
         data["obs"].astype(np.float32).reshape(rollouts, steps_per_rollout, 3),
