@@ -71,7 +71,7 @@ try:
     missing = [k for k in ("rollout", "obs", "next_obs", "action") if k not in data.files]
 except (OSError, ValueError) as e:
     raise SystemExit(f"error: {args.data}: not a readable .npz ({e})")
-if missing or data["obs"].ndim != 2 or data["obs"].shape[1] != 3 or data["action"].shape[1] != 1:
+if missing or data["obs"].shape[1:] != (3,) or data["action"].shape[1:] != (1,):
     raise SystemExit(
         f"error: {args.data}: expected a pendulum export (arrays rollout, obs [N x 3: cos, sin, theta-dot], "
         f"next_obs, action [N x 1]){'; missing ' + ', '.join(missing) if missing else ''}"
