@@ -645,7 +645,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__dlgpd)
-            opts="-q -h -V --model --env --evidence-rollouts --runs --steps --candidates --elites --iters --out --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --model --env --evidence-rollouts --runs --steps --candidates --elites --iters --prediction-only --out --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0

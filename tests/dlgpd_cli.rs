@@ -59,6 +59,26 @@ fn train_on_angles_then_plan_on_swapped_evidence() {
         |p: &str| read_dataset(&dir.path().join(p)).unwrap().steps.iter().map(|s| s.action[0]).collect::<Vec<_>>();
     assert_eq!(actions("plan.mcap"), actions("again.mcap"));
 
+    // The prediction check alone: no swing-ups, a reward-RMSE curve per setting over the held-out rollouts'
+    // 28 windows, and the same bytes from the same seed.
+    let check = |out: &str| {
+        let run = mbrl(dir.path())
+            .args(["eval", "dlgpd", "--model", "models/d", "--env", "pendulum:inverted", "--evidence-rollouts", "3"])
+            .args(["--prediction-only", "--no-tui", "--out", out])
+            .output()
+            .unwrap();
+        assert!(run.status.success(), "{}", stderr_of(&run));
+        assert!(stdout_of(&run).contains("reward RMSE, held-out rollouts"), "{}", stdout_of(&run));
+        std::fs::read_to_string(dir.path().join(out).join("prediction.csv")).unwrap()
+    };
+    let csv = check("check");
+    assert_eq!(csv.lines().count(), 1 + 2 * 28, "{csv}");
+    assert!(csv.lines().nth(1).unwrap().starts_with("pendulum:inverted,matching,3,0,"), "{csv}");
+    assert_eq!(csv, check("again"));
+    let report = std::fs::read_to_string(dir.path().join("check/report.md")).unwrap();
+    assert!(report.contains("## Reward prediction") && !report.contains("## Swing-ups"), "{report}");
+    assert!(!dir.path().join("check/results.csv").exists());
+
     // Planning without evidence, or an image model's evidence without frames, is a one-line error.
     let out = mbrl(dir.path()).args(["plan", "--env", "pendulum", "--model", "models/d", "-q"]).output().unwrap();
     assert_one_line_error(&out, &["DLGPD", "--evidence"]);

@@ -9,7 +9,8 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use super::plot::{line_plot, line_plot_in, Series};
+use super::dlgpd_prediction::{reward_prediction, RewardPrediction};
+use super::plot::{line_plot, line_plot_in, rising_line_plot, Series};
 use super::stats::{wilcoxon_signed_rank, Alternative};
 use crate::data::collect::{collect_random, CollectSettings};
 use crate::data::collect_frames::add_pendulum_frames;
@@ -30,6 +31,9 @@ use crate::util::table::write_csv;
 
 const EVIDENCE_STREAM: u64 = 1;
 const CONTROL_STREAM: u64 = 2;
+const HELD_OUT_STREAM: u64 = 3;
+/// Random-action rollouts per system on which the conditioned models' reward predictions are scored.
+pub const HELD_OUT_ROLLOUTS: usize = 20;
 /// Frames per evidence rollout: the authors' 30 (29 steps, 28 transitions).
 pub const EVIDENCE_STEPS: usize = 29;
 
@@ -41,6 +45,8 @@ pub struct DlgpdEvalSettings {
     pub runs: usize,
     pub steps: usize,
     pub cem: crate::planning::CemConfig,
+    /// Run the swing-ups; without them only the held-out reward prediction is scored.
+    pub swing_ups: bool,
 }
 
 fn variant_names<S: serde::Serializer>(v: &[PendulumVariant], s: S) -> std::result::Result<S::Ok, S::Error> {
@@ -109,10 +115,21 @@ pub struct EvidenceTest {
     pub p_value: f64,
 }
 
+/// Reward prediction on held-out rollouts of one system, by the model conditioned on the largest evidence
+/// set of run 0 (matching or mismatching).
+#[derive(Clone, Debug, Serialize)]
+pub struct PredictionCheck {
+    pub env: String,
+    pub evidence: &'static str,
+    pub evidence_rollouts: usize,
+    pub prediction: RewardPrediction,
+}
+
 pub struct DlgpdEvalSummary {
     pub points: Vec<Point>,
     pub outcomes: Vec<Outcome>,
     pub tests: Vec<EvidenceTest>,
+    pub predictions: Vec<PredictionCheck>,
 }
 
 fn evidence_tests(outcomes: &[Outcome]) -> Result<Vec<EvidenceTest>> {
@@ -193,9 +210,10 @@ pub fn evaluate(
             plan.push((variant.clone(), "mismatching", PendulumVariant::Standard));
         }
     }
+    let predictions = prediction_checks(trained, &plan, largest, seed, images, &monitor)?;
     let total = (plan.len() * settings.evidence_rollouts.len() * settings.runs) as u64;
     let mut outcomes = Vec::new();
-    for run in 0..settings.runs {
+    for run in (0..settings.runs).filter(|_| settings.swing_ups) {
         let pool_seed = derive_seed(seed, &[EVIDENCE_STREAM, run as u64]);
         let control_seed = derive_seed(seed, &[CONTROL_STREAM, run as u64]);
         // One pool per run and source env, shared by the settings that use it; smaller evidence sets are its
@@ -234,13 +252,50 @@ pub fn evaluate(
     }
     let points = summarize(&outcomes);
     let tests = evidence_tests(&outcomes)?;
-    write_report(trained, settings, &run_dir, &points, &outcomes, &tests)?;
+    write_report(
+        trained,
+        settings,
+        &run_dir,
+        &Findings { points: &points, outcomes: &outcomes, tests: &tests, predictions: &predictions },
+    )?;
     if images {
         let pool = evidence_rollouts(&settings.variants[0], 1, derive_seed(seed, &[EVIDENCE_STREAM, 0]), true)?;
         write_reconstructions(trained, &pool, &run_dir.file("reconstructions.png"))?;
     }
     metrics.emit(&Event::Finished { ok: true });
-    Ok(DlgpdEvalSummary { points, outcomes, tests })
+    Ok(DlgpdEvalSummary { points, outcomes, tests, predictions })
+}
+
+/// For every setting, the model conditioned on run 0's largest evidence set predicts the rewards of held-out
+/// rollouts of the system at hand (the same held-out rollouts for matching and mismatching evidence).
+fn prediction_checks(
+    trained: &TrainedDlgpd,
+    plan: &[(PendulumVariant, &'static str, PendulumVariant)],
+    largest: usize,
+    seed: u64,
+    images: bool,
+    monitor: &dyn Monitor,
+) -> Result<Vec<PredictionCheck>> {
+    let pool_seed = derive_seed(seed, &[EVIDENCE_STREAM, 0]);
+    let held_out_seed = derive_seed(seed, &[HELD_OUT_STREAM]);
+    let mut checks = Vec::with_capacity(plan.len());
+    for (index, (variant, kind, source)) in plan.iter().enumerate() {
+        if monitor.is_cancelled() {
+            return Err(Error::Cancelled);
+        }
+        let evidence = evidence_rollouts(source, largest, pool_seed, images)?;
+        let dynamics = condition_on(trained, &evidence, pool_seed)?;
+        let held_out = evidence_rollouts(variant, HELD_OUT_ROLLOUTS, held_out_seed, images)?;
+        let prediction = reward_prediction(trained, &dynamics, &held_out, held_out_seed)?;
+        checks.push(PredictionCheck {
+            env: variant.env_name(),
+            evidence: kind,
+            evidence_rollouts: largest,
+            prediction,
+        });
+        monitor.progress("reward prediction checks", index as u64 + 1, plan.len() as u64);
+    }
+    Ok(checks)
 }
 
 /// The first `count` rollouts of a dataset (its ids are 0, 1, … in order).
@@ -277,14 +332,60 @@ fn summarize(outcomes: &[Outcome]) -> Vec<Point> {
     points
 }
 
+/// What an evaluation found, for its report.
+struct Findings<'a> {
+    points: &'a [Point],
+    outcomes: &'a [Outcome],
+    tests: &'a [EvidenceTest],
+    predictions: &'a [PredictionCheck],
+}
+
 fn write_report(
     trained: &TrainedDlgpd,
     settings: &DlgpdEvalSettings,
     run_dir: &RunDir,
-    points: &[Point],
-    outcomes: &[Outcome],
-    tests: &[EvidenceTest],
+    findings: &Findings,
 ) -> Result<()> {
+    let mut md = String::new();
+    md.push_str("# DLGPD: swing-up on swapped evidence (thesis 3.5.3, Figs. 3.4/3.5)\n\n");
+    let observed = match trained.run.observation {
+        ObservationKind::Images { side } => format!("{side}×{side} rendered frames (the paper's conv VAE)"),
+        ObservationKind::Angles => {
+            "pole angles (cos θ, sin θ) with an MLP VAE: the small preset, not the paper's images".to_string()
+        }
+    };
+    md.push_str(&format!(
+        "One model trained on {} transitions of `{}` from {observed}, {} steps at batch {}. No retraining: for \
+         each setting the GPs are conditioned on encoded evidence rollouts (random actions, {} frames each) of \
+         the system at hand (**matching**) or of the standard pendulum (**mismatching**).\n\n",
+        trained.run.transitions.train,
+        trained.run.env,
+        trained.run.config.steps,
+        trained.run.config.batch_size,
+        EVIDENCE_STEPS + 1,
+    ));
+    let mut files: Vec<String> = Vec::new();
+    if settings.swing_ups {
+        write_swing_up_section(settings, run_dir, findings, &mut md)?;
+        files.push("`results.csv` (every run)".into());
+        files.extend(["summary.csv", "wilcoxon.csv", "returns.png", "success.png"].map(|f| format!("`{f}`")));
+    }
+    write_prediction_section(run_dir, findings.predictions, &mut md)?;
+    files.extend(["prediction.csv", "prediction.png"].map(|f| format!("`{f}`")));
+    if matches!(trained.run.observation, ObservationKind::Images { .. }) {
+        files.push("`reconstructions.png` (top: observed newer frames; bottom: decoded from the encoder mean)".into());
+    }
+    md.push_str(&format!("\nFiles: {}.\n", files.join(", ")));
+    std::fs::write(run_dir.file("report.md"), md).map_err(|e| Error::io(&run_dir.file("report.md"), e))
+}
+
+fn write_swing_up_section(
+    settings: &DlgpdEvalSettings,
+    run_dir: &RunDir,
+    findings: &Findings,
+    md: &mut String,
+) -> Result<()> {
+    let (points, outcomes, tests) = (findings.points, findings.outcomes, findings.tests);
     let rows: Vec<Vec<String>> = outcomes
         .iter()
         .map(|o| {
@@ -349,26 +450,10 @@ fn write_report(
         &curves(&|p| p.successes as f64 / p.runs as f64),
         (-0.05, 1.05),
     )?;
-    let mut md = String::new();
-    md.push_str("# DLGPD: swing-up on swapped evidence (thesis 3.5.3, Figs. 3.4/3.5)\n\n");
-    let observed = match trained.run.observation {
-        ObservationKind::Images { side } => format!("{side}×{side} rendered frames (the paper's conv VAE)"),
-        ObservationKind::Angles => {
-            "pole angles (cos θ, sin θ) with an MLP VAE: the small preset, not the paper's images".to_string()
-        }
-    };
     md.push_str(&format!(
-        "One model trained on {} transitions of `{}` from {observed}, {} steps at batch {}. No retraining: for \
-         each setting the GPs are conditioned on encoded evidence rollouts (random actions, {} frames each) of \
-         the system at hand (**matching**) or of the standard pendulum (**mismatching**). CEM: {} candidates, \
-         {} elites, ≤ {} iterations (stopping at first-action std ≤ 0.01), horizon {}; {} steps from the \
-         hanging position; success = each of the last 25 rewards > −1. Each point averages {} runs (run r: the \
-         same evidence seeds and start state in every setting).\n\n",
-        trained.run.transitions.train,
-        trained.run.env,
-        trained.run.config.steps,
-        trained.run.config.batch_size,
-        EVIDENCE_STEPS + 1,
+        "## Swing-ups\n\nCEM: {} candidates, {} elites, ≤ {} iterations (stopping at first-action std ≤ 0.01), \
+         horizon {}; {} steps from the hanging position; success = each of the last 25 rewards > −1. Each point \
+         averages {} runs (run r: the same evidence seeds and start state in every setting).\n\n",
         settings.cem.candidates,
         settings.cem.elites,
         settings.cem.iterations,
@@ -411,14 +496,85 @@ fn write_report(
     md.push_str(
         "\nThe thesis reports these as figures only (27 runs per point: 3 models × 3 evidence pools × 3 trials, \
          evidence of 10 to 200 rollouts, 1000 candidates); it states that DLGPD reaches 100 % success on the \
-         standard pendulum and adapts to the changed ones with few matching rollouts. Files: `results.csv` (every \
-         run), `summary.csv`, `returns.png`, `success.png`",
+         standard pendulum and adapts to the changed ones with few matching rollouts.\n",
     );
-    if matches!(trained.run.observation, ObservationKind::Images { .. }) {
-        md.push_str(", `reconstructions.png` (top: observed newer frames; bottom: decoded from the encoder mean)");
+    Ok(())
+}
+
+/// Horizons of the open-loop reward prediction that the report's table shows.
+const TABLE_HORIZONS: [usize; 5] = [0, 1, 5, 10, 20];
+
+fn write_prediction_section(run_dir: &RunDir, predictions: &[PredictionCheck], md: &mut String) -> Result<()> {
+    let name = |p: &PredictionCheck| format!("{} ({})", p.env, p.evidence);
+    let mut rows = Vec::new();
+    for p in predictions {
+        for (h, e) in p.prediction.open_loop_rmse.iter().enumerate() {
+            rows.push(vec![
+                p.env.clone(),
+                p.evidence.to_string(),
+                p.evidence_rollouts.to_string(),
+                h.to_string(),
+                format!("{e:.5}"),
+            ]);
+        }
     }
-    md.push_str(".\n");
-    std::fs::write(run_dir.file("report.md"), md).map_err(|e| Error::io(&run_dir.file("report.md"), e))
+    write_csv(
+        &run_dir.file("prediction.csv"),
+        &["env", "evidence", "evidence_rollouts", "horizon", "reward_rmse"],
+        &rows,
+    )?;
+    let mut series: Vec<Series> = predictions
+        .iter()
+        .map(|p| Series {
+            name: name(p),
+            points: p.prediction.open_loop_rmse.iter().enumerate().map(|(h, e)| (h as f64, *e)).collect(),
+        })
+        .collect();
+    // The line a model must stay under to know anything about the state: its held-out rewards' spread.
+    if let Some(p) = predictions.iter().find(|p| p.evidence == "matching") {
+        let last = p.prediction.open_loop_rmse.len().saturating_sub(1) as f64;
+        let level = p.prediction.constant_rmse;
+        series.push(Series { name: format!("best constant ({})", p.env), points: vec![(0.0, level), (last, level)] });
+    }
+    rising_line_plot(
+        &run_dir.file("prediction.png"),
+        "DLGPD open-loop reward prediction on held-out rollouts",
+        "steps after the encoded start",
+        "reward RMSE",
+        &series,
+    )?;
+    let rollouts = predictions.first().map_or(0, |p| p.prediction.rollouts);
+    md.push_str(&format!(
+        "\n## Reward prediction on held-out rollouts\n\nWhat the planner optimizes, checked against the simulator: \
+         {rollouts} random-action rollouts of each system (not in any evidence); the model conditioned on run 0's \
+         evidence ({} rollouts) encodes each rollout's first two frames (encoder mean), rolls the latent mean \
+         forward with the rollout's own actions and reads the reward GP's mean (CEM averages it over 5 latent \
+         samples instead). *Encoded*: the reward GP at the encoding of every step's own frames, no dynamics. \
+         *Constant*: the held-out rewards' own mean, the best a model that ignores the state can do. Reward RMSE \
+         (a step's reward lies in [−16.3, 0]). *Probe R²*: cos θ / sin θ / θ̇ regressed linearly on the latent \
+         means of the held-out frames; the transition GPs predict each latent dimension around its current value, \
+         so a latent that holds the velocity only nonlinearly is harder for them to roll forward.\n\n\
+         | env | evidence | encoded | {} | constant | probe R² |\n|---|---|---|{}---|---|\n",
+        predictions.first().map_or(0, |p| p.evidence_rollouts),
+        TABLE_HORIZONS.iter().map(|h| format!("h = {h}")).collect::<Vec<_>>().join(" | "),
+        "---|".repeat(TABLE_HORIZONS.len()),
+    ));
+    for p in predictions {
+        let cells: Vec<String> = TABLE_HORIZONS
+            .iter()
+            .map(|&h| p.prediction.open_loop_rmse.get(h).map_or("–".into(), |e| format!("{e:.2}")))
+            .collect();
+        let [c, s, v] = p.prediction.linear_probe_r2;
+        md.push_str(&format!(
+            "| {} | {} | {:.2} | {} | {:.2} | {c:.2} / {s:.2} / {v:.2} |\n",
+            p.env,
+            p.evidence,
+            p.prediction.encoded_rmse,
+            cells.join(" | "),
+            p.prediction.constant_rmse
+        ));
+    }
+    Ok(())
 }
 
 /// Observed frames above the model's reconstructions of them (newer frame of each pair, from the encoder mean).

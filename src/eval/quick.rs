@@ -355,6 +355,7 @@ fn dlgpd_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) -
         runs: 1,
         steps: QUICK_DLGPD_SWINGUP_STEPS,
         cem,
+        swing_ups: true,
     };
     let summary = evaluate(&trained, &settings, provenance, &dir.join("eval"), monitor)?;
     let describe = |kind: &str| {
