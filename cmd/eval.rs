@@ -484,6 +484,9 @@ struct ContextArgs {
     /// CEM candidates of the swing-up planner (thesis 1000; elites are a tenth, 10 iterations, horizon 20).
     #[arg(long, default_value_t = 1000, requires = "swingup")]
     swingup_candidates: usize,
+    /// Take a run still in training (its best-validation weights so far); the report says how far it got.
+    #[arg(long)]
+    allow_incomplete: bool,
     /// Report directory.
     #[arg(long, default_value = "reports/context")]
     out: PathBuf,
@@ -533,7 +536,11 @@ fn eval_context(global: &GlobalArgs, provenance: &Provenance, a: ContextArgs) ->
     {
         bail!("--contexts must be 2..=100000, --validation-rollouts and --validation-steps 1..=10000");
     }
-    let model = mbrl::models::context::load(&a.model, &env)?;
+    let accept = if a.allow_incomplete { mbrl::train::Accept::InProgress } else { mbrl::train::Accept::Finished };
+    let model = mbrl::models::context::load_accepting(&a.model, &env, accept)?;
+    if !model.progress.complete {
+        eprintln!("warning: {}: {}", a.model.display(), model.progress.describe());
+    }
     let summary = run_job(global, "eval context", |monitor| {
         mbrl::eval::context::evaluate(&model, &env, &settings, provenance, &a.out, monitor)
     })?;
@@ -679,6 +686,9 @@ struct DlgpdArgs {
     /// (seconds instead of an hour; tells a model that cannot see the pendulum from a planner that fails).
     #[arg(long, conflicts_with_all = ["runs", "steps", "candidates", "elites", "iters"])]
     prediction_only: bool,
+    /// Take a run still in training (its best-validation weights so far); the report says how far it got.
+    #[arg(long)]
+    allow_incomplete: bool,
     /// Report directory.
     #[arg(long, default_value = "reports/dlgpd")]
     out: PathBuf,
@@ -707,7 +717,11 @@ fn eval_dlgpd(global: &GlobalArgs, provenance: &Provenance, a: DlgpdArgs) -> any
         cem,
         swing_ups: !a.prediction_only,
     };
-    let trained = mbrl::models::dlgpd::job::load(&a.model)?;
+    let accept = if a.allow_incomplete { mbrl::train::Accept::InProgress } else { mbrl::train::Accept::Finished };
+    let trained = mbrl::models::dlgpd::job::load_accepting(&a.model, accept)?;
+    if !trained.progress.complete {
+        eprintln!("warning: {}: {}", a.model.display(), trained.progress.describe());
+    }
     let summary = run_job(global, "eval dlgpd", |monitor| evaluate(&trained, &settings, provenance, &a.out, monitor))?;
     if !summary.points.is_empty() {
         say!("env                   evidence     rollouts  mean return  successes");

@@ -525,7 +525,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__context)
-            opts="-q -h -V --model --env --contexts --validation-rollouts --validation-steps --transitions --horizon --strategy --candidates --elites --iters --beta-samples --swingup --swingup-steps --swingup-candidates --out --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --model --env --contexts --validation-rollouts --validation-steps --transitions --horizon --strategy --candidates --elites --iters --beta-samples --swingup --swingup-steps --swingup-candidates --allow-incomplete --out --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -645,7 +645,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__dlgpd)
-            opts="-q -h -V --model --env --evidence-rollouts --runs --steps --candidates --elites --iters --prediction-only --out --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --model --env --evidence-rollouts --runs --steps --candidates --elites --iters --prediction-only --allow-incomplete --out --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0

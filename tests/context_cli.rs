@@ -175,4 +175,39 @@ fn wrong_inputs_are_one_line_errors() {
         assert!(err.contains("'pets' checkpoint") && err.lines().count() == 1, "{err}");
     }
     assert!(!d.join("report").exists());
+
+    // A run still in training (here: a finished one's manifest marked unfinished) is refused unless asked for.
+    std::fs::create_dir_all(d.join("partial")).unwrap();
+    for (name, bytes) in dir_bytes(&d.join("models/toy")) {
+        let bytes = if name == "checkpoint.json" {
+            String::from_utf8(bytes).unwrap().replace("\"complete\": true", "\"complete\": false").into_bytes()
+        } else {
+            bytes
+        };
+        std::fs::write(d.join("partial").join(name), bytes).unwrap();
+    }
+    let eval = |extra: &[&str]| {
+        mbrl(d)
+            .args(["eval", "context", "--model", "partial", "--env", "toy:inner", "--contexts", "2"])
+            .args([
+                "--validation-rollouts",
+                "2",
+                "--validation-steps",
+                "5",
+                "--transitions",
+                "1",
+                "--strategy",
+                "random",
+            ])
+            .args(["--out", "partial-report", "--no-tui", "-q"])
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    assert_one_line_error(&eval(&[]), &["partial", "training stopped at step 10 of 10"]);
+    assert!(!d.join("partial-report").exists());
+    let out = eval(&["--allow-incomplete"]);
+    assert!(out.status.success(), "{}", stderr_of(&out));
+    let report = std::fs::read_to_string(d.join("partial-report/report.md")).unwrap();
+    assert!(report.contains("10 of 10 steps (training still in progress)"), "{report}");
 }

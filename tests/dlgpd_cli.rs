@@ -112,6 +112,23 @@ fn resume_ends_with_the_bytes_of_an_uninterrupted_run() {
     let stop = StopAfter::new(25);
     let err = dlgpd::train(&request("stopped"), false, &stop).err().unwrap();
     assert!(matches!(err, mbrl::Error::Cancelled), "{err}");
+
+    // A run still in training is refused, unless asked for; its report then says how far it got.
+    let eval = |extra: &[&str]| {
+        mbrl(dir.path())
+            .args(["eval", "dlgpd", "--model", "stopped", "--env", "pendulum", "--evidence-rollouts", "2"])
+            .args(["--prediction-only", "-q", "--out", "partial"])
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    assert_one_line_error(&eval(&[]), &["stopped", "training stopped at step 20 of 30"]);
+    assert!(!dir.path().join("partial").exists());
+    let out = eval(&["--allow-incomplete"]);
+    assert!(out.status.success(), "{}", stderr_of(&out));
+    let report = std::fs::read_to_string(dir.path().join("partial/report.md")).unwrap();
+    assert!(report.contains("20 of 30 steps (training still in progress)"), "{report}");
+
     let out = mbrl(dir.path()).args(["train", "--resume", "stopped", "--no-tui"]).output().unwrap();
     assert!(out.status.success(), "{}", stderr_of(&out));
     // The CLI adds its loss report after training; the library run writes none.

@@ -355,12 +355,12 @@ fn write_report(
         }
     };
     md.push_str(&format!(
-        "One model trained on {} transitions of `{}` from {observed}, {} steps at batch {}. No retraining: for \
+        "One model trained on {} transitions of `{}` from {observed}, {} at batch {}. No retraining: for \
          each setting the GPs are conditioned on encoded evidence rollouts (random actions, {} frames each) of \
          the system at hand (**matching**) or of the standard pendulum (**mismatching**).\n\n",
         trained.run.transitions.train,
         trained.run.env,
-        trained.run.config.steps,
+        trained.progress.describe(),
         trained.run.config.batch_size,
         EVIDENCE_STEPS + 1,
     ));

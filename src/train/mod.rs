@@ -20,6 +20,33 @@ use std::path::Path;
 use crate::error::{Error, Result};
 
 /// An opened checkpoint with its config, verified against the manifest.
+/// Which checkpoints a loader takes: finished runs only, or also a run still in training (its best-validation
+/// weights so far), for looking at a long run while it goes on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Accept {
+    Finished,
+    InProgress,
+}
+
+/// How far the training of a loaded model went, for reports that must not pass a run in progress off as done.
+#[derive(Clone, Copy, Debug, serde::Serialize)]
+pub struct TrainingProgress {
+    pub step: u64,
+    pub total_steps: u64,
+    pub complete: bool,
+}
+
+impl TrainingProgress {
+    /// "3000 steps", or "11200 of 30000 steps (training still in progress)".
+    pub fn describe(&self) -> String {
+        if self.complete {
+            format!("{} steps", self.total_steps)
+        } else {
+            format!("{} of {} steps (training still in progress)", self.step, self.total_steps)
+        }
+    }
+}
+
 pub struct OpenedCheckpoint {
     pub dir: CheckpointDir,
     pub manifest: Manifest,
@@ -56,6 +83,11 @@ impl OpenedCheckpoint {
 
     /// Refuses checkpoints of another method, and models still in training.
     pub fn expect_finished(&self, method: &str) -> Result<()> {
+        self.expect(method, Accept::Finished)
+    }
+
+    /// Refuses checkpoints of another method, and, unless `accept` takes them, models still in training.
+    pub fn expect(&self, method: &str, accept: Accept) -> Result<()> {
         let path = self.dir.path();
         if self.manifest.method != method {
             return Err(Error::bad_file(
@@ -63,7 +95,7 @@ impl OpenedCheckpoint {
                 format!("is a '{}' checkpoint; expected '{method}'", self.manifest.method),
             ));
         }
-        if !self.manifest.complete {
+        if !self.manifest.complete && accept == Accept::Finished {
             return Err(Error::bad_file(
                 path,
                 format!(
@@ -75,6 +107,14 @@ impl OpenedCheckpoint {
             ));
         }
         Ok(())
+    }
+
+    pub fn progress(&self) -> TrainingProgress {
+        TrainingProgress {
+            step: self.manifest.step,
+            total_steps: self.manifest.total_steps,
+            complete: self.manifest.complete,
+        }
     }
 
     /// The verified bytes of a listed file; `None` when the checkpoint does not list it.

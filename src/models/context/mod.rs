@@ -27,7 +27,8 @@ use crate::run::dir::Provenance;
 use crate::run::Monitor;
 use crate::train::tensors::to_params;
 use crate::train::{
-    loss_panel, run_training, training_view, DataFile, FitOutcome, FitSettings, OpenedCheckpoint, MODEL_FILE,
+    loss_panel, run_training, training_view, Accept, DataFile, FitOutcome, FitSettings, OpenedCheckpoint,
+    TrainingProgress, MODEL_FILE,
 };
 use data::{ContextData, Episode, InstancePair};
 
@@ -331,6 +332,7 @@ pub struct LoadedModel {
     pub run: ContextRun,
     pub fast: FastContextModel,
     pub dir: PathBuf,
+    pub progress: TrainingProgress,
 }
 
 impl LoadedModel {
@@ -368,6 +370,16 @@ pub fn load(dir: &Path, env: &EnvName) -> Result<LoadedModel> {
 
 /// Loads a finished checkpoint of this module's network made by `method` (`context` or `tradyn`).
 pub fn load_method(dir: &Path, env: &EnvName, method: &str) -> Result<LoadedModel> {
+    load_method_accepting(dir, env, method, Accept::Finished)
+}
+
+/// A context model of `env`, finished or (with [`Accept::InProgress`]) still training: then its
+/// best-validation weights so far.
+pub fn load_accepting(dir: &Path, env: &EnvName, accept: Accept) -> Result<LoadedModel> {
+    load_method_accepting(dir, env, METHOD, accept)
+}
+
+fn load_method_accepting(dir: &Path, env: &EnvName, method: &str, accept: Accept) -> Result<LoadedModel> {
     let opened = OpenedCheckpoint::open(dir)?;
     if opened.manifest.method != method {
         return Err(Error::bad_file(
@@ -378,7 +390,7 @@ pub fn load_method(dir: &Path, env: &EnvName, method: &str) -> Result<LoadedMode
             ),
         ));
     }
-    opened.expect_finished(method)?;
+    opened.expect(method, accept)?;
     let run = read_run(&opened)?;
     if run.env != env.canonical() {
         return Err(Error::bad_file(dir, format!("is a model of '{}', not of '{}'", run.env, env.canonical())));
@@ -392,7 +404,7 @@ pub fn load_method(dir: &Path, env: &EnvName, method: &str) -> Result<LoadedMode
     let layout = crate::nn::ParamSet::<f32>::from_module(&layout_net, net::param_name);
     let params = to_params(&model_path, &opened.tensors(MODEL_FILE)?, &layout)?;
     let fast = FastContextModel::from_params(&params).map_err(|e| Error::bad_file(&model_path, e.to_string()))?;
-    Ok(LoadedModel { run, fast, dir: dir.to_path_buf() })
+    Ok(LoadedModel { run, fast, dir: dir.to_path_buf(), progress: opened.progress() })
 }
 
 #[cfg(test)]

@@ -21,7 +21,8 @@ use crate::run::dir::Provenance;
 use crate::run::Monitor;
 use crate::train::tensors::TensorData;
 use crate::train::{
-    loss_panel, run_training, training_view, DataFile, FitOutcome, FitSettings, OpenedCheckpoint, MODEL_FILE,
+    loss_panel, run_training, training_view, Accept, DataFile, FitOutcome, FitSettings, OpenedCheckpoint,
+    TrainingProgress, MODEL_FILE,
 };
 use crate::util::seeding::rng_for;
 
@@ -174,11 +175,19 @@ pub struct TrainedDlgpd {
     pub transition: Vec<GpHypers>,
     pub reward: GpHypers,
     pub scale: LatentScale,
+    pub progress: TrainingProgress,
 }
 
+/// A finished DLGPD run.
 pub fn load(dir: &Path) -> Result<TrainedDlgpd> {
+    load_accepting(dir, Accept::Finished)
+}
+
+/// A DLGPD run, finished or (with [`Accept::InProgress`]) still training: then its best-validation weights
+/// so far.
+pub fn load_accepting(dir: &Path, accept: Accept) -> Result<TrainedDlgpd> {
     let opened = OpenedCheckpoint::open(dir)?;
-    opened.expect_finished(METHOD)?;
+    opened.expect(METHOD, accept)?;
     let run = read_run(&opened)?;
     let stored = opened.tensors(MODEL_FILE)?;
     let path = opened.dir.file(MODEL_FILE);
@@ -208,5 +217,5 @@ pub fn load(dir: &Path) -> Result<TrainedDlgpd> {
     if scale.std.iter().any(|s| *s <= 0.0) {
         return Err(bad(format!("'{SCALE_STD}' must be positive, got {:?}", scale.std)));
     }
-    Ok(TrainedDlgpd { run, vae, transition, reward, scale })
+    Ok(TrainedDlgpd { run, vae, transition, reward, scale, progress: opened.progress() })
 }
