@@ -28,10 +28,13 @@ lr 3e-3 (3000 steps), --encin delta (3500) and --encin delta --nonoise --lr 3e-3
 -139 against the plain run's -152 at 4000 steps: beta carries something, not the sign). The stall is the
 encoder's: random symmetric actions make the visited states independent of the torque's sign, so only the
 product of action and velocity change carries it, and at this scale the encoder does not find that feature.
+Nor is the thesis' wider gain range to blame: with the gains the authors' sampler drew (`--simulate 1.25`,
+|alpha| ~ U[1.25, 2], 10 000 simulated pairs, seed 0) the response stayed at -0.004..0.003 for 6000 steps.
 
 Usage: mbrl collect --env pendulum:quadrant --instances 10000 --steps 100 --out pq.mcap
        mbrl export --input pq.mcap --out pq.npz
        python3 benches/pytorch/context_pendulum_check.py --data pq.npz [--oracle] [--steps 4000]
+       python3 benches/pytorch/context_pendulum_check.py --simulate 1.25 --steps 6000
 """
 
 import argparse
@@ -46,7 +49,15 @@ import torch.nn.functional as F
 DT, REPEAT, CHUNK = 0.05, 2, 50
 
 parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-parser.add_argument("--data", required=True, help=".npz from `mbrl export` of a pendulum:quadrant context dataset")
+source = parser.add_mutually_exclusive_group(required=True)
+source.add_argument("--data", help=".npz from `mbrl export` of a pendulum:quadrant context dataset")
+source.add_argument(
+    "--simulate",
+    type=float,
+    metavar="LO",
+    help="instead of --data, simulate 10 000 instance pairs here with quadrant gains |alpha| ~ U[LO, 2] "
+    "(0.5: the thesis' range, as mbrl collects; 1.25: what the authors' sampler drew)",
+)
 parser.add_argument("--units", type=int, default=64)
 parser.add_argument("--batch", type=int, default=64)
 parser.add_argument("--steps", type=int, default=4000)
@@ -66,16 +77,63 @@ args = parser.parse_args()
 torch.manual_seed(args.seed)
 torch.set_num_threads(args.threads)
 
-try:
-    data = np.load(args.data)
-    missing = [k for k in ("rollout", "obs", "next_obs", "action") if k not in data.files]
-except (OSError, ValueError) as e:
-    raise SystemExit(f"error: {args.data}: not a readable .npz ({e})")
-if missing or data["obs"].shape[1:] != (3,) or data["action"].shape[1:] != (1,):
-    raise SystemExit(
-        f"error: {args.data}: expected a pendulum export (arrays rollout, obs [N x 3: cos, sin, theta-dot], "
-        f"next_obs, action [N x 1]){'; missing ' + ', '.join(missing) if missing else ''}"
-    )
+
+
+def simulate_pairs(low, instances=10_000, steps=100, seed=0):
+    """Instance pairs as `mbrl collect --env pendulum:quadrant` makes them (uniform start, uniform actions in
+    [-2, 2], action repeat 2, torque clipped then scaled by the quadrant's gain), in the layout of its export."""
+    rng = np.random.default_rng(seed)
+    gains = rng.uniform(low, 2.0, (instances, 4)) * rng.choice([-1.0, 1.0], (instances, 4))
+    per_rollout = np.repeat(gains, 2, 0)
+    rows = np.arange(2 * instances)
+    theta = rng.uniform(-np.pi, np.pi, 2 * instances)
+    theta_dot = rng.uniform(-8.0, 8.0, 2 * instances)
+    obs, actions = [], []
+    for _ in range(steps):
+        u = rng.uniform(-2.0, 2.0, 2 * instances)
+        obs.append(np.stack([np.cos(theta), np.sin(theta), theta_dot], 1))
+        actions.append(u)
+        for _ in range(REPEAT):
+            wrapped = (theta + np.pi) % (2 * np.pi) - np.pi
+            torque = u * per_rollout[rows, quadrant(wrapped)]
+            new_theta_dot = theta_dot + (15.0 * np.sin(theta) + 3.0 * torque) * DT
+            theta = theta + new_theta_dot * DT
+            theta_dot = np.clip(new_theta_dot, -8.0, 8.0)
+    last = np.stack([np.cos(theta), np.sin(theta), theta_dot], 1)
+    obs = np.stack(obs, 1)
+    next_obs = np.concatenate([obs[:, 1:], last[:, None]], 1)
+    return {
+        "rollout": np.repeat(rows, steps),
+        "obs": obs.reshape(-1, 3),
+        "next_obs": next_obs.reshape(-1, 3),
+        "action": np.stack(actions, 1).reshape(-1, 1),
+    }
+
+
+def quadrant(theta):
+    return np.where(theta >= np.pi / 2, 0, np.where(theta >= 0, 1, np.where(theta >= -np.pi / 2, 2, 3)))
+
+
+def load_export(path):
+    try:
+        data = np.load(path)
+        missing = [k for k in ("rollout", "obs", "next_obs", "action") if k not in data.files]
+    except (OSError, ValueError) as e:
+        raise SystemExit(f"error: {path}: not a readable .npz ({e})")
+    if missing or data["obs"].shape[1:] != (3,) or data["action"].shape[1:] != (1,):
+        raise SystemExit(
+            f"error: {path}: expected a pendulum export (arrays rollout, obs [N x 3: cos, sin, theta-dot], "
+            f"next_obs, action [N x 1]){'; missing ' + ', '.join(missing) if missing else ''}"
+        )
+    return data
+
+
+if args.simulate is not None:
+    if not 0.0 <= args.simulate <= 2.0:
+        raise SystemExit(f"error: --simulate {args.simulate}: the lowest gain must lie in [0, 2]")
+    data = simulate_pairs(args.simulate, seed=args.seed)
+else:
+    data = load_export(args.data)
 rollouts = int(data["rollout"].max()) + 1
 steps_per_rollout = len(data["obs"]) // rollouts
 if rollouts % 2 or rollouts * steps_per_rollout != len(data["obs"]) or steps_per_rollout < CHUNK:
@@ -90,10 +148,6 @@ OBS = np.concatenate(
 ACT = data["action"].astype(np.float32).reshape(rollouts, steps_per_rollout, 1)
 instances = rollouts // 2
 train_instances = int(instances * 0.9)
-
-
-def quadrant(theta):
-    return np.where(theta >= np.pi / 2, 0, np.where(theta >= 0, 1, np.where(theta >= -np.pi / 2, 2, 3)))
 
 
 def estimated_gains():
