@@ -22,7 +22,7 @@ use crate::error::{Error, Result};
 use crate::models::dlgpd::control::{condition_on, swing_up, ControlSettings};
 use crate::models::dlgpd::data::{ObservationKind, Windows};
 use crate::models::dlgpd::job::TrainedDlgpd;
-use crate::models::dlgpd::train::encode_rows;
+use crate::models::dlgpd::vae::encode_rows;
 use crate::nn::tensor::{inference_device, tensor};
 use crate::run::dir::{Provenance, RunDir};
 use crate::run::{Event, Monitor, NullMonitor, Tee};

@@ -1,7 +1,7 @@
-//! How well a conditioned DLGPD model predicts the rewards a planner optimizes, on held-out rollouts: the
-//! check that separates a model that cannot see the pendulum from a planner that cannot find the swing-up.
-//! Open loop as CEM uses it: encode the first two observations (encoder mean), roll the latent mean forward
-//! with the rollout's own actions through the transition GPs, and read the reward GP's mean at every step.
+//! How well a conditioned DLGPD model predicts the rewards a planner optimizes, on held-out rollouts of a
+//! setting (open loop, as `models::dlgpd::prediction` computes it), and how linearly its latent holds the
+//! pendulum's state: the check that separates a model that cannot see the pendulum from a planner that
+//! cannot find the swing-up.
 
 use serde::Serialize;
 
@@ -11,9 +11,9 @@ use crate::data::{Dataset, Rollout};
 use crate::error::{Error, Result};
 use crate::models::dlgpd::data::Windows;
 use crate::models::dlgpd::dynamics::LatentDynamics;
+use crate::models::dlgpd::evidence::encoded_means;
 use crate::models::dlgpd::job::TrainedDlgpd;
-use crate::models::dlgpd::train::encode_rows;
-use crate::nn::tensor::inference_device;
+use crate::models::dlgpd::prediction::reward_errors;
 
 /// Reward prediction errors of one conditioned model on held-out rollouts of one system.
 #[derive(Clone, Debug, Serialize)]
@@ -39,47 +39,17 @@ pub fn reward_prediction(
     seed: u64,
 ) -> Result<RewardPrediction> {
     let windows = Windows::from_dataset(held_out, trained.run.observation, seed)?;
-    let all: Vec<usize> = (0..windows.len()).collect();
-    let (obs, _) = windows.observations(&all);
-    let (actions, rewards) = windows.actions_and_rewards(&all);
-    let action_dim = windows.action_dim;
-    let width = trained.run.observation.input_len();
-    let dims = trained.run.config.latent_dim;
-    let latents: Vec<f64> =
-        encode_rows(&trained.vae, &obs, width, &inference_device()).0.into_iter().map(f64::from).collect();
-    if latents.iter().any(|v| !v.is_finite()) {
-        return Err(Error::Diverged("the encoder gave non-finite latents for the held-out rollouts".into()));
-    }
-    let linear_probe_r2 = linear_probe(&latents, dims, &window_states(held_out, &windows)?)?;
-    let encoded = dynamics.reward_mean(&latents, &actions)?;
-    let encoded_rmse = rmse(encoded.iter().zip(&rewards).map(|(p, r)| p - r));
-    let mean_reward = rewards.iter().sum::<f64>() / rewards.len() as f64;
-    let constant_rmse = rmse(rewards.iter().map(|r| r - mean_reward));
-
-    // Each rollout's windows in time order; the open loop runs over the shortest one.
-    let mut starts: Vec<usize> = Vec::new();
-    for row in 0..windows.len() {
-        if row == 0 || windows.rollout[row] != windows.rollout[row - 1] {
-            starts.push(row);
-        }
-    }
-    let ends: Vec<usize> = starts.iter().skip(1).copied().chain(std::iter::once(windows.len())).collect();
-    let horizon = starts.iter().zip(&ends).map(|(s, e)| e - s).min().unwrap_or(0);
-    let mut state: Vec<f64> = starts.iter().flat_map(|&s| latents[s * dims..(s + 1) * dims].to_vec()).collect();
-    let mut open_loop_rmse = Vec::with_capacity(horizon);
-    for h in 0..horizon {
-        let step_actions: Vec<f64> =
-            starts.iter().flat_map(|&s| actions[(s + h) * action_dim..(s + h + 1) * action_dim].to_vec()).collect();
-        let predicted = dynamics.reward_mean(&state, &step_actions)?;
-        open_loop_rmse.push(rmse(predicted.iter().zip(&starts).map(|(p, &s)| p - rewards[s + h])));
-        if h + 1 < horizon {
-            state = dynamics.step(&state, &step_actions)?.0;
-        }
-    }
-    if open_loop_rmse.iter().any(|v| !v.is_finite()) {
-        return Err(Error::Diverged("the open-loop latent rollout of the held-out rollouts went non-finite".into()));
-    }
-    Ok(RewardPrediction { open_loop_rmse, encoded_rmse, constant_rmse, linear_probe_r2, rollouts: starts.len() })
+    let rows: Vec<usize> = (0..windows.len()).collect();
+    let latents = encoded_means(&trained.vae, &windows, &rows)?;
+    let linear_probe_r2 = linear_probe(&latents, dynamics.latent_dim(), &window_states(held_out, &windows)?)?;
+    let errors = reward_errors(dynamics, &windows, &rows, &latents)?;
+    Ok(RewardPrediction {
+        open_loop_rmse: errors.open_loop_rmse,
+        encoded_rmse: errors.encoded_rmse,
+        constant_rmse: errors.constant_rmse,
+        linear_probe_r2,
+        rollouts: errors.rollouts,
+    })
 }
 
 /// The simulator state (θ, θ̇) of each window's newer observation, in window order.
@@ -113,11 +83,6 @@ fn linear_probe(latents: &[f64], dims: usize, states: &[[f64; 2]]) -> Result<[f6
         *out = if total > 0.0 { 1.0 - residual.norm_squared() / total } else { f64::NAN };
     }
     Ok(r2)
-}
-
-fn rmse(errors: impl Iterator<Item = f64>) -> f64 {
-    let (sum, count) = errors.fold((0.0, 0usize), |(s, n), e| (s + e * e, n + 1));
-    (sum / count.max(1) as f64).sqrt()
 }
 
 #[cfg(test)]

@@ -36,6 +36,11 @@ pub trait TrainingMethod {
     fn budget(&self) -> Option<Budget> {
         None
     }
+    /// Figures of the validation just run beyond its loss, logged and charted under these names (non-finite
+    /// ones are left out).
+    fn validation_scalars(&mut self) -> Result<Vec<(&'static str, f64)>> {
+        Ok(Vec::new())
+    }
     /// Figures of the step just taken beyond its loss, charted and logged under these names.
     fn step_scalars(&self) -> Vec<(&'static str, f64)> {
         Vec::new()
@@ -137,6 +142,11 @@ pub fn fit(
                     return Err(diverged(settings, step, "validation", valid, last_checkpoint));
                 }
                 monitor.scalar("valid/loss", step, valid);
+                for (name, value) in method.validation_scalars()? {
+                    if value.is_finite() {
+                        monitor.scalar(name, step, value);
+                    }
+                }
                 if best.loss.is_none_or(|b| valid < b) {
                     best = Best { step: Some(step), loss: Some(valid), weights: method.weights() };
                 }

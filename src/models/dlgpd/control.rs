@@ -11,9 +11,10 @@ use rand_distr::StandardNormal;
 use rayon::prelude::*;
 
 use super::data::{angle_observation, frame_planes, ObservationKind, Windows, OBSERVATION_NOISE_STD};
-use super::dynamics::{Evidence, LatentDynamics};
+use super::dynamics::LatentDynamics;
+use super::evidence::condition_on_rows;
 use super::job::TrainedDlgpd;
-use super::train::encode_rows;
+use super::vae::encode_rows;
 use crate::data::{Dataset, Rollout};
 use crate::envs::pendulum::render::PendulumRenderer;
 use crate::envs::pendulum::{Pendulum, PendulumVariant, StartDistribution};
@@ -41,22 +42,14 @@ const OBJECTIVE_STREAM: u64 = 4;
 /// observations; the observation noise is drawn from `seed` as at training).
 pub fn condition_on(trained: &TrainedDlgpd, data: &Dataset, seed: u64) -> Result<LatentDynamics> {
     let windows = Windows::from_dataset(data, trained.run.observation, seed)?;
-    let rows: Vec<usize> = (0..windows.len()).collect();
-    let (obs, next) = windows.observations(&rows);
-    let (actions, rewards) = windows.actions_and_rewards(&rows);
     if windows.action_dim != trained.run.action_dim {
         return Err(Error::data(format!(
             "evidence actions have {} dimensions; the model was trained with {}",
             windows.action_dim, trained.run.action_dim
         )));
     }
-    let width = trained.run.observation.input_len();
-    let device = inference_device();
-    let widen = |v: Vec<f32>| v.into_iter().map(f64::from).collect::<Vec<f64>>();
-    let latents = widen(encode_rows(&trained.vae, &obs, width, &device).0);
-    let next_latents = widen(encode_rows(&trained.vae, &next, width, &device).0);
-    let evidence = Evidence { latents: &latents, actions: &actions, next_latents: &next_latents, rewards: &rewards };
-    LatentDynamics::condition(&trained.transition, &trained.reward, trained.scale.clone(), &evidence)
+    let rows: Vec<usize> = (0..windows.len()).collect();
+    condition_on_rows(&trained.vae, (&trained.transition, &trained.reward), trained.scale.clone(), &windows, &rows)
 }
 
 /// Noisy observations of the pendulum as the model saw them in training: a rendered frame or the angle, with

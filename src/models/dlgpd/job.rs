@@ -126,7 +126,18 @@ pub fn train(request: &TrainRequest, resume: bool, monitor: &dyn Monitor) -> Res
     let c = &request.config;
     let view = training_view(
         &format!("train DLGPD on {}", run.env),
-        vec![loss_panel("loss: −ELBO (train, held-out)", true)],
+        vec![
+            loss_panel("loss: −ELBO (train, held-out)", true),
+            crate::run::PanelSpec {
+                title: "reward RMSE on held-out rollouts (open loop 5, 10 steps; constant)".into(),
+                x_label: "step".into(),
+                series: ["valid/reward_rmse_h5", "valid/reward_rmse_h10", "valid/reward_rmse_constant"]
+                    .map(String::from)
+                    .to_vec(),
+                restart_on_rewind: false,
+                path: None,
+            },
+        ],
         &[
             ("observations", observed),
             ("transitions", format!("{} train / {} valid", run.transitions.train, run.transitions.valid)),

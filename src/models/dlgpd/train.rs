@@ -11,15 +11,18 @@ use rand_distr::StandardNormal;
 
 use super::config::DlgpdConfig;
 use super::data::Windows;
+use super::evidence::{condition_on_rows, encoded_means};
 use super::latent_gp::LatentScale;
 use super::model::{
     init_hypers, loss_and_gradients, raw_gradient, raw_vector, sample_noise, set_raw_vector, Batch, Gradients, StepLoss,
 };
+use super::prediction::reward_errors;
+use super::vae::encode_rows;
 use super::vae::VaeNet;
 use crate::error::{Error, Result};
 use crate::models::gp::{GpHypers, HyperInit};
 use crate::nn::params::NamedTensor;
-use crate::nn::tensor::{tensor, training_device, values};
+use crate::nn::tensor::training_device;
 use crate::nn::{Adam, AdamConfig, ParamSet};
 use crate::train::tensors::TensorData;
 use crate::train::{state, StoredTensor, TrainingMethod};
@@ -31,8 +34,6 @@ const VALID_STREAM: u64 = 3;
 const SCALE_STREAM: u64 = 4;
 /// Training transitions the frozen standardization is measured on (the authors' one batch of 1024).
 pub const SCALE_ROWS: usize = 1024;
-/// Rows encoded at once outside training, bounding the memory of a conv forward pass.
-const ENCODE_CHUNK: usize = 256;
 
 pub const SCALE_MEAN: &str = "latent_scale.mean";
 pub const SCALE_STD: &str = "latent_scale.std";
@@ -104,16 +105,25 @@ pub fn gps_from_stored(
     Ok((transition, reward))
 }
 
-/// Encoder means and stds of observation rows, in chunks.
-pub fn encode_rows(vae: &VaeNet, obs: &[f32], width: usize, device: &Device) -> (Vec<f32>, Vec<f32>) {
-    let (mut means, mut stds) = (Vec::new(), Vec::new());
-    for chunk in obs.chunks(ENCODE_CHUNK * width) {
-        let rows = chunk.len() / width;
-        let (m, s) = vae.encode(tensor(chunk.to_vec(), [rows, width], device));
-        means.extend(values(&m));
-        stds.extend(values(&s));
-    }
-    (means, stds)
+/// Rollouts on each side of the validation's reward-prediction check (evidence from training rollouts,
+/// scored on held-out ones): 20, the evidence size of the thesis' planning runs.
+const CHECK_ROLLOUTS: usize = 20;
+
+/// The rows of the first `count` rollouts among `rows` (rows of a rollout are consecutive, in time order).
+fn leading_rollouts(windows: &Windows, rows: &[usize], count: usize) -> Vec<usize> {
+    let mut seen = 0;
+    let mut last = None;
+    rows.iter()
+        .copied()
+        .take_while(|&r| {
+            let id = windows.rollout[r];
+            if last != Some(id) {
+                seen += 1;
+                last = Some(id);
+            }
+            seen <= count
+        })
+        .collect()
 }
 
 pub struct DlgpdTrainer {
@@ -266,6 +276,30 @@ impl TrainingMethod for DlgpdTrainer {
         Ok(Some(loss.total))
     }
 
+    /// The planner's view of the model: the GPs as trained, conditioned on the first training rollouts
+    /// (encoder means, frozen standardization, as `plan` conditions them), predict the rewards of the first
+    /// held-out rollouts open loop. A falling loss with a flat prediction error means a latent that the GPs
+    /// cannot roll forward.
+    fn validation_scalars(&mut self) -> Result<Vec<(&'static str, f64)>> {
+        let evidence_rows = leading_rollouts(&self.windows, &self.train_rows, CHECK_ROLLOUTS);
+        let scored_rows = leading_rollouts(&self.windows, &self.valid_rows, CHECK_ROLLOUTS);
+        let Some(gps) = self.gps.as_ref().filter(|_| !evidence_rows.is_empty() && !scored_rows.is_empty()) else {
+            return Ok(Vec::new());
+        };
+        let scale = self.frozen_scale()?;
+        let vae = self.vae.as_ref().expect("present between steps");
+        let dynamics = condition_on_rows(vae, (&gps.transition, &gps.reward), scale, &self.windows, &evidence_rows)?;
+        let latents = encoded_means(vae, &self.windows, &scored_rows)?;
+        let errors = reward_errors(&dynamics, &self.windows, &scored_rows, &latents)?;
+        let at = |h: usize| errors.open_loop_rmse.get(h).copied().unwrap_or(f64::NAN);
+        Ok(vec![
+            ("valid/reward_rmse_encoded", errors.encoded_rmse),
+            ("valid/reward_rmse_h5", at(5)),
+            ("valid/reward_rmse_h10", at(10)),
+            ("valid/reward_rmse_constant", errors.constant_rmse),
+        ])
+    }
+
     fn weights(&self) -> Vec<StoredTensor> {
         let mut out = state::weights(&self.params);
         if let Some(gps) = &self.gps {
@@ -392,6 +426,33 @@ mod tests {
             assert_eq!(a.step(step).unwrap(), b.step(step).unwrap(), "step {step}");
         }
         assert_eq!(a.weights(), b.weights());
+    }
+
+    #[test]
+    fn validation_scores_the_planners_view_once_there_are_gps() {
+        let mut t = trainer(&config());
+        assert!(t.validation_scalars().unwrap().is_empty(), "no GPs before the first step");
+        for step in 1..=150 {
+            t.step(step).unwrap();
+        }
+        let scalars = t.validation_scalars().unwrap();
+        let names: Vec<&str> = scalars.iter().map(|(n, _)| *n).collect();
+        assert_eq!(
+            names,
+            [
+                "valid/reward_rmse_encoded",
+                "valid/reward_rmse_h5",
+                "valid/reward_rmse_h10",
+                "valid/reward_rmse_constant"
+            ]
+        );
+        // Two held-out rollouts of 10 steps have 9 windows each: open-loop errors up to h = 8 only, so no
+        // 10-step figure (the training loop leaves non-finite figures out of the log).
+        assert!(scalars[3].1 > 0.0 && scalars[..2].iter().all(|(_, v)| v.is_finite() && *v >= 0.0), "{scalars:?}");
+        assert!(scalars[2].1.is_nan(), "{scalars:?}");
+        let t2 = trainer(&config());
+        assert_eq!(leading_rollouts(&t2.windows, &t2.valid_rows, 1).len(), 9);
+        assert_eq!(leading_rollouts(&t2.windows, &t2.valid_rows, 20), t2.valid_rows);
     }
 
     #[test]

@@ -13,6 +13,7 @@ use super::data::ObservationKind;
 use super::loss::reconstruction_bce;
 use crate::error::{Error, Result};
 use crate::nn::conv::{Conv2d, Conv2dConfig, ConvTranspose2d};
+use crate::nn::tensor::tensor;
 use crate::nn::tensor::values;
 use crate::nn::{Linear, LinearConfig, ParamSet};
 
@@ -246,6 +247,21 @@ impl VaeNet {
             VaeNet::Angles(vae) => VaeNet::Angles(params.load_into(vae, device)?),
         })
     }
+}
+
+/// Rows encoded at once outside training, bounding the memory of a conv forward pass.
+const ENCODE_CHUNK: usize = 256;
+
+/// Encoder means and stds of observation rows, in chunks.
+pub fn encode_rows(vae: &VaeNet, obs: &[f32], width: usize, device: &Device) -> (Vec<f32>, Vec<f32>) {
+    let (mut means, mut stds) = (Vec::new(), Vec::new());
+    for chunk in obs.chunks(ENCODE_CHUNK * width) {
+        let rows = chunk.len() / width;
+        let (m, s) = vae.encode(tensor(chunk.to_vec(), [rows, width], device));
+        means.extend(values(&m));
+        stds.extend(values(&s));
+    }
+    (means, stds)
 }
 
 #[cfg(test)]
