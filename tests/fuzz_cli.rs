@@ -24,10 +24,10 @@
 //!
 //! ```sh
 //! cargo test --release --test fuzz_cli -- --nocapture                            # the CI slice
-//! MBRL_FUZZ_MUTANTS=300 cargo test --release --test fuzz_cli fuzz_every -- --nocapture   # 10 500 mutants
+//! MBRL_FUZZ_MUTANTS=300 cargo test --release --test fuzz_cli fuzz_every -- --nocapture   # 13 200 mutants
 //! ```
 //!
-//! Environment: `MBRL_FUZZ_MUTANTS` (mutants per target, default 100: 3500 runs, about 30 s on two cores),
+//! Environment: `MBRL_FUZZ_MUTANTS` (mutants per target, default 100: 4400 runs, about 40 s on two cores),
 //! `MBRL_FUZZ_SEED` (another family of mutants, default 0), `MBRL_FUZZ_TARGETS` (comma-separated substrings of
 //! target names), `MBRL_FUZZ_JOBS` (parallel runs, default one per core), `MBRL_FUZZ_BIN` (fuzz another `mbrl`
 //! binary), `MBRL_FUZZ_VERBOSE` (set: print every run's outcome and first stderr line).
@@ -286,6 +286,18 @@ fn targets() -> Vec<Target> {
             concat!("plan --env pendulum --model {in} --evidence roll.mcap --out {out}", cheap_plan!()),
         ),
         target("dlgpd-resume", Input::Checkpoint { dir: "dlgpd-resume", files: RESUME_FILES }, "train --resume {in}"),
+        // A run still in training, looked at with `--allow-incomplete` (the unfinished copies made for resume).
+        target(
+            "dlgpd-eval-incomplete",
+            Input::Checkpoint { dir: "dlgpd-resume", files: MODEL_FILES },
+            "eval dlgpd --model {in} --env pendulum --evidence-rollouts 1 --prediction-only --allow-incomplete --out {out}",
+        ),
+        target(
+            "context-eval-incomplete",
+            Input::Checkpoint { dir: "context-model-resume", files: MODEL_FILES },
+            "eval context --model {in} --env toy:inner --contexts 2 --validation-rollouts 1 --validation-steps 3 \
+             --transitions 1 --strategy random --allow-incomplete --out {out}",
+        ),
         target(
             "ekf-predict",
             Input::Checkpoint {
