@@ -492,6 +492,21 @@ struct ContextArgs {
     out: PathBuf,
 }
 
+/// The checkpoints `--allow-incomplete` lets an evaluation take.
+fn accepting(allow_incomplete: bool) -> mbrl::train::Accept {
+    if allow_incomplete {
+        mbrl::train::Accept::InProgress
+    } else {
+        mbrl::train::Accept::Finished
+    }
+}
+
+fn warn_if_unfinished(model: &std::path::Path, progress: &mbrl::train::TrainingProgress) {
+    if !progress.complete {
+        eprintln!("warning: {}: {}", model.display(), progress.describe());
+    }
+}
+
 fn eval_context(global: &GlobalArgs, provenance: &Provenance, a: ContextArgs) -> anyhow::Result<()> {
     use mbrl::models::context::calibration::{CalibrationSettings, Strategy};
     let env = mbrl::envs::parse_env(&a.env)?;
@@ -536,11 +551,8 @@ fn eval_context(global: &GlobalArgs, provenance: &Provenance, a: ContextArgs) ->
     {
         bail!("--contexts must be 2..=100000, --validation-rollouts and --validation-steps 1..=10000");
     }
-    let accept = if a.allow_incomplete { mbrl::train::Accept::InProgress } else { mbrl::train::Accept::Finished };
-    let model = mbrl::models::context::load_accepting(&a.model, &env, accept)?;
-    if !model.progress.complete {
-        eprintln!("warning: {}: {}", a.model.display(), model.progress.describe());
-    }
+    let model = mbrl::models::context::load_accepting(&a.model, &env, accepting(a.allow_incomplete))?;
+    warn_if_unfinished(&a.model, &model.progress);
     let summary = run_job(global, "eval context", |monitor| {
         mbrl::eval::context::evaluate(&model, &env, &settings, provenance, &a.out, monitor)
     })?;
@@ -717,11 +729,8 @@ fn eval_dlgpd(global: &GlobalArgs, provenance: &Provenance, a: DlgpdArgs) -> any
         cem,
         swing_ups: !a.prediction_only,
     };
-    let accept = if a.allow_incomplete { mbrl::train::Accept::InProgress } else { mbrl::train::Accept::Finished };
-    let trained = mbrl::models::dlgpd::job::load_accepting(&a.model, accept)?;
-    if !trained.progress.complete {
-        eprintln!("warning: {}: {}", a.model.display(), trained.progress.describe());
-    }
+    let trained = mbrl::models::dlgpd::job::load_accepting(&a.model, accepting(a.allow_incomplete))?;
+    warn_if_unfinished(&a.model, &trained.progress);
     let summary = run_job(global, "eval dlgpd", |monitor| evaluate(&trained, &settings, provenance, &a.out, monitor))?;
     if !summary.points.is_empty() {
         say!("env                   evidence     rollouts  mean return  successes");
@@ -749,15 +758,15 @@ fn eval_dlgpd(global: &GlobalArgs, provenance: &Provenance, a: DlgpdArgs) -> any
         );
     }
     for p in &summary.predictions {
-        let at = |h: usize| p.prediction.open_loop_rmse.get(h).copied().unwrap_or(f64::NAN);
+        let at = |h: usize| p.prediction.errors.open_loop_rmse.get(h).copied().unwrap_or(f64::NAN);
         say!(
             "{:<21} {:<12} {:>8.2} {:>14.2} {:>6.2} {:>10.2} {:>9.2}",
             p.env,
             p.evidence,
-            p.prediction.encoded_rmse,
+            p.prediction.errors.encoded_rmse,
             at(1),
             at(10),
-            p.prediction.constant_rmse,
+            p.prediction.errors.constant_rmse,
             p.prediction.linear_probe_r2[2]
         );
     }

@@ -21,6 +21,7 @@ use crate::envs::EnvName;
 use crate::error::{Error, Result};
 use crate::models::dlgpd::control::{condition_on, swing_up, ControlSettings};
 use crate::models::dlgpd::data::{ObservationKind, Windows};
+use crate::models::dlgpd::dynamics::LatentDynamics;
 use crate::models::dlgpd::job::TrainedDlgpd;
 use crate::models::dlgpd::vae::encode_rows;
 use crate::nn::tensor::{inference_device, tensor};
@@ -220,10 +221,7 @@ pub fn evaluate(
         // first rollouts, as the authors' buckets.
         let mut pools: Vec<(PendulumVariant, Dataset)> = Vec::new();
         for (variant, kind, source) in &plan {
-            if !pools.iter().any(|(v, _)| v == source) {
-                pools.push((source.clone(), evidence_rollouts(source, largest, pool_seed, images)?));
-            }
-            let pool = &pools.iter().find(|(v, _)| v == source).expect("pushed above").1;
+            let pool = cached(&mut pools, source, || evidence_rollouts(source, largest, pool_seed, images))?;
             for &rollouts in &settings.evidence_rollouts {
                 if monitor.is_cancelled() {
                     return Err(Error::Cancelled);
@@ -278,15 +276,20 @@ fn prediction_checks(
 ) -> Result<Vec<PredictionCheck>> {
     let pool_seed = derive_seed(seed, &[EVIDENCE_STREAM, 0]);
     let held_out_seed = derive_seed(seed, &[HELD_OUT_STREAM]);
+    // Settings share their evidence source (the standard pendulum's) and their held-out system.
+    let mut conditioned: Vec<(PendulumVariant, LatentDynamics)> = Vec::new();
+    let mut held_outs: Vec<(PendulumVariant, Dataset)> = Vec::new();
     let mut checks = Vec::with_capacity(plan.len());
     for (index, (variant, kind, source)) in plan.iter().enumerate() {
         if monitor.is_cancelled() {
             return Err(Error::Cancelled);
         }
-        let evidence = evidence_rollouts(source, largest, pool_seed, images)?;
-        let dynamics = condition_on(trained, &evidence, pool_seed)?;
-        let held_out = evidence_rollouts(variant, HELD_OUT_ROLLOUTS, held_out_seed, images)?;
-        let prediction = reward_prediction(trained, &dynamics, &held_out, held_out_seed)?;
+        let dynamics = cached(&mut conditioned, source, || {
+            condition_on(trained, &evidence_rollouts(source, largest, pool_seed, images)?, pool_seed)
+        })?;
+        let held_out =
+            cached(&mut held_outs, variant, || evidence_rollouts(variant, HELD_OUT_ROLLOUTS, held_out_seed, images))?;
+        let prediction = reward_prediction(trained, dynamics, held_out, held_out_seed)?;
         checks.push(PredictionCheck {
             env: variant.env_name(),
             evidence: kind,
@@ -296,6 +299,22 @@ fn prediction_checks(
         monitor.progress("reward prediction checks", index as u64 + 1, plan.len() as u64);
     }
     Ok(checks)
+}
+
+/// The entry of `cache` for `key`, made on first use.
+fn cached<'a, T>(
+    cache: &'a mut Vec<(PendulumVariant, T)>,
+    key: &PendulumVariant,
+    make: impl FnOnce() -> Result<T>,
+) -> Result<&'a T> {
+    let index = match cache.iter().position(|(k, _)| k == key) {
+        Some(index) => index,
+        None => {
+            cache.push((key.clone(), make()?));
+            cache.len() - 1
+        }
+    };
+    Ok(&cache[index].1)
 }
 
 /// The first `count` rollouts of a dataset (its ids are 0, 1, … in order).
@@ -508,7 +527,7 @@ fn write_prediction_section(run_dir: &RunDir, predictions: &[PredictionCheck], m
     let name = |p: &PredictionCheck| format!("{} ({})", p.env, p.evidence);
     let mut rows = Vec::new();
     for p in predictions {
-        for (h, e) in p.prediction.open_loop_rmse.iter().enumerate() {
+        for (h, e) in p.prediction.errors.open_loop_rmse.iter().enumerate() {
             rows.push(vec![
                 p.env.clone(),
                 p.evidence.to_string(),
@@ -527,13 +546,13 @@ fn write_prediction_section(run_dir: &RunDir, predictions: &[PredictionCheck], m
         .iter()
         .map(|p| Series {
             name: name(p),
-            points: p.prediction.open_loop_rmse.iter().enumerate().map(|(h, e)| (h as f64, *e)).collect(),
+            points: p.prediction.errors.open_loop_rmse.iter().enumerate().map(|(h, e)| (h as f64, *e)).collect(),
         })
         .collect();
     // The line a model must stay under to know anything about the state: its held-out rewards' spread.
     if let Some(p) = predictions.iter().find(|p| p.evidence == "matching") {
-        let last = p.prediction.open_loop_rmse.len().saturating_sub(1) as f64;
-        let level = p.prediction.constant_rmse;
+        let last = p.prediction.errors.open_loop_rmse.len().saturating_sub(1) as f64;
+        let level = p.prediction.errors.constant_rmse;
         series.push(Series { name: format!("best constant ({})", p.env), points: vec![(0.0, level), (last, level)] });
     }
     rising_line_plot(
@@ -543,7 +562,7 @@ fn write_prediction_section(run_dir: &RunDir, predictions: &[PredictionCheck], m
         "reward RMSE",
         &series,
     )?;
-    let rollouts = predictions.first().map_or(0, |p| p.prediction.rollouts);
+    let rollouts = predictions.first().map_or(0, |p| p.prediction.errors.rollouts);
     md.push_str(&format!(
         "\n## Reward prediction on held-out rollouts\n\nWhat the planner optimizes, checked against the simulator: \
          {rollouts} random-action rollouts of each system (not in any evidence); the model conditioned on run 0's \
@@ -562,16 +581,16 @@ fn write_prediction_section(run_dir: &RunDir, predictions: &[PredictionCheck], m
     for p in predictions {
         let cells: Vec<String> = TABLE_HORIZONS
             .iter()
-            .map(|&h| p.prediction.open_loop_rmse.get(h).map_or("–".into(), |e| format!("{e:.2}")))
+            .map(|&h| p.prediction.errors.open_loop_rmse.get(h).map_or("–".into(), |e| format!("{e:.2}")))
             .collect();
         let [c, s, v] = p.prediction.linear_probe_r2;
         md.push_str(&format!(
             "| {} | {} | {:.2} | {} | {:.2} | {c:.2} / {s:.2} / {v:.2} |\n",
             p.env,
             p.evidence,
-            p.prediction.encoded_rmse,
+            p.prediction.errors.encoded_rmse,
             cells.join(" | "),
-            p.prediction.constant_rmse
+            p.prediction.errors.constant_rmse
         ));
     }
     Ok(())

@@ -13,22 +13,17 @@ use crate::models::dlgpd::data::Windows;
 use crate::models::dlgpd::dynamics::LatentDynamics;
 use crate::models::dlgpd::evidence::encoded_means;
 use crate::models::dlgpd::job::TrainedDlgpd;
-use crate::models::dlgpd::prediction::reward_errors;
+use crate::models::dlgpd::prediction::{reward_errors, RewardErrors};
 
-/// Reward prediction errors of one conditioned model on held-out rollouts of one system.
+/// Reward prediction errors of one conditioned model on held-out rollouts of one system, and the probe.
 #[derive(Clone, Debug, Serialize)]
 pub struct RewardPrediction {
-    /// RMSE of the open-loop reward prediction h steps after the encoded start, h = 0, 1, ….
-    pub open_loop_rmse: Vec<f64>,
-    /// RMSE of the reward GP at the encoding of every step's own observations (no dynamics involved).
-    pub encoded_rmse: f64,
-    /// RMSE of the best constant: the held-out rewards' own mean (their standard deviation).
-    pub constant_rmse: f64,
+    #[serde(flatten)]
+    pub errors: RewardErrors,
     /// R² of cos θ, sin θ and θ̇ regressed linearly on the latent means (in sample). The GPs predict each
     /// latent dimension around its current value; a latent that holds the velocity only through a
     /// nonlinear fold gives them a harder function to learn than one near-linear in the state.
     pub linear_probe_r2: [f64; 3],
-    pub rollouts: usize,
 }
 
 /// Predict the rewards of `held_out` (random-action rollouts of the system at hand) with `dynamics`.
@@ -42,14 +37,7 @@ pub fn reward_prediction(
     let rows: Vec<usize> = (0..windows.len()).collect();
     let latents = encoded_means(&trained.vae, &windows, &rows)?;
     let linear_probe_r2 = linear_probe(&latents, dynamics.latent_dim(), &window_states(held_out, &windows)?)?;
-    let errors = reward_errors(dynamics, &windows, &rows, &latents)?;
-    Ok(RewardPrediction {
-        open_loop_rmse: errors.open_loop_rmse,
-        encoded_rmse: errors.encoded_rmse,
-        constant_rmse: errors.constant_rmse,
-        linear_probe_r2,
-        rollouts: errors.rollouts,
-    })
+    Ok(RewardPrediction { errors: reward_errors(dynamics, &windows, &rows, &latents)?, linear_probe_r2 })
 }
 
 /// The simulator state (θ, θ̇) of each window's newer observation, in window order.

@@ -11,9 +11,7 @@ use crate::nn::tensor::inference_device;
 
 /// Encoder means of the windows `rows`, widened to f64; an error when any is not finite.
 pub fn encoded_means(vae: &VaeNet, windows: &Windows, rows: &[usize]) -> Result<Vec<f64>> {
-    let (obs, _) = windows.observations(rows);
-    let latents: Vec<f64> =
-        encode_rows(vae, &obs, windows.kind.input_len(), &inference_device()).0.into_iter().map(f64::from).collect();
+    let latents = widened_means(vae, &windows.observations(rows).0, windows.kind.input_len());
     if latents.iter().any(|v| !v.is_finite()) {
         return Err(Error::Diverged("the encoder gave non-finite latents".into()));
     }
@@ -32,10 +30,12 @@ pub fn condition_on_rows(
     let (obs, next) = windows.observations(rows);
     let (actions, rewards) = windows.actions_and_rewards(rows);
     let width = windows.kind.input_len();
-    let device = inference_device();
-    let widen = |v: Vec<f32>| v.into_iter().map(f64::from).collect::<Vec<f64>>();
-    let latents = widen(encode_rows(vae, &obs, width, &device).0);
-    let next_latents = widen(encode_rows(vae, &next, width, &device).0);
+    let latents = widened_means(vae, &obs, width);
+    let next_latents = widened_means(vae, &next, width);
     let evidence = Evidence { latents: &latents, actions: &actions, next_latents: &next_latents, rewards: &rewards };
     LatentDynamics::condition(gps.0, gps.1, scale, &evidence)
+}
+
+fn widened_means(vae: &VaeNet, obs: &[f32], width: usize) -> Vec<f64> {
+    encode_rows(vae, obs, width, &inference_device()).0.into_iter().map(f64::from).collect()
 }

@@ -22,7 +22,7 @@ pub struct RewardErrors {
 }
 
 /// Score `dynamics` on the windows `rows` (whole rollouts, each in time order); `latents` are their
-/// encoder means ([`encoded_means`]). The open loop runs over the shortest rollout.
+/// encoder means ([`encoded_means`](super::evidence::encoded_means)). The open loop runs over the shortest rollout.
 pub fn reward_errors(
     dynamics: &LatentDynamics,
     windows: &Windows,

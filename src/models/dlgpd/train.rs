@@ -17,8 +17,7 @@ use super::model::{
     init_hypers, loss_and_gradients, raw_gradient, raw_vector, sample_noise, set_raw_vector, Batch, Gradients, StepLoss,
 };
 use super::prediction::reward_errors;
-use super::vae::encode_rows;
-use super::vae::VaeNet;
+use super::vae::{encode_rows, VaeNet};
 use crate::error::{Error, Result};
 use crate::models::gp::{GpHypers, HyperInit};
 use crate::nn::params::NamedTensor;

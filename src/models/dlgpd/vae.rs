@@ -13,8 +13,7 @@ use super::data::ObservationKind;
 use super::loss::reconstruction_bce;
 use crate::error::{Error, Result};
 use crate::nn::conv::{Conv2d, Conv2dConfig, ConvTranspose2d};
-use crate::nn::tensor::tensor;
-use crate::nn::tensor::values;
+use crate::nn::tensor::{tensor, values};
 use crate::nn::{Linear, LinearConfig, ParamSet};
 
 pub const FRAME_CHANNELS: usize = 6;
