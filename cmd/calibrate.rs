@@ -14,9 +14,10 @@ use mbrl::models::context::calibration::{
 };
 use mbrl::models::context::{self, fast::gaussian_entropy, LoadedModel};
 use mbrl::models::tradyn::{self, TradynModel};
-use mbrl::train::OpenedCheckpoint;
+use mbrl::train::{Accept, OpenedCheckpoint};
 
 use crate::common::{check_output_file, command_line, file_stem, parse_floats, run_job, GlobalArgs};
+use crate::model_args::{accepting, report_unfinished};
 
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
 pub enum StrategyChoice {
@@ -84,6 +85,9 @@ pub struct CalibrateArgs {
     /// Where to write the calibration transitions (default: datasets/calib-<env>-<strategy>-i<S>.mcap).
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Take a run still in training (its best-validation weights so far); the output says how far it got.
+    #[arg(long)]
+    allow_incomplete: bool,
 }
 
 impl StrategyChoice {
@@ -121,7 +125,8 @@ pub fn run(global: &GlobalArgs, args: CalibrateArgs) -> anyhow::Result<()> {
     if !args.model.is_dir() {
         bail!("--model {}: no such checkpoint directory", args.model.display());
     }
-    let model = load_model(&args.model, &env)?;
+    let model = load_model(&args.model, &env, accepting(args.allow_incomplete))?;
+    report_unfinished(&args.model, &model.progress);
     let out = args.out.clone().unwrap_or_else(|| {
         PathBuf::from(format!(
             "datasets/calib-{}-{}-i{}.mcap",
@@ -140,11 +145,12 @@ pub fn run(global: &GlobalArgs, args: CalibrateArgs) -> anyhow::Result<()> {
     };
     let spec = env.build()?.spec();
     let title = format!(
-        "calibrate {} ({}, {} transitions, instance {})",
+        "calibrate {} ({}, {} transitions, instance {}{})",
         env.canonical(),
         strategy.name(),
         transitions,
-        args.instance_seed
+        args.instance_seed,
+        model.progress.unfinished_note()
     );
     let (calibration, instance) = run_job(global, "calibrate", |monitor| {
         monitor.emit(&layout(&title, &spec.state_names));
@@ -156,21 +162,22 @@ pub fn run(global: &GlobalArgs, args: CalibrateArgs) -> anyhow::Result<()> {
     let prior = gaussian_entropy(&model.fast.belief(&vec![0.0; model.fast.transition_features], 1).std);
     let last = calibration.entropies.last().copied().unwrap_or(prior);
     say!(
-        "calibrated {} instance {} ({}) with {} {} transitions: entropy of q(β | context) {:.3} → {:.3} nats",
+        "calibrated {} instance {} ({}) with {} {} transitions: entropy of q(β | context) {:.3} → {:.3} nats{}",
         env.canonical(),
         args.instance_seed,
         instance,
         calibration.rollout.len(),
         strategy.name(),
         prior,
-        last
+        last,
+        model.progress.unfinished_note()
     );
     say!("context set written to {}", out.display());
     Ok(())
 }
 
 /// A context model of `env`, or a TRADYN model when `env` is the unicycle.
-fn load_model(dir: &std::path::Path, env: &EnvName) -> anyhow::Result<LoadedModel> {
+fn load_model(dir: &std::path::Path, env: &EnvName, accept: Accept) -> anyhow::Result<LoadedModel> {
     let method = OpenedCheckpoint::open(dir)?.manifest.method;
     let unicycle = matches!(env, EnvName::Unicycle(_));
     if unicycle && method != tradyn::METHOD {
@@ -182,5 +189,9 @@ fn load_model(dir: &std::path::Path, env: &EnvName) -> anyhow::Result<LoadedMode
     if method == tradyn::METHOD && !unicycle {
         bail!("{}: is a TRADYN model of the unicycle; calibrate it with --env unicycle --map PNG", dir.display());
     }
-    Ok(if unicycle { TradynModel::load(dir)?.loaded } else { context::load(dir, env)? })
+    Ok(if unicycle {
+        TradynModel::load_accepting(dir, accept)?.loaded
+    } else {
+        context::load_accepting(dir, env, accept)?
+    })
 }

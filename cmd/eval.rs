@@ -18,7 +18,7 @@ use mbrl::run::dir::Provenance;
 
 use crate::cem_args::CemArgs;
 use crate::common::{command_line, pendulum_variant, run_job, GlobalArgs};
-use crate::model_args::ModelArgs;
+use crate::model_args::{accepting, report_unfinished, ModelArgs};
 use crate::solve_board::{EmbodimentChoice, SplitChoice};
 
 /// Run an evaluation protocol and write a report directory (report.md, CSV, PNG).
@@ -492,21 +492,6 @@ struct ContextArgs {
     out: PathBuf,
 }
 
-/// The checkpoints `--allow-incomplete` lets an evaluation take.
-fn accepting(allow_incomplete: bool) -> mbrl::train::Accept {
-    if allow_incomplete {
-        mbrl::train::Accept::InProgress
-    } else {
-        mbrl::train::Accept::Finished
-    }
-}
-
-fn warn_if_unfinished(model: &std::path::Path, progress: &mbrl::train::TrainingProgress) {
-    if !progress.complete {
-        eprintln!("warning: {}: {}", model.display(), progress.describe());
-    }
-}
-
 fn eval_context(global: &GlobalArgs, provenance: &Provenance, a: ContextArgs) -> anyhow::Result<()> {
     use mbrl::models::context::calibration::{CalibrationSettings, Strategy};
     let env = mbrl::envs::parse_env(&a.env)?;
@@ -552,7 +537,7 @@ fn eval_context(global: &GlobalArgs, provenance: &Provenance, a: ContextArgs) ->
         bail!("--contexts must be 2..=100000, --validation-rollouts and --validation-steps 1..=10000");
     }
     let model = mbrl::models::context::load_accepting(&a.model, &env, accepting(a.allow_incomplete))?;
-    warn_if_unfinished(&a.model, &model.progress);
+    report_unfinished(&a.model, &model.progress);
     let summary = run_job(global, "eval context", |monitor| {
         mbrl::eval::context::evaluate(&model, &env, &settings, provenance, &a.out, monitor)
     })?;
@@ -730,7 +715,7 @@ fn eval_dlgpd(global: &GlobalArgs, provenance: &Provenance, a: DlgpdArgs) -> any
         swing_ups: !a.prediction_only,
     };
     let trained = mbrl::models::dlgpd::job::load_accepting(&a.model, accepting(a.allow_incomplete))?;
-    warn_if_unfinished(&a.model, &trained.progress);
+    report_unfinished(&a.model, &trained.progress);
     let summary = run_job(global, "eval dlgpd", |monitor| evaluate(&trained, &settings, provenance, &a.out, monitor))?;
     if !summary.points.is_empty() {
         say!("env                   evidence     rollouts  mean return  successes");

@@ -1,13 +1,14 @@
 //! Which dynamics a planner uses: `--model true` (the simulator's own equations) or a trained checkpoint, and
 //! how a stochastic learned model is rolled out.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::bail;
 use clap::{Args, ValueEnum};
 use mbrl::envs::{BatchDynamics, EnvName};
 use mbrl::models::pets::Propagation;
 use mbrl::models::{load_planning_model, RolloutOptions};
+use mbrl::train::{Accept, OpenedCheckpoint, TrainingProgress};
 
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
 pub enum PropagationChoice {
@@ -35,6 +36,9 @@ pub struct ModelArgs {
     /// model plans with its prior mean context.
     #[arg(long)]
     pub context: Option<PathBuf>,
+    /// Take a run still in training (its best-validation weights so far); the output says how far it got.
+    #[arg(long)]
+    pub allow_incomplete: bool,
 }
 
 impl ModelArgs {
@@ -61,10 +65,45 @@ impl ModelArgs {
                 self.model
             );
         }
-        Ok(Some(load_planning_model(
+        let model = load_planning_model(
             &dir,
             env,
-            RolloutOptions { propagation, particles: self.particles, context: self.context.clone() },
-        )?))
+            RolloutOptions {
+                propagation,
+                particles: self.particles,
+                context: self.context.clone(),
+                accept: self.accept(),
+            },
+        )?;
+        warn_if_unfinished(&dir)?;
+        Ok(Some(model))
+    }
+
+    /// The checkpoints `--allow-incomplete` lets a command take.
+    pub fn accept(&self) -> Accept {
+        accepting(self.allow_incomplete)
+    }
+}
+
+/// The checkpoints `--allow-incomplete` lets a command take.
+pub fn accepting(allow_incomplete: bool) -> Accept {
+    if allow_incomplete {
+        Accept::InProgress
+    } else {
+        Accept::Finished
+    }
+}
+
+/// A one-line warning on stderr when a loaded model's training is unfinished (only `--allow-incomplete` lets
+/// such a model load).
+pub fn warn_if_unfinished(model: &Path) -> anyhow::Result<()> {
+    report_unfinished(model, &OpenedCheckpoint::open(model)?.progress());
+    Ok(())
+}
+
+/// As [`warn_if_unfinished`], for a caller that holds the loaded model's progress.
+pub fn report_unfinished(model: &Path, progress: &TrainingProgress) {
+    if !progress.complete {
+        eprintln!("warning: {}: {}", model.display(), progress.describe());
     }
 }

@@ -11,7 +11,7 @@ use mbrl::util::budget;
 
 use crate::cem_args::CemArgs;
 use crate::common::{check_output_file, command_line, file_stem, pendulum_variant, run_job, GlobalArgs};
-use crate::model_args::ModelArgs;
+use crate::model_args::{report_unfinished, ModelArgs};
 
 /// Plan with CEM on a model and execute the plan in the simulator (MPC).
 #[derive(Args, Debug)]
@@ -164,7 +164,9 @@ fn plan_dlgpd(
     if args.instance_seed.is_some() || args.model.context.is_some() {
         bail!("--instance-seed and --context are for context models; a DLGPD model adapts through --evidence");
     }
-    let trained = dlgpd::job::load(std::path::Path::new(&args.model.model))?;
+    let model_dir = std::path::Path::new(&args.model.model);
+    let trained = dlgpd::job::load_accepting(model_dir, args.model.accept())?;
+    report_unfinished(model_dir, &trained.progress);
     let evidence = mbrl::data::read_dataset(evidence_path)?;
     let seed = global.seed;
     let dynamics = dlgpd::control::condition_on(&trained, &evidence, seed)
@@ -180,10 +182,11 @@ fn plan_dlgpd(
     control.steps = settings.steps;
     control.cem = mbrl::planning::CemConfig { stop_std: Some(dlgpd::control::STOP_STD), ..settings.cem.clone() };
     let title = format!(
-        "plan: {} swing-up with DLGPD on {} evidence transitions from {}",
+        "plan: {} swing-up with DLGPD on {} evidence transitions from {}{}",
         settings.variant.env_name(),
         dynamics.evidence_len(),
-        evidence.meta.env
+        evidence.meta.env,
+        trained.progress.unfinished_note()
     );
     let episode = run_job(global, "plan: DLGPD swing-up", |monitor| {
         monitor.emit(&swingup::layout(&title, false));
@@ -199,12 +202,13 @@ fn plan_dlgpd(
     };
     write_dataset(out, &swingup::episodes_dataset(&settings, seed, &command_line(), std::slice::from_ref(&record)))?;
     say!(
-        "return {:.2}, success: {} (last 25 rewards > -1); {:.1} CEM iterations per step; evidence: {} transitions of {}; rollout saved to {}",
+        "return {:.2}, success: {} (last 25 rewards > -1); {:.1} CEM iterations per step; evidence: {} transitions of {}{}; rollout saved to {}",
         record.total_return,
         if record.success { "yes" } else { "no" },
         iterations,
         dynamics.evidence_len(),
         evidence.meta.env,
+        trained.progress.unfinished_note(),
         out.display()
     );
     Ok(())

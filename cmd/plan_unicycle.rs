@@ -16,7 +16,7 @@ use mbrl::train::OpenedCheckpoint;
 
 use crate::cem_args::CemArgs;
 use crate::common::{check_output_file, command_line, parse_floats, run_job, GlobalArgs};
-use crate::model_args::ModelArgs;
+use crate::model_args::{report_unfinished, ModelArgs};
 
 /// The unicycle flags of `plan`.
 pub struct UnicycleTask {
@@ -64,7 +64,8 @@ fn load_dynamics(
             dir.display()
         );
     }
-    let trained = TradynModel::load(dir)?;
+    let trained = TradynModel::load_accepting(dir, model.accept())?;
+    report_unfinished(dir, &trained.loaded.progress);
     let rows = match &model.context {
         Some(path) => read_context(&trained.loaded, path)?,
         None => Vec::new(),

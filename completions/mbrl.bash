@@ -217,7 +217,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__calibrate)
-            opts="-q -h -V --model --env --map --instance-seed --strategy --transitions --horizon --candidates --elites --iters --beta-samples --init-state --out --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --model --env --map --instance-seed --strategy --transitions --horizon --candidates --elites --iters --beta-samples --init-state --out --allow-incomplete --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -925,7 +925,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__pendulum__subcmd__swingup)
-            opts="-q -h -V --model --particles --propagation --context --episodes --env --steps --horizon --candidates --elites --iters --noise --beta --no-warm-start --out --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --model --particles --propagation --context --allow-incomplete --episodes --env --steps --horizon --candidates --elites --iters --noise --beta --no-warm-start --out --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1571,7 +1571,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__plan)
-            opts="-q -h -V --env --model --particles --propagation --context --steps --map --start --goal --horizon --candidates --elites --iters --noise --beta --no-warm-start --evidence --instance-seed --out --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --env --model --particles --propagation --context --allow-incomplete --steps --map --start --goal --horizon --candidates --elites --iters --noise --beta --no-warm-start --evidence --instance-seed --out --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0

@@ -97,6 +97,7 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l out -d 'Where to save
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l allow-incomplete -d 'Take a run still in training (its best-validation weights so far); the output says how far it got'
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l no-warm-start -d 'Start every planning call from zero instead of the previous plan shifted by one step'
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
@@ -157,6 +158,7 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l out -d 'Where to
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l allow-incomplete -d 'Take a run still in training (its best-validation weights so far); the output says how far it got'
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -s q -l quiet -d 'Print only results and errors'
@@ -390,6 +392,7 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l allow-incomplete -d 'Take a run still in training (its best-validation weights so far); the output says how far it got'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l no-warm-start -d 'Start every planning call from zero instead of the previous plan shifted by one step'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'

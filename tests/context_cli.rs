@@ -177,15 +177,18 @@ fn wrong_inputs_are_one_line_errors() {
     assert!(!d.join("report").exists());
 
     // A run still in training (here: a finished one's manifest marked unfinished) is refused unless asked for.
-    std::fs::create_dir_all(d.join("partial")).unwrap();
-    for (name, bytes) in dir_bytes(&d.join("models/toy")) {
-        let bytes = if name == "checkpoint.json" {
-            String::from_utf8(bytes).unwrap().replace("\"complete\": true", "\"complete\": false").into_bytes()
-        } else {
-            bytes
-        };
-        std::fs::write(d.join("partial").join(name), bytes).unwrap();
-    }
+    let mark_unfinished = |from: &str, to: &str| {
+        std::fs::create_dir_all(d.join(to)).unwrap();
+        for (name, bytes) in dir_bytes(&d.join(from)) {
+            let bytes = if name == "checkpoint.json" {
+                String::from_utf8(bytes).unwrap().replace("\"complete\": true", "\"complete\": false").into_bytes()
+            } else {
+                bytes
+            };
+            std::fs::write(d.join(to).join(name), bytes).unwrap();
+        }
+    };
+    mark_unfinished("models/toy", "partial");
     let eval = |extra: &[&str]| {
         mbrl(d)
             .args(["eval", "context", "--model", "partial", "--env", "toy:inner", "--contexts", "2"])
@@ -210,4 +213,35 @@ fn wrong_inputs_are_one_line_errors() {
     assert!(out.status.success(), "{}", stderr_of(&out));
     let report = std::fs::read_to_string(d.join("partial-report/report.md")).unwrap();
     assert!(report.contains("10 of 10 steps (training still in progress)"), "{report}");
+
+    // calibrate and plan take such a run with --allow-incomplete too, and say how far it got.
+    let calibrate = |extra: &[&str]| {
+        mbrl(d)
+            .args(["calibrate", "--model", "partial", "--env", "toy:inner", "--instance-seed", "1"])
+            .args(["--strategy", "random", "--transitions", "1", "--out", "partial-calib.mcap", "--no-tui"])
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    assert_one_line_error(&calibrate(&[]), &["partial", "training stopped at step 10 of 10"]);
+    assert!(!d.join("partial-calib.mcap").exists());
+    let out = calibrate(&["--allow-incomplete"]);
+    assert!(out.status.success(), "{}", stderr_of(&out));
+    assert!(stdout_of(&out).contains("trained 10 of 10 steps (training still in progress)"), "{}", stdout_of(&out));
+    assert!(stderr_of(&out).contains("warning: partial"), "{}", stderr_of(&out));
+    mark_unfinished("pets", "pets-partial");
+    let plan = |extra: &[&str]| {
+        mbrl(d)
+            .args(["plan", "--env", "pendulum", "--model", "pets-partial", "--steps", "2", "--candidates", "8"])
+            .args(["--elites", "2", "--iters", "1", "--particles", "2", "--out", "partial-plan.mcap", "--no-tui"])
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    assert_one_line_error(&plan(&[]), &["pets-partial", "training stopped at step 5 of 5"]);
+    assert!(!d.join("partial-plan.mcap").exists());
+    let out = plan(&["--allow-incomplete"]);
+    assert!(out.status.success(), "{}", stderr_of(&out));
+    let said = format!("{}{}", stdout_of(&out), stderr_of(&out));
+    assert!(said.contains("warning: pets-partial: 5 of 5 steps (training still in progress)"), "{said}");
 }

@@ -299,6 +299,17 @@ fn targets() -> Vec<Target> {
              --transitions 1 --strategy random --allow-incomplete --out {out}",
         ),
         target(
+            "pets-plan-incomplete",
+            Input::Checkpoint { dir: "pets-resume", files: MODEL_FILES },
+            concat!("plan --env pendulum --model {in} --particles 2 --allow-incomplete --out {out}", cheap_plan!()),
+        ),
+        target(
+            "context-calibrate-incomplete",
+            Input::Checkpoint { dir: "context-model-resume", files: MODEL_FILES },
+            "calibrate --model {in} --env toy:inner --instance-seed 1 --strategy random --transitions 2 \
+             --allow-incomplete --out {out}",
+        ),
+        target(
             "ekf-predict",
             Input::Checkpoint {
                 dir: "ekf",

@@ -150,7 +150,13 @@ fn pets_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) ->
         provenance: provenance.clone(),
     };
     let trained = pets::train(&request, false, monitor)?;
-    let model = pets::load_dynamics(&request.out, &collect.env, Propagation::TsInf, QUICK_PETS_PARTICLES)?;
+    let model = pets::load_dynamics(
+        &request.out,
+        &collect.env,
+        Propagation::TsInf,
+        QUICK_PETS_PARTICLES,
+        crate::train::Accept::Finished,
+    )?;
     let mut settings = SwingupSettings::thesis(PendulumVariant::Standard);
     settings.steps = QUICK_PETS_SWINGUP_STEPS;
     settings.cem.candidates = QUICK_PETS_CANDIDATES;

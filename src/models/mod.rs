@@ -19,6 +19,8 @@ pub struct RolloutOptions {
     pub particles: usize,
     /// Calibration transitions to condition a context model on (`None`: the empty context, the prior mean).
     pub context: Option<std::path::PathBuf>,
+    /// Whether a run still in training is taken (its best-validation weights so far).
+    pub accept: crate::train::Accept,
 }
 
 /// The methods whose checkpoints `plan` can plan with.
@@ -42,10 +44,10 @@ pub fn load_planning_model(dir: &Path, env: &EnvName, options: RolloutOptions) -
                     format!("--context conditions context models; {} is a PETS ensemble", dir.display()),
                 ));
             }
-            Ok(Box::new(pets::load_dynamics(dir, env, options.propagation, options.particles)?))
+            Ok(Box::new(pets::load_dynamics(dir, env, options.propagation, options.particles, options.accept)?))
         }
         context::METHOD => {
-            let model = context::load(dir, env)?;
+            let model = context::load_accepting(dir, env, options.accept)?;
             let rows = match &options.context {
                 Some(path) => context::calibration::read_context(&model, path)?,
                 None => Vec::new(),

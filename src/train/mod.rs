@@ -45,6 +45,16 @@ impl TrainingProgress {
             format!("{} of {} steps (training still in progress)", self.step, self.total_steps)
         }
     }
+
+    /// Empty for a finished run, else ", trained 11200 of 30000 steps (training still in progress)": appended to
+    /// a model's one-line description, so planner output never passes a run in progress off as done.
+    pub fn unfinished_note(&self) -> String {
+        if self.complete {
+            String::new()
+        } else {
+            format!(", trained {}", self.describe())
+        }
+    }
 }
 
 pub struct OpenedCheckpoint {

@@ -114,10 +114,11 @@ impl BatchDynamics for ContextDynamics {
 
     fn describe(&self) -> String {
         format!(
-            "context model {} conditioned on {} calibration transitions (context mean), planning reward: {}",
+            "context model {} conditioned on {} calibration transitions (context mean), planning reward: {}{}",
             self.model.dir.display(),
             self.context_size,
-            self.reward_name
+            self.reward_name,
+            self.model.progress.unfinished_note()
         )
     }
 }

@@ -379,7 +379,8 @@ pub fn load_accepting(dir: &Path, env: &EnvName, accept: Accept) -> Result<Loade
     load_method_accepting(dir, env, METHOD, accept)
 }
 
-fn load_method_accepting(dir: &Path, env: &EnvName, method: &str, accept: Accept) -> Result<LoadedModel> {
+/// As [`load_method`], also taking a run still in training when `accept` does.
+pub fn load_method_accepting(dir: &Path, env: &EnvName, method: &str, accept: Accept) -> Result<LoadedModel> {
     let opened = OpenedCheckpoint::open(dir)?;
     if opened.manifest.method != method {
         return Err(Error::bad_file(

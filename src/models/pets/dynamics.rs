@@ -69,6 +69,12 @@ pub struct PetsDynamics {
 }
 
 impl PetsDynamics {
+    /// Appends to the one-line description (how far training went, for a run still in progress).
+    pub fn with_note(mut self, note: &str) -> Self {
+        self.label.push_str(note);
+        self
+    }
+
     /// From a checkpoint's weights. `reward` is the env's closed-form reward when the model was trained with
     /// `reward = known` (it must then be given).
     #[allow(clippy::too_many_arguments)]

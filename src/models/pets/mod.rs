@@ -24,8 +24,8 @@ use crate::run::dir::Provenance;
 use crate::run::Monitor;
 use crate::train::tensors::{to_params, TensorData};
 use crate::train::{
-    loss_panel, run_training, training_view, validation_panel, DataFile, FitOutcome, FitSettings, OpenedCheckpoint,
-    MODEL_FILE,
+    loss_panel, run_training, training_view, validation_panel, Accept, DataFile, FitOutcome, FitSettings,
+    OpenedCheckpoint, MODEL_FILE,
 };
 
 pub const METHOD: &str = "pets";
@@ -254,10 +254,17 @@ pub fn resume(dir: &Path, monitor: &dyn Monitor) -> Result<TrainReport> {
     train(&request, true, monitor)
 }
 
-/// A finished PETS checkpoint as a planner's dynamics in `env` (which must be the env it was trained on).
-pub fn load_dynamics(dir: &Path, env: &EnvName, propagation: Propagation, particles: usize) -> Result<PetsDynamics> {
+/// A PETS checkpoint as a planner's dynamics in `env` (which must be the env it was trained on); a run still
+/// in training only when `accept` takes it (then its best-validation weights so far).
+pub fn load_dynamics(
+    dir: &Path,
+    env: &EnvName,
+    propagation: Propagation,
+    particles: usize,
+    accept: Accept,
+) -> Result<PetsDynamics> {
     let opened = OpenedCheckpoint::open(dir)?;
-    opened.expect_finished(METHOD)?;
+    opened.expect(METHOD, accept)?;
     let run = read_run(&opened)?;
     if run.env != env.canonical() {
         return Err(Error::bad_file(
@@ -295,6 +302,7 @@ pub fn load_dynamics(dir: &Path, env: &EnvName, propagation: Propagation, partic
         propagation,
         particles,
     )
+    .map(|dynamics| dynamics.with_note(&opened.progress().unfinished_note()))
     .map_err(|e| Error::bad_file(&model_path, e.to_string()))
 }
 

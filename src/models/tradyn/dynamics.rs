@@ -91,10 +91,11 @@ impl BatchDynamics for TradynDynamics {
 
     fn describe(&self) -> String {
         format!(
-            "TRADYN model {} ({}) conditioned on {} calibration transitions (context mean)",
+            "TRADYN model {} ({}) conditioned on {} calibration transitions (context mean){}",
             self.model.loaded.dir.display(),
             self.model.variant_name(),
-            self.context_size
+            self.context_size,
+            self.model.loaded.progress.unfinished_note()
         )
     }
 }

@@ -18,6 +18,7 @@ use crate::envs::EnvName;
 use crate::error::{Error, Result};
 use crate::models::context::fast::LocalFeatures;
 use crate::models::context::{self, LoadedModel, StateSpace};
+use crate::train::Accept;
 
 pub const METHOD: &str = "tradyn";
 
@@ -38,7 +39,12 @@ pub struct TradynModel {
 
 impl TradynModel {
     pub fn load(dir: &Path) -> Result<Self> {
-        let loaded = context::load_method(dir, &EnvName::Unicycle(None), METHOD)?;
+        Self::load_accepting(dir, Accept::Finished)
+    }
+
+    /// Also a run still in training when `accept` takes it (its best-validation weights so far).
+    pub fn load_accepting(dir: &Path, accept: Accept) -> Result<Self> {
+        let loaded = context::load_method_accepting(dir, &EnvName::Unicycle(None), METHOD, accept)?;
         let spec = &loaded.run.model;
         let names_fit = spec.observations && spec.state_names.iter().map(String::as_str).eq(OBSERVATION_NAMES);
         if !names_fit || spec.action_dim != 2 || ![0, TERRAIN_FEATURES].contains(&spec.local_dim) {
