@@ -1633,7 +1633,7 @@ fn fuzz_every_reader() {
                     let mut counts = counts.lock().unwrap();
                     counts[t].add(&run);
                     let done: u64 = counts.iter().map(|c| c.runs).sum();
-                    if done % 500 == 0 {
+                    if done.is_multiple_of(500) {
                         eprintln!("fuzz: {done}/{} runs, {:.0} s", jobs.len(), start.elapsed().as_secs_f64());
                     }
                 }

@@ -14,8 +14,6 @@ use crate::util::seeding::{derive_seed, rng_for};
 /// The random stream under `--seed` that a replay's reset state (and toy noise) come from.
 pub(super) const REPLAY_STREAM: u64 = u64::from_be_bytes(*b"replay\0\0");
 
-/// Refuse before allocating: a dataset is built in memory before it is written.
-
 pub struct CollectSettings {
     pub env: EnvName,
     pub rollouts: usize,

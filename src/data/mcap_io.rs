@@ -129,13 +129,16 @@ pub fn read_messages<T: DeserializeOwned>(
     Ok((metadata, messages))
 }
 
+/// A file's metadata, its decoded messages (with channel ids) and a second topic's raw payloads.
+pub type MessagesAndRaw<T> = (BTreeMap<String, String>, Vec<(u32, T)>, Vec<Vec<u8>>);
+
 /// Like [`read_messages`], plus the raw payloads of a second topic (in file order).
 pub fn read_messages_and_raw<T: DeserializeOwned>(
     path: &Path,
     metadata_name: &str,
     topic: &str,
     raw_topic: &str,
-) -> Result<(BTreeMap<String, String>, Vec<(u32, T)>, Vec<Vec<u8>>)> {
+) -> Result<MessagesAndRaw<T>> {
     let (metadata, mut topics) = read_raw(path, metadata_name, &[topic, raw_topic])?;
     let raw = topics.pop().unwrap_or_default().into_iter().map(|(_, data)| data).collect();
     let messages = decode(path, topic, topics.pop().unwrap_or_default())?;

@@ -50,6 +50,7 @@ impl Default for BallEvalSettings {
 }
 
 /// Something that predicts a recording's future from a cut frame.
+#[allow(clippy::large_enum_variant)] // one per evaluation, never in a collection
 pub enum Predictor {
     /// The EKF; with a spin network its spin prior comes from the launcher settings.
     Ekf(LoadedBallModel),

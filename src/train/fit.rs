@@ -180,6 +180,7 @@ fn diverged(settings: &FitSettings, step: u64, what: &str, value: f64, checkpoin
     ))
 }
 
+#[allow(clippy::too_many_arguments)] // the checkpoint's parts, each owned by a different piece of the loop
 fn save(
     method: &dyn TrainingMethod,
     settings: &FitSettings,

@@ -48,15 +48,13 @@ impl ColoredNoise {
     pub fn sample_into<R: Rng + ?Sized>(&self, rng: &mut R, scratch: &mut [Complex<f64>], out: &mut [f64]) {
         let n = self.len;
         let bins = self.amplitudes.len();
-        for k in 0..bins {
+        for (k, (bin, amplitude)) in scratch[..bins].iter_mut().zip(&self.amplitudes).enumerate() {
             let re: f64 = rng.sample(StandardNormal);
-            let mut im: f64 = rng.sample(StandardNormal);
+            let im: f64 = rng.sample(StandardNormal);
             // Bins whose conjugate is themselves (DC, and Nyquist for even lengths) must be real.
-            if k == 0 || (n % 2 == 0 && k == n / 2) {
-                im = 0.0;
-            }
-            let re = if k == 0 || (n % 2 == 0 && k == n / 2) { re * std::f64::consts::SQRT_2 } else { re };
-            scratch[k] = Complex::new(re, im) * self.amplitudes[k];
+            let self_conjugate = k == 0 || (n.is_multiple_of(2) && k == n / 2);
+            *bin = if self_conjugate { Complex::new(re * std::f64::consts::SQRT_2, 0.0) } else { Complex::new(re, im) }
+                * *amplitude;
         }
         // Hermitian symmetry makes the inverse transform real.
         for k in bins..n {

@@ -5,6 +5,7 @@
 //! zero to every kernel sum it feeds.
 
 const LOG2_E: f64 = std::f64::consts::LOG2_E;
+#[allow(clippy::excessive_precision)] // the split of ln 2 must be exact to the last bit
 const LN2_HI: f64 = 6.931_471_803_691_238_2e-1;
 const LN2_LO: f64 = 1.908_214_929_270_587_7e-10;
 /// 1.5 · 2^52: adding it rounds to an integer held in the low mantissa bits.

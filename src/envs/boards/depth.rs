@@ -21,7 +21,7 @@ pub trait DenseIndex: BoardGame {
 }
 
 /// Breadth-first search backwards from the goal: the depth of every board from its shortest path.
-fn reverse_bfs<G: DenseIndex + ?Sized>(game: &G) -> Vec<u8> {
+fn reverse_bfs<G: DenseIndex>(game: &G) -> Vec<u8> {
     let mut depths = vec![UNREACHED; game.state_count()];
     let goal = game.index_of(game.goal());
     depths[goal] = 0;

@@ -70,9 +70,8 @@ impl Manipulator for Cursor {
 
     /// The move is applied (and clipped to the board) before the push is checked, as in the original.
     fn step(&mut self, action: &[f64]) -> Option<BoardPoint> {
-        for axis in 0..2 {
-            let delta = action[axis].clamp(-MAX_STEP, MAX_STEP);
-            self.position[axis] = (self.position[axis] + delta).clamp(0.0, 1.0);
+        for (position, delta) in self.position.iter_mut().zip(&action[..2]) {
+            *position = (*position + delta.clamp(-MAX_STEP, MAX_STEP)).clamp(0.0, 1.0);
         }
         (action[2] > PUSH_THRESHOLD).then_some(self.position)
     }

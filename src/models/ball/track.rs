@@ -127,6 +127,41 @@ pub fn plane_crossing(
     None
 }
 
+/// Measurements a filter sees at least before predicting (thesis 6.5.2).
+pub const MIN_FILTERED_MEASUREMENTS: usize = 10;
+/// Prediction–measurement pairs at the end of a trajectory whose largest distance is the error (6.5.2).
+pub const ERROR_PAIRS: usize = 5;
+
+/// The frame to filter until when predicting `horizon_frames` before the end: one horizon before the
+/// last frame, but never fewer than ten measurements.
+pub fn protocol_cut(recording: &Recording, horizon_frames: u64) -> Option<u64> {
+    let last = *recording.frames.last()?;
+    let tenth = recording
+        .frames
+        .iter()
+        .zip(&recording.positions)
+        .filter(|(_, p)| p.is_some())
+        .nth(MIN_FILTERED_MEASUREMENTS - 1)?
+        .0;
+    Some(last.saturating_sub(horizon_frames).max(*tenth))
+}
+
+/// Largest distance over the last five predicted points that have a measurement at the same frame.
+pub fn prediction_error(points: &[PredictedPoint], recording: &Recording) -> Option<f64> {
+    let measured: std::collections::HashMap<u64, [f64; 3]> =
+        recording.frames.iter().zip(&recording.positions).filter_map(|(f, p)| p.map(|p| (*f, p))).collect();
+    let pairs: Vec<f64> = points
+        .iter()
+        .filter_map(|p| {
+            measured.get(&p.frame).map(|m| (0..3).map(|i| (p.position[i] - m[i]).powi(2)).sum::<f64>().sqrt())
+        })
+        .collect();
+    if pairs.is_empty() {
+        return None;
+    }
+    Some(pairs[pairs.len().saturating_sub(ERROR_PAIRS)..].iter().copied().fold(0.0, f64::max))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -174,39 +209,4 @@ mod tests {
         let (_, crossing) = plane_crossing(&points, start, 0.0, 1.0).expect("crosses y = 1");
         assert_eq!(crossing[1], 1.0);
     }
-}
-
-/// Measurements a filter sees at least before predicting (thesis 6.5.2).
-pub const MIN_FILTERED_MEASUREMENTS: usize = 10;
-/// Prediction–measurement pairs at the end of a trajectory whose largest distance is the error (6.5.2).
-pub const ERROR_PAIRS: usize = 5;
-
-/// The frame to filter until when predicting `horizon_frames` before the end: one horizon before the
-/// last frame, but never fewer than ten measurements.
-pub fn protocol_cut(recording: &Recording, horizon_frames: u64) -> Option<u64> {
-    let last = *recording.frames.last()?;
-    let tenth = recording
-        .frames
-        .iter()
-        .zip(&recording.positions)
-        .filter(|(_, p)| p.is_some())
-        .nth(MIN_FILTERED_MEASUREMENTS - 1)?
-        .0;
-    Some(last.saturating_sub(horizon_frames).max(*tenth))
-}
-
-/// Largest distance over the last five predicted points that have a measurement at the same frame.
-pub fn prediction_error(points: &[PredictedPoint], recording: &Recording) -> Option<f64> {
-    let measured: std::collections::HashMap<u64, [f64; 3]> =
-        recording.frames.iter().zip(&recording.positions).filter_map(|(f, p)| p.map(|p| (*f, p))).collect();
-    let pairs: Vec<f64> = points
-        .iter()
-        .filter_map(|p| {
-            measured.get(&p.frame).map(|m| (0..3).map(|i| (p.position[i] - m[i]).powi(2)).sum::<f64>().sqrt())
-        })
-        .collect();
-    if pairs.is_empty() {
-        return None;
-    }
-    Some(pairs[pairs.len().saturating_sub(ERROR_PAIRS)..].iter().copied().fold(0.0, f64::max))
 }

@@ -231,6 +231,7 @@ impl FastContextModel {
     /// Entropy of q(β | base ∪ chop(R)) per row, where R is the row's imagined rollout from `init` (`actions`
     /// rows × H × A, `states` its predictions rows × H × S) and `base_pool` the pooled features of the
     /// transitions observed so far.
+    #[allow(clippy::too_many_arguments)] // flat buffers of the hot path, kept apart to avoid copies
     pub fn entropy_after(
         &self,
         base_pool: &[f32],

@@ -156,6 +156,7 @@ impl MlpVae {
 
 /// The VAE of either observation kind, behind one interface: flat observation rows in, latents out.
 #[derive(Debug, Clone)]
+#[allow(clippy::large_enum_variant)] // one per model, never in a collection
 pub enum VaeNet {
     Images { side: usize, vae: ConvVae },
     Angles(MlpVae),

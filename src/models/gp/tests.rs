@@ -119,7 +119,7 @@ fn a_singular_kernel_matrix_is_recovered_by_jitter_and_bad_data_are_errors() {
     assert!(gp.jitter() > 0.0 && gp.jitter() <= 1e-4, "jitter {}", gp.jitter());
     assert!(gp.neg_log_likelihood().is_finite());
 
-    let err = |r: crate::error::Result<ConditionedGp>| r.err().expect("an error").to_string();
+    let err = |r: crate::error::Result<ConditionedGp>| r.expect_err("an error").to_string();
     let e = err(ConditionedGp::condition(&[0.5, f64::NAN], &[1.0, 1.0], &[0.0; 2], kernel.clone(), 0.1));
     assert!(e.contains("inputs") && e.contains("NaN"), "{e}");
     let e = err(ConditionedGp::condition(&[0.5, 1.0], &[1.0], &[0.0], kernel.clone(), 0.1));
