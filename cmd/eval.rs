@@ -733,26 +733,29 @@ fn eval_dlgpd(global: &GlobalArgs, provenance: &Provenance, a: DlgpdArgs) -> any
     }
     if !summary.predictions.is_empty() {
         say!(
-            "{:<34} {:>8} {:>14} {:>6} {:>10} {:>9}",
+            "{:<34} {:>8} {:>14} {:>6} {:>10} {:>9} {:>20}",
             "reward RMSE, held-out rollouts",
             "encoded",
             "open loop h=1",
             "h=10",
             "constant",
-            "θ̇ R²"
+            "θ̇ R²",
+            "action response h=5"
         );
     }
     for p in &summary.predictions {
         let at = |h: usize| p.prediction.errors.open_loop_rmse.get(h).copied().unwrap_or(f64::NAN);
+        let response = p.prediction.action_response.iter().find(|r| r.horizon == 5).map_or(f64::NAN, |r| r.response);
         say!(
-            "{:<21} {:<12} {:>8.2} {:>14.2} {:>6.2} {:>10.2} {:>9.2}",
+            "{:<21} {:<12} {:>8.2} {:>14.2} {:>6.2} {:>10.2} {:>9.2} {:>20.2}",
             p.env,
             p.evidence,
             p.prediction.errors.encoded_rmse,
             at(1),
             at(10),
             p.prediction.errors.constant_rmse,
-            p.prediction.linear_probe_r2[2]
+            p.prediction.linear_probe_r2[2],
+            response
         );
     }
     for t in &summary.tests {

@@ -79,6 +79,28 @@ fn train_on_angles_then_plan_on_swapped_evidence() {
     assert!(report.contains("## Reward prediction") && !report.contains("## Swing-ups"), "{report}");
     assert!(!dir.path().join("check/results.csv").exists());
 
+    // The action response: the standard pendulum's evidence answers a held action the same way on both systems,
+    // while the inverted system answers it the other way round, so that setting mirrors the standard one.
+    let run = mbrl(dir.path())
+        .args(["eval", "dlgpd", "--model", "models/d", "--env", "pendulum", "--env", "pendulum:inverted"])
+        .args(["--evidence-rollouts", "3", "--prediction-only", "-q", "--out", "mirror"])
+        .output()
+        .unwrap();
+    assert!(run.status.success(), "{}", stderr_of(&run));
+    let csv = std::fs::read_to_string(dir.path().join("mirror/action_response.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = csv.lines().skip(1).map(|l| l.split(',').collect()).collect();
+    assert_eq!(csv.lines().next(), Some("env,evidence,horizon,response,true_effect"));
+    assert_eq!(rows.len(), 3 * 3, "{csv}");
+    let response = |env: &str, evidence: &str, horizon: &str| -> f64 {
+        let row = rows.iter().find(|r| r[0] == env && r[1] == evidence && r[2] == horizon).expect("row");
+        row[3].parse().unwrap()
+    };
+    for horizon in ["1", "5", "10"] {
+        let (standard, mirrored) =
+            (response("pendulum", "matching", horizon), response("pendulum:inverted", "mismatching", horizon));
+        assert!(standard.is_finite() && (standard + mirrored).abs() <= 0.15 * standard.abs() + 0.05, "{csv}");
+    }
+
     // Planning without evidence, or an image model's evidence without frames, is a one-line error.
     let out = mbrl(dir.path()).args(["plan", "--env", "pendulum", "--model", "models/d", "-q"]).output().unwrap();
     assert_one_line_error(&out, &["DLGPD", "--evidence"]);

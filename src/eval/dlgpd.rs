@@ -9,6 +9,7 @@ use std::path::Path;
 
 use serde::Serialize;
 
+use super::dlgpd_action_response::RESPONSE_HORIZONS;
 use super::dlgpd_prediction::{reward_prediction, RewardPrediction};
 use super::plot::{line_plot, line_plot_in, rising_line_plot, Series};
 use super::stats::{wilcoxon_signed_rank, Alternative};
@@ -289,7 +290,7 @@ fn prediction_checks(
         })?;
         let held_out =
             cached(&mut held_outs, variant, || evidence_rollouts(variant, HELD_OUT_ROLLOUTS, held_out_seed, images))?;
-        let prediction = reward_prediction(trained, dynamics, held_out, held_out_seed)?;
+        let prediction = reward_prediction(trained, dynamics, held_out, variant, held_out_seed)?;
         checks.push(PredictionCheck {
             env: variant.env_name(),
             evidence: kind,
@@ -390,7 +391,7 @@ fn write_report(
         files.extend(["summary.csv", "wilcoxon.csv", "returns.png", "success.png"].map(|f| format!("`{f}`")));
     }
     write_prediction_section(run_dir, findings.predictions, &mut md)?;
-    files.extend(["prediction.csv", "prediction.png"].map(|f| format!("`{f}`")));
+    files.extend(["prediction.csv", "prediction.png", "action_response.csv"].map(|f| format!("`{f}`")));
     if matches!(trained.run.observation, ObservationKind::Images { .. }) {
         files.push("`reconstructions.png` (top: observed newer frames; bottom: decoded from the encoder mean)".into());
     }
@@ -542,6 +543,25 @@ fn write_prediction_section(run_dir: &RunDir, predictions: &[PredictionCheck], m
         &["env", "evidence", "evidence_rollouts", "horizon", "reward_rmse"],
         &rows,
     )?;
+    let responses: Vec<Vec<String>> = predictions
+        .iter()
+        .flat_map(|p| {
+            p.prediction.action_response.iter().map(|r| {
+                vec![
+                    p.env.clone(),
+                    p.evidence.to_string(),
+                    r.horizon.to_string(),
+                    format!("{:.5}", r.response),
+                    format!("{:.5}", r.true_effect),
+                ]
+            })
+        })
+        .collect();
+    write_csv(
+        &run_dir.file("action_response.csv"),
+        &["env", "evidence", "horizon", "response", "true_effect"],
+        &responses,
+    )?;
     let mut series: Vec<Series> = predictions
         .iter()
         .map(|p| Series {
@@ -572,10 +592,17 @@ fn write_prediction_section(run_dir: &RunDir, predictions: &[PredictionCheck], m
          *Constant*: the held-out rewards' own mean, the best a model that ignores the state can do. Reward RMSE \
          (a step's reward lies in [−16.3, 0]). *Probe R²*: cos θ / sin θ / θ̇ regressed linearly on the latent \
          means of the held-out frames; the transition GPs predict each latent dimension around its current value, \
-         so a latent that holds the velocity only nonlinearly is harder for them to roll forward.\n\n\
-         | env | evidence | encoded | {} | constant | probe R² |\n|---|---|---|{}---|---|\n",
+         so a latent that holds the velocity only nonlinearly is harder for them to roll forward. *Action \
+         response*: from each held-out start the simulator runs with the largest and with the smallest action held \
+         for h steps, and the model rolls its latent mean from the same encoding with the same actions; the \
+         model's latent difference between the two, projected on the encoded true one (1: right; 0: the model \
+         ignores the action, so CEM has nothing to choose between). *True effect*: the encoded true difference's \
+         RMS over the latents' spread (small: the encoder barely sees what the action did).\n\n\
+         | env | evidence | encoded | {} | constant | probe R² | action response h = {} | true effect |\n\
+         |---|---|---|{}---|---|---|---|\n",
         predictions.first().map_or(0, |p| p.evidence_rollouts),
         TABLE_HORIZONS.iter().map(|h| format!("h = {h}")).collect::<Vec<_>>().join(" | "),
+        RESPONSE_HORIZONS.map(|h| h.to_string()).join(" / "),
         "---|".repeat(TABLE_HORIZONS.len()),
     ));
     for p in predictions {
@@ -584,13 +611,16 @@ fn write_prediction_section(run_dir: &RunDir, predictions: &[PredictionCheck], m
             .map(|&h| p.prediction.errors.open_loop_rmse.get(h).map_or("–".into(), |e| format!("{e:.2}")))
             .collect();
         let [c, s, v] = p.prediction.linear_probe_r2;
+        let responses = &p.prediction.action_response;
         md.push_str(&format!(
-            "| {} | {} | {:.2} | {} | {:.2} | {c:.2} / {s:.2} / {v:.2} |\n",
+            "| {} | {} | {:.2} | {} | {:.2} | {c:.2} / {s:.2} / {v:.2} | {} | {} |\n",
             p.env,
             p.evidence,
             p.prediction.errors.encoded_rmse,
             cells.join(" | "),
-            p.prediction.errors.constant_rmse
+            p.prediction.errors.constant_rmse,
+            responses.iter().map(|r| format!("{:.2}", r.response)).collect::<Vec<_>>().join(" / "),
+            responses.iter().map(|r| format!("{:.2}", r.true_effect)).collect::<Vec<_>>().join(" / "),
         ));
     }
     Ok(())

@@ -7,7 +7,9 @@ use serde::Serialize;
 
 use nalgebra::{DMatrix, DVector};
 
+use super::dlgpd_action_response::{action_response, ActionResponse};
 use crate::data::{Dataset, Rollout};
+use crate::envs::pendulum::PendulumVariant;
 use crate::error::{Error, Result};
 use crate::models::dlgpd::data::Windows;
 use crate::models::dlgpd::dynamics::LatentDynamics;
@@ -24,20 +26,42 @@ pub struct RewardPrediction {
     /// latent dimension around its current value; a latent that holds the velocity only through a
     /// nonlinear fold gives them a harder function to learn than one near-linear in the state.
     pub linear_probe_r2: [f64; 3],
+    /// How the model's latent answers a held extreme action, against the encoded simulator's answer.
+    pub action_response: Vec<ActionResponse>,
 }
 
-/// Predict the rewards of `held_out` (random-action rollouts of the system at hand) with `dynamics`.
+/// Predict the rewards of `held_out` (random-action rollouts of `variant`, the system at hand) with
+/// `dynamics`.
 pub fn reward_prediction(
     trained: &TrainedDlgpd,
     dynamics: &LatentDynamics,
     held_out: &Dataset,
+    variant: &PendulumVariant,
     seed: u64,
 ) -> Result<RewardPrediction> {
     let windows = Windows::from_dataset(held_out, trained.run.observation, seed)?;
     let rows: Vec<usize> = (0..windows.len()).collect();
     let latents = encoded_means(&trained.vae, &windows, &rows)?;
-    let linear_probe_r2 = linear_probe(&latents, dynamics.latent_dim(), &window_states(held_out, &windows)?)?;
-    Ok(RewardPrediction { errors: reward_errors(dynamics, &windows, &rows, &latents)?, linear_probe_r2 })
+    let dims = dynamics.latent_dim();
+    let linear_probe_r2 = linear_probe(&latents, dims, &window_states(held_out, &windows)?)?;
+    let action_response = action_response(trained, dynamics, held_out, variant, rms_spread(&latents, dims), seed)?;
+    Ok(RewardPrediction {
+        errors: reward_errors(dynamics, &windows, &rows, &latents)?,
+        linear_probe_r2,
+        action_response,
+    })
+}
+
+/// RMS distance of latent rows from their mean.
+fn rms_spread(latents: &[f64], dims: usize) -> f64 {
+    let rows = latents.len() / dims.max(1);
+    if rows == 0 {
+        return f64::NAN;
+    }
+    let mean: Vec<f64> = (0..dims).map(|d| latents.iter().skip(d).step_by(dims).sum::<f64>() / rows as f64).collect();
+    let square: f64 =
+        latents.chunks(dims).map(|z| z.iter().zip(&mean).map(|(v, m)| (v - m).powi(2)).sum::<f64>()).sum();
+    (square / rows as f64).sqrt()
 }
 
 /// The simulator state (θ, θ̇) of each window's newer observation, in window order.

@@ -5,6 +5,7 @@ pub mod boards;
 pub mod context;
 pub mod dataset_report;
 pub mod dlgpd;
+pub mod dlgpd_action_response;
 pub mod dlgpd_prediction;
 pub mod plot;
 pub mod quick;

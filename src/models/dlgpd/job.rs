@@ -137,6 +137,13 @@ pub fn train(request: &TrainRequest, resume: bool, monitor: &dyn Monitor) -> Res
                 restart_on_rewind: false,
                 path: None,
             },
+            crate::run::PanelSpec {
+                title: "GP action lengthscale (min; actions span 4)".into(),
+                x_label: "step".into(),
+                series: vec!["dlgpd/action_lengthscale".into()],
+                restart_on_rewind: false,
+                path: None,
+            },
         ],
         &[
             ("observations", observed),

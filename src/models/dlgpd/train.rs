@@ -355,14 +355,32 @@ impl TrainingMethod for DlgpdTrainer {
         let Some(l) = &self.last else {
             return Vec::new();
         };
-        vec![
+        let mut scalars = vec![
             ("dlgpd/reconstruction", l.reconstruction),
             ("dlgpd/entropy", l.entropy),
             ("dlgpd/transition_gp_nll", l.gp.transition),
             ("dlgpd/reward_gp_nll", l.gp.reward),
             ("dlgpd/snr_penalty", l.gp.snr),
-        ]
+        ];
+        if let Some(gps) = &self.gps {
+            scalars.push(("dlgpd/action_lengthscale", shortest_action_lengthscale(&gps.transition)));
+        }
+        scalars
     }
+}
+
+/// The shortest lengthscale any transition GP has on an action input (inputs are [standardized latent, raw
+/// action]; actions span [−2, 2]). Far above that span, no latent dimension's predicted next value depends on
+/// the action, and a planner on the model has nothing to choose between.
+fn shortest_action_lengthscale(transition: &[GpHypers]) -> f64 {
+    transition
+        .iter()
+        .flat_map(|gp| {
+            let lengthscales = gp.kernel().lengthscales;
+            let latent = transition.len();
+            lengthscales.into_iter().skip(latent)
+        })
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// Whether `stored` holds a tensor of f64 values named `name` with `len` entries.
