@@ -17,7 +17,7 @@ use mbrl::models::tradyn;
 use mbrl::run::dir::{Provenance, METRICS_FILE};
 use mbrl::train::config::apply_toml_file;
 use mbrl::train::data_file::scalar_history;
-use mbrl::train::{loss_history, OpenedCheckpoint};
+use mbrl::train::{loss_history, OpenedCheckpoint, Start};
 use mbrl::util::table::write_csv;
 
 use crate::common::{command_line, file_stem, run_job, GlobalArgs};
@@ -73,6 +73,7 @@ Examples:
   mbrl train --method pets --env pendulum --data datasets/pendulum-random.mcap --out models/pets-pendulum
   mbrl train --method pets --data a.mcap --data b.mcap --preset medium --config pets.toml --out models/pets-big
   mbrl train --resume models/pets-big
+  mbrl train --resume models/pets-big --steps 8000
   mbrl collect --env ball --trajectories 108 --augment-rotations 19 --out datasets/ball-train.mcap
   mbrl train --method ball-ekf --data datasets/ball-train.mcap --out models/ball-ekf --steps 2000
   mbrl collect --env toy:inner --instances 1000 --steps 100 --out datasets/toy-inner.mcap
@@ -86,7 +87,9 @@ Examples:
 
 A config file (TOML) sets any key of the method's config.json `config` table; unknown keys are errors.
 Flags given explicitly override the file. `--resume DIR` continues a stopped run from its last checkpoint
-with the config and data it was started with, and ends with the same bytes as an uninterrupted run.")]
+with the config and data it was started with, and ends with the same bytes as an uninterrupted run.
+`--resume DIR --steps N` trains a pets or dlgpd run, finished or not, on to N steps in total; its weights
+end as those of a run started with N steps, when the old total was a multiple of the validation interval.")]
 pub struct TrainArgs {
     /// What to train.
     #[arg(long, value_enum, required_unless_present = "resume")]
@@ -102,7 +105,7 @@ pub struct TrainArgs {
     #[arg(long)]
     out: Option<PathBuf>,
     /// Continue the stopped run in this checkpoint directory.
-    #[arg(long, conflicts_with_all = ["method", "data", "env", "out", "config", "preset", "ensemble", "steps", "batch", "lr", "reward", "launcher_prior", "skills", "env_steps", "no_relabel", "no_second_best", "no_novelty", "no_terrain"])]
+    #[arg(long, conflicts_with_all = ["method", "data", "env", "out", "config", "preset", "ensemble", "batch", "lr", "reward", "launcher_prior", "skills", "env_steps", "no_relabel", "no_second_best", "no_novelty", "no_terrain"])]
     resume: Option<PathBuf>,
     /// Hyperparameters from a TOML file (pets, context), over the preset's.
     #[arg(long)]
@@ -113,7 +116,8 @@ pub struct TrainArgs {
     /// Ensemble members (pets; default 5).
     #[arg(long)]
     ensemble: Option<usize>,
-    /// Optimizer steps (pets, context, dlgpd: the preset's; ball-ekf: 1000).
+    /// Optimizer steps (pets, context, dlgpd: the preset's; ball-ekf: 1000). With --resume: train a pets or
+    /// dlgpd run, finished or not, on to this many steps in total.
     #[arg(long)]
     steps: Option<u64>,
     /// Batch size: transitions per member (pets, 256), chunks (ball-ekf, thesis 64), transitions (dlgpd: the
@@ -153,11 +157,11 @@ pub struct TrainArgs {
 }
 
 pub fn run(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
-    if let Some(dir) = &args.resume {
-        return resume(global, dir);
-    }
     if args.steps == Some(0) {
         bail!("--steps must be at least 1");
+    }
+    if let Some(dir) = &args.resume {
+        return resume(global, dir, args.steps);
     }
     match args.method.expect("clap requires --method without --resume") {
         Method::Pets => train_pets(global, args),
@@ -169,11 +173,22 @@ pub fn run(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
     }
 }
 
-fn resume(global: &GlobalArgs, dir: &Path) -> anyhow::Result<()> {
+fn resume(global: &GlobalArgs, dir: &Path, extend_to: Option<u64>) -> anyhow::Result<()> {
     let method = OpenedCheckpoint::open(dir)?.manifest.method;
+    // Training that depends on its total (context's p_ctx schedule, ball-ekf's and seads' budgets) cannot be
+    // lengthened without changing what was already trained.
+    if extend_to.is_some() && method != pets::METHOD && method != dlgpd::METHOD {
+        bail!(
+            "{}: --steps with --resume extends a run, which works for {} and {} runs; a {method} run's training \
+             depends on its total, so start a new run with the steps you want",
+            dir.display(),
+            pets::METHOD,
+            dlgpd::METHOD
+        );
+    }
     match method.as_str() {
         pets::METHOD => {
-            let report = run_job(global, "train pets (resumed)", |monitor| pets::resume(dir, monitor))?;
+            let report = run_job(global, "train pets (resumed)", |monitor| pets::resume(dir, extend_to, monitor))?;
             print_pets_report(&report, dir)
         }
         ball_job::METHOD => {
@@ -193,7 +208,7 @@ fn resume(global: &GlobalArgs, dir: &Path) -> anyhow::Result<()> {
             print_seads_report(&report, dir)
         }
         dlgpd::METHOD => {
-            let report = run_job(global, "train dlgpd (resumed)", |monitor| dlgpd::resume(dir, monitor))?;
+            let report = run_job(global, "train dlgpd (resumed)", |monitor| dlgpd::resume(dir, extend_to, monitor))?;
             print_dlgpd_report(&report, dir)
         }
         other => bail!(
@@ -264,7 +279,7 @@ fn train_pets(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
         seed: global.seed,
         provenance: Provenance::new(command_line(), global.seed, global.thread_count()),
     };
-    let report = run_job(global, "train pets", |monitor| pets::train(&request, false, monitor))?;
+    let report = run_job(global, "train pets", |monitor| pets::train(&request, Start::Fresh, monitor))?;
     print_pets_report(&report, &out)
 }
 
@@ -671,7 +686,7 @@ fn train_dlgpd(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
         seed: global.seed,
         provenance: Provenance::new(command_line(), global.seed, global.thread_count()),
     };
-    let report = run_job(global, "train dlgpd", |monitor| dlgpd::train(&request, false, monitor))?;
+    let report = run_job(global, "train dlgpd", |monitor| dlgpd::train(&request, Start::Fresh, monitor))?;
     print_dlgpd_report(&report, &out)
 }
 

@@ -119,7 +119,7 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l preset -d 'Network s
 medium\t'4 × 200 SiLU units, 5000 steps: mbrl-lib\'s PETS pendulum network'
 paper\t'The paper\'s scale (context: Table B.1; seads: 500k/10M env steps; dlgpd: batch 1024, 28 000 steps)'"
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l ensemble -d 'Ensemble members (pets; default 5)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l steps -d 'Optimizer steps (pets, context, dlgpd: the preset\'s; ball-ekf: 1000)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l steps -d 'Optimizer steps (pets, context, dlgpd: the preset\'s; ball-ekf: 1000). With --resume: train a pets or dlgpd run, finished or not, on to this many steps in total' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l batch -d 'Batch size: transitions per member (pets, 256), chunks (ball-ekf, thesis 64), transitions (dlgpd: the preset\'s; the paper 1024)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l lr -d 'Adam learning rate (pets, dlgpd: 1e-3; ball-ekf: thesis 5e-3)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l reward -d 'Where the model\'s reward comes from (pets; default: known where the env has a closed form)' -r -f -a "known\t'The env\'s closed-form reward (pendulum variants without hidden actuators)'

@@ -9,6 +9,7 @@ use mbrl::data::read_dataset;
 use mbrl::models::dlgpd::config::{DlgpdConfig, Preset};
 use mbrl::models::dlgpd::job as dlgpd;
 use mbrl::run::dir::Provenance;
+use mbrl::train::Start;
 
 fn collect(dir: &Path, name: &str, env: &str, rollouts: &str, images: bool) {
     let mut cmd = mbrl(dir);
@@ -130,9 +131,9 @@ fn resume_ends_with_the_bytes_of_an_uninterrupted_run() {
         seed: 4,
         provenance: Provenance::new("mbrl train …".into(), 4, 1),
     };
-    dlgpd::train(&request("whole"), false, &mbrl::run::NullMonitor).unwrap();
+    dlgpd::train(&request("whole"), Start::Fresh, &mbrl::run::NullMonitor).unwrap();
     let stop = StopAfter::new(25);
-    let err = dlgpd::train(&request("stopped"), false, &stop).err().unwrap();
+    let err = dlgpd::train(&request("stopped"), Start::Fresh, &stop).err().unwrap();
     assert!(matches!(err, mbrl::Error::Cancelled), "{err}");
 
     // A run still in training is refused, unless asked for; its report then says how far it got.
@@ -157,12 +158,28 @@ fn resume_ends_with_the_bytes_of_an_uninterrupted_run() {
     let model_files = |d: &str| -> Vec<(String, Vec<u8>)> {
         dir_bytes(&dir.path().join(d)).into_iter().filter(|(n, _)| !n.starts_with("loss")).collect()
     };
-    let (whole, resumed) = (model_files("whole"), model_files("stopped"));
+    let whole = model_files("whole");
     let names = |files: &[(String, Vec<u8>)]| files.iter().map(|f| f.0.clone()).collect::<Vec<_>>();
-    assert_eq!(names(&whole), names(&resumed));
-    for ((name, a), (_, b)) in whole.iter().zip(&resumed) {
-        assert!(a == b, "{name} differs after resuming");
-    }
+    let same_as_whole = |run: &str| {
+        let files = model_files(run);
+        assert_eq!(names(&whole), names(&files));
+        for ((name, a), (_, b)) in whole.iter().zip(&files) {
+            assert!(a == b, "{name} of {run} differs from the uninterrupted run");
+        }
+    };
+    same_as_whole("stopped");
+
+    // A finished run of 20 steps, trained on to 30, is the run that was started with 30.
+    let short = dlgpd::TrainRequest { config: DlgpdConfig { steps: 20, ..config.clone() }, ..request("short") };
+    dlgpd::train(&short, Start::Fresh, &mbrl::run::NullMonitor).unwrap();
+    let extend = |steps: &str| {
+        mbrl(dir.path()).args(["train", "--resume", "short", "--steps", steps, "--no-tui"]).output().unwrap()
+    };
+    assert_one_line_error(&extend("10"), &["short", "started for 20 steps", "--steps 10 would shorten it"]);
+    assert_one_line_error(&extend("20"), &["short", "already finished"]);
+    let out = extend("30");
+    assert!(out.status.success(), "{}", stderr_of(&out));
+    assert_extended_like(&dir.path().join("whole"), &dir.path().join("short"));
 }
 
 #[test]

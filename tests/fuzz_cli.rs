@@ -286,6 +286,8 @@ fn targets() -> Vec<Target> {
             concat!("plan --env pendulum --model {in} --evidence roll.mcap --out {out}", cheap_plan!()),
         ),
         target("dlgpd-resume", Input::Checkpoint { dir: "dlgpd-resume", files: RESUME_FILES }, "train --resume {in}"),
+        // A finished run trained on past its total (its 5 steps, one more).
+        target("dlgpd-extend", Input::Checkpoint { dir: "dlgpd", files: RESUME_FILES }, "train --resume {in} --steps 6"),
         // A run still in training, looked at with `--allow-incomplete` (the unfinished copies made for resume).
         target(
             "dlgpd-eval-incomplete",

@@ -8,6 +8,7 @@ use common::*;
 use mbrl::data::{read_dataset, write_dataset};
 use mbrl::models::pets::{self, PetsConfig, Preset};
 use mbrl::run::dir::Provenance;
+use mbrl::train::Start;
 
 /// A network small enough to train in a second; checkpoints every 20 steps.
 const TINY: &str = "hidden_layers = 2\nhidden_units = 16\nvalidate_every = 10\ncheckpoint_every = 20\n";
@@ -74,10 +75,10 @@ fn resume_ends_with_the_bytes_of_an_uninterrupted_run() {
         seed: 5,
         provenance: Provenance::new("mbrl train …".into(), 5, 1),
     };
-    pets::train(&request("whole"), false, &mbrl::run::NullMonitor).unwrap();
+    pets::train(&request("whole"), Start::Fresh, &mbrl::run::NullMonitor).unwrap();
     // Stopped after step 50: the last checkpoint is step 40, so steps 41–50 are redone after resuming.
     let stop = StopAfter::new(50);
-    let err = pets::train(&request("stopped"), false, &stop).err().unwrap();
+    let err = pets::train(&request("stopped"), Start::Fresh, &stop).err().unwrap();
     assert!(matches!(err, mbrl::Error::Cancelled), "{err}");
     let manifest: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dir.path().join("stopped/checkpoint.json")).unwrap()).unwrap();
@@ -88,17 +89,27 @@ fn resume_ends_with_the_bytes_of_an_uninterrupted_run() {
 
     let out = mbrl(dir.path()).args(["train", "--resume", "stopped", "--no-tui"]).output().unwrap();
     assert!(out.status.success(), "{}", stderr_of(&out));
-    let (whole, resumed) = (dir_bytes(&dir.path().join("whole")), dir_bytes(&dir.path().join("stopped")));
+    let whole = dir_bytes(&dir.path().join("whole"));
     let names = |files: &[(String, Vec<u8>)]| files.iter().map(|f| f.0.clone()).collect::<Vec<_>>();
-    assert_eq!(names(&whole), names(&resumed));
-    for ((name, a), (_, b)) in whole.iter().zip(&resumed) {
-        assert!(
-            a == b,
-            "{name} differs after resuming:\n{}\n---\n{}",
-            String::from_utf8_lossy(a).chars().take(600).collect::<String>(),
-            String::from_utf8_lossy(b).chars().take(600).collect::<String>()
-        );
-    }
+    let same_as_whole = |files: &[(String, Vec<u8>)]| {
+        assert_eq!(names(&whole), names(files));
+        for ((name, a), (_, b)) in whole.iter().zip(files) {
+            assert!(
+                a == b,
+                "{name} differs from the uninterrupted run:\n{}\n---\n{}",
+                String::from_utf8_lossy(a).chars().take(600).collect::<String>(),
+                String::from_utf8_lossy(b).chars().take(600).collect::<String>()
+            );
+        }
+    };
+    same_as_whole(&dir_bytes(&dir.path().join("stopped")));
+
+    // A finished run of 40 steps, trained on to 70, is the run that was started with 70.
+    let short = pets::TrainRequest { config: PetsConfig { steps: 40, ..config.clone() }, ..request("short") };
+    pets::train(&short, Start::Fresh, &mbrl::run::NullMonitor).unwrap();
+    let out = mbrl(dir.path()).args(["train", "--resume", "short", "--steps", "70", "--no-tui"]).output().unwrap();
+    assert!(out.status.success(), "{}", stderr_of(&out));
+    assert_extended_like(&dir.path().join("whole"), &dir.path().join("short"));
 }
 
 #[test]

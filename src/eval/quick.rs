@@ -28,6 +28,7 @@ use crate::models::pets::{self, PetsConfig, Preset, Propagation};
 use crate::models::seads;
 use crate::run::dir::Provenance;
 use crate::run::Monitor;
+use crate::train::Start;
 use crate::util::atomic::write_text;
 use crate::util::seeding::derive_seed;
 
@@ -149,7 +150,7 @@ fn pets_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) ->
         seed: provenance.seed,
         provenance: provenance.clone(),
     };
-    let trained = pets::train(&request, false, monitor)?;
+    let trained = pets::train(&request, Start::Fresh, monitor)?;
     let model = pets::load_dynamics(
         &request.out,
         &collect.env,
@@ -349,7 +350,7 @@ fn dlgpd_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) -
         seed: provenance.seed,
         provenance: provenance.clone(),
     };
-    dlgpd::train(&request, false, monitor)?;
+    dlgpd::train(&request, Start::Fresh, monitor)?;
     let trained = dlgpd::load(&request.out)?;
     let mut cem = ControlSettings::authors(PendulumVariant::Inverted).cem;
     cem.candidates = QUICK_DLGPD_CANDIDATES;

@@ -13,15 +13,60 @@ use crate::run::{Event, JsonlMonitor, Monitor, Tee};
 /// A billion optimizer steps: beyond any training budget, so a larger count is a typo or a corrupt config.
 pub const MAX_TRAIN_STEPS: u64 = 1_000_000_000;
 
+/// How [`run_training`] treats what is already in the checkpoint directory.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Start {
+    /// A new run: from its first moment nothing in the directory passes for a model.
+    Fresh,
+    /// The unfinished run in the directory goes on with its own config.
+    Resume,
+    /// The run in the directory, finished or not, goes on to a larger total of steps. Its config changes in
+    /// that total only (the caller builds it from the checkpoint's), and only for methods whose training does
+    /// not depend on the total, so the run ends as one started with the larger total would have.
+    Extend,
+}
+
+impl Start {
+    pub fn resuming(resume: bool) -> Start {
+        if resume {
+            Start::Resume
+        } else {
+            Start::Fresh
+        }
+    }
+}
+
+/// Whether `train --resume DIR --steps N` extends the run in `opened` (whose config asks for `config_steps`):
+/// the new total, or `None` for a plain resume. A smaller total is refused: a run is never cut short.
+pub fn extension(opened: &OpenedCheckpoint, config_steps: u64, requested: Option<u64>) -> Result<Option<u64>> {
+    match requested {
+        None => Ok(None),
+        Some(total) if total == config_steps => Ok(None),
+        Some(total) if total < config_steps => Err(Error::bad_file(
+            opened.dir.path(),
+            format!(
+                "was started for {config_steps} steps; --steps {total} would shorten it (with --resume, --steps only \
+                 extends a run)"
+            ),
+        )),
+        Some(total) if total > MAX_TRAIN_STEPS => Err(Error::config(format!(
+            "--steps {total}: at most {MAX_TRAIN_STEPS} (months on any machine mbrl runs on)"
+        ))),
+        Some(total) => Ok(Some(total)),
+    }
+}
+
 /// Runs `method` to the end in `dir`. A fresh run writes `config` (the full description a resumed run is rebuilt
-/// from) and starts the metrics log with `view`; with `resume`, `dir` must hold an unfinished checkpoint of
-/// the same config, and the run continues from it so that it ends with the bytes an uninterrupted run would.
+/// from) and starts the metrics log with `view`. To resume, `dir` must hold an unfinished checkpoint of the same
+/// config, and the run continues from it so that it ends with the bytes an uninterrupted run would. To extend,
+/// the new config is staged with the next checkpoint, so until that checkpoint the directory still holds the
+/// run as it was.
 pub fn run_training(
     dir: &Path,
     config: &serde_json::Value,
     settings: &FitSettings,
     method: &mut dyn TrainingMethod,
-    resume: bool,
+    start: Start,
     view: &[Event],
     monitor: &dyn Monitor,
 ) -> Result<FitOutcome> {
@@ -35,7 +80,24 @@ pub fn run_training(
     for event in view {
         monitor.emit(event);
     }
-    if resume {
+    if start == Start::Extend {
+        let opened = OpenedCheckpoint::open(dir)?;
+        if settings.total_steps <= opened.manifest.total_steps {
+            return Err(Error::config(format!(
+                "extending {} to {} steps: the run already has {}",
+                dir.display(),
+                settings.total_steps,
+                opened.manifest.total_steps
+            )));
+        }
+        opened.dir.settle()?;
+        method.restore(&opened.tensors(STATE_FILE)?)?;
+        // Everything is read from the checkpoint before the new config is staged beside it.
+        let point = opened.resume_point()?;
+        let entry = opened.dir.write_file(CONFIG_FILE, &config_bytes)?;
+        return continue_run(&opened, settings, method, &entry, point, monitor);
+    }
+    if start == Start::Resume {
         let opened = OpenedCheckpoint::open(dir)?;
         if opened.manifest.total_steps != settings.total_steps {
             return Err(Error::bad_file(
@@ -62,15 +124,8 @@ pub fn run_training(
         // A checkpoint killed halfway into place is finished first, so this run stages its own cleanly.
         opened.dir.settle()?;
         method.restore(&opened.tensors(STATE_FILE)?)?;
-        let metrics_path = opened.dir.file(METRICS_FILE);
-        let metrics = JsonlMonitor::resume(&metrics_path, opened.manifest.metrics_bytes)
-            .map_err(|e| Error::io(&metrics_path, e))?;
         let point = opened.resume_point()?;
-        monitor.message(&format!("resuming at step {} of {}", point.step, settings.total_steps));
-        let tee = Tee { first: monitor, second: &metrics };
-        let outcome = fit(method, settings, &opened.dir, &entry, Some(point), &metrics, &tee)?;
-        metrics.emit(&Event::Finished { ok: true });
-        return Ok(outcome);
+        return continue_run(&opened, settings, method, &entry, point, monitor);
     }
     let ckpt = CheckpointDir::start(dir)?;
     let entry = ckpt.write_file(CONFIG_FILE, &config_bytes)?;
@@ -81,6 +136,25 @@ pub fn run_training(
     }
     let tee = Tee { first: monitor, second: &metrics };
     let outcome = fit(method, settings, &ckpt, &entry, None, &metrics, &tee)?;
+    metrics.emit(&Event::Finished { ok: true });
+    Ok(outcome)
+}
+
+/// Continues the restored `method` from the checkpoint in `opened`, its metrics log cut back to that checkpoint.
+fn continue_run(
+    opened: &OpenedCheckpoint,
+    settings: &FitSettings,
+    method: &mut dyn TrainingMethod,
+    config_entry: &super::checkpoint::FileEntry,
+    point: super::ResumePoint,
+    monitor: &dyn Monitor,
+) -> Result<FitOutcome> {
+    let metrics_path = opened.dir.file(METRICS_FILE);
+    let metrics =
+        JsonlMonitor::resume(&metrics_path, opened.manifest.metrics_bytes).map_err(|e| Error::io(&metrics_path, e))?;
+    monitor.message(&format!("resuming at step {} of {}", point.step, settings.total_steps));
+    let tee = Tee { first: monitor, second: &metrics };
+    let outcome = fit(method, settings, &opened.dir, config_entry, Some(point), &metrics, &tee)?;
     metrics.emit(&Event::Finished { ok: true });
     Ok(outcome)
 }

@@ -91,6 +91,36 @@ pub fn dir_bytes(dir: &Path) -> Vec<(String, Vec<u8>)> {
     names.into_iter().map(|n| (n.clone(), std::fs::read(dir.join(&n)).unwrap())).collect()
 }
 
+/// A run trained on to a larger total (`train --resume DIR --steps N`) against the run started with that total:
+/// the same files with the same weights, optimizer state and config, and the same metrics log apart from its
+/// progress records, which keep the total they were written under (and so may change the log's length in the
+/// manifest).
+#[allow(dead_code)]
+pub fn assert_extended_like(whole: &Path, extended: &Path) {
+    let (a, b) = (dir_bytes(whole), dir_bytes(extended));
+    let names = |files: &[(String, Vec<u8>)]| files.iter().map(|f| f.0.clone()).collect::<Vec<_>>();
+    assert_eq!(names(&a), names(&b));
+    let without_progress = |bytes: &[u8]| -> Vec<String> {
+        String::from_utf8_lossy(bytes)
+            .lines()
+            .filter(|l| !l.contains(r#""kind":"progress""#))
+            .map(String::from)
+            .collect()
+    };
+    let without_log_length = |bytes: &[u8]| {
+        let mut manifest: serde_json::Value = serde_json::from_slice(bytes).unwrap();
+        manifest.as_object_mut().unwrap().remove("metrics_bytes");
+        manifest
+    };
+    for ((name, x), (_, y)) in a.iter().zip(&b) {
+        match name.as_str() {
+            "metrics.jsonl" => assert_eq!(without_progress(x), without_progress(y), "{name} of {}", extended.display()),
+            "checkpoint.json" => assert_eq!(without_log_length(x), without_log_length(y), "{name}"),
+            _ => assert!(x == y, "{name} of {} differs from {}", extended.display(), whole.display()),
+        }
+    }
+}
+
 /// A falling ball sampled at 180 Hz for 40 frames, frame 5 lost: a ball CSV recording.
 pub fn falling_ball_csv() -> String {
     let mut text = String::from("frame,x,y,z\n");

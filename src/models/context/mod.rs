@@ -27,7 +27,7 @@ use crate::run::dir::Provenance;
 use crate::run::Monitor;
 use crate::train::tensors::to_params;
 use crate::train::{
-    loss_panel, run_training, training_view, Accept, DataFile, FitOutcome, FitSettings, OpenedCheckpoint,
+    loss_panel, run_training, training_view, Accept, DataFile, FitOutcome, FitSettings, OpenedCheckpoint, Start,
     TrainingProgress, MODEL_FILE,
 };
 use data::{ContextData, Episode, InstancePair};
@@ -217,7 +217,8 @@ pub fn train(request: &TrainRequest, resume: bool, monitor: &dyn Monitor) -> Res
             ("parameters", parameters.to_string()),
         ],
     );
-    let outcome = run_training(&request.out, &config, &settings, &mut trainer, resume, &view, monitor)?;
+    let outcome =
+        run_training(&request.out, &config, &settings, &mut trainer, Start::resuming(resume), &view, monitor)?;
     Ok(TrainReport { run, outcome, parameters })
 }
 

@@ -21,8 +21,8 @@ use crate::run::dir::Provenance;
 use crate::run::Monitor;
 use crate::train::tensors::TensorData;
 use crate::train::{
-    loss_panel, run_training, training_view, Accept, DataFile, FitOutcome, FitSettings, OpenedCheckpoint,
-    TrainingProgress, MODEL_FILE,
+    extension, loss_panel, run_training, training_view, Accept, DataFile, FitOutcome, FitSettings, OpenedCheckpoint,
+    Start, TrainingProgress, MODEL_FILE,
 };
 use crate::util::seeding::rng_for;
 
@@ -81,8 +81,8 @@ fn split_rows(windows: &Windows, fraction: f64, seed: u64) -> (Vec<usize>, Vec<u
     (train, valid, counts)
 }
 
-/// Trains (or, with `resume`, continues) DLGPD into `request.out`.
-pub fn train(request: &TrainRequest, resume: bool, monitor: &dyn Monitor) -> Result<TrainReport> {
+/// Trains DLGPD into `request.out`, fresh or continuing the run there (see [`Start`]).
+pub fn train(request: &TrainRequest, start: Start, monitor: &dyn Monitor) -> Result<TrainReport> {
     request.config.validate()?;
     let (dataset, files) = load_datasets(&request.data)?;
     let env = env_of(&dataset, request.env.as_deref(), &request.data[0])?;
@@ -154,7 +154,7 @@ pub fn train(request: &TrainRequest, resume: bool, monitor: &dyn Monitor) -> Res
             ("parameters", parameters.to_string()),
         ],
     );
-    let outcome = run_training(&request.out, &config, &settings, &mut trainer, resume, &view, monitor)?;
+    let outcome = run_training(&request.out, &config, &settings, &mut trainer, start, &view, monitor)?;
     Ok(TrainReport { run, outcome, parameters })
 }
 
@@ -166,11 +166,15 @@ fn read_run(opened: &OpenedCheckpoint) -> Result<DlgpdRun> {
     Ok(run)
 }
 
-/// Continues the run in `dir` from its last checkpoint, with the config and data it was started with.
-pub fn resume(dir: &Path, monitor: &dyn Monitor) -> Result<TrainReport> {
+/// Continues the run in `dir` from its last checkpoint, with the config and data it was started with; with
+/// `extend_to`, on to that many steps in total (the run may be finished: its training does not depend on the
+/// total, so its weights end as those of a run started with that total, provided its old total fell on a
+/// validation).
+pub fn resume(dir: &Path, extend_to: Option<u64>, monitor: &dyn Monitor) -> Result<TrainReport> {
     let opened = OpenedCheckpoint::open(dir)?;
     let run = read_run(&opened)?;
     opened.expect_total_steps(run.config.steps as u64)?;
+    let extended = extension(&opened, run.config.steps, extend_to)?;
     for file in &run.data {
         file.verify_unchanged()?;
     }
@@ -178,11 +182,14 @@ pub fn resume(dir: &Path, monitor: &dyn Monitor) -> Result<TrainReport> {
         out: dir.to_path_buf(),
         data: run.data.iter().map(|f| f.path.clone()).collect(),
         env: Some(run.env.clone()),
-        config: run.config.clone(),
+        config: match extended {
+            Some(steps) => DlgpdConfig { steps, ..run.config.clone() },
+            None => run.config.clone(),
+        },
         seed: run.seed,
         provenance: run.provenance.clone(),
     };
-    train(&request, true, monitor)
+    train(&request, if extended.is_some() { Start::Extend } else { Start::Resume }, monitor)
 }
 
 /// A finished DLGPD checkpoint: the VAE on the inference device, the GPs' trained hyperparameters and the

@@ -24,8 +24,8 @@ use crate::run::dir::Provenance;
 use crate::run::Monitor;
 use crate::train::tensors::{to_params, TensorData};
 use crate::train::{
-    loss_panel, run_training, training_view, validation_panel, Accept, DataFile, FitOutcome, FitSettings,
-    OpenedCheckpoint, MODEL_FILE,
+    extension, loss_panel, run_training, training_view, validation_panel, Accept, DataFile, FitOutcome, FitSettings,
+    OpenedCheckpoint, Start, MODEL_FILE,
 };
 
 pub const METHOD: &str = "pets";
@@ -127,8 +127,8 @@ pub fn env_of(dataset: &Dataset, requested: Option<&str>, data: &Path) -> Result
     Ok(env)
 }
 
-/// Trains (or, with `resume`, continues) a PETS ensemble into `request.out`.
-pub fn train(request: &TrainRequest, resume: bool, monitor: &dyn Monitor) -> Result<TrainReport> {
+/// Trains a PETS ensemble into `request.out`, fresh or continuing the run there (see [`Start`]).
+pub fn train(request: &TrainRequest, start: Start, monitor: &dyn Monitor) -> Result<TrainReport> {
     request.config.validate()?;
     let (dataset, files) = load_datasets(&request.data)?;
     let env = env_of(&dataset, request.env.as_deref(), &request.data[0])?;
@@ -190,7 +190,7 @@ pub fn train(request: &TrainRequest, resume: bool, monitor: &dyn Monitor) -> Res
             ("parameters", parameters.to_string()),
         ],
     );
-    let outcome = run_training(&request.out, &config, &settings, &mut trainer, resume, &view, monitor)?;
+    let outcome = run_training(&request.out, &config, &settings, &mut trainer, start, &view, monitor)?;
     Ok(TrainReport { run, outcome, parameters })
 }
 
@@ -235,11 +235,15 @@ impl ModelSpec {
     }
 }
 
-/// Continues the run in `dir` from its last checkpoint, with the config and data it was started with.
-pub fn resume(dir: &Path, monitor: &dyn Monitor) -> Result<TrainReport> {
+/// Continues the run in `dir` from its last checkpoint, with the config and data it was started with; with
+/// `extend_to`, on to that many steps in total (the run may be finished: its training does not depend on the
+/// total, so its weights end as those of a run started with that total, provided its old total fell on a
+/// validation).
+pub fn resume(dir: &Path, extend_to: Option<u64>, monitor: &dyn Monitor) -> Result<TrainReport> {
     let opened = OpenedCheckpoint::open(dir)?;
     let run = read_run(&opened)?;
     opened.expect_total_steps(run.config.steps as u64)?;
+    let extended = extension(&opened, run.config.steps, extend_to)?;
     for file in &run.data {
         file.verify_unchanged()?;
     }
@@ -247,11 +251,14 @@ pub fn resume(dir: &Path, monitor: &dyn Monitor) -> Result<TrainReport> {
         out: dir.to_path_buf(),
         data: run.data.iter().map(|f| f.path.clone()).collect(),
         env: Some(run.env.clone()),
-        config: run.config.clone(),
+        config: match extended {
+            Some(steps) => PetsConfig { steps, ..run.config.clone() },
+            None => run.config.clone(),
+        },
         seed: run.seed,
         provenance: run.provenance.clone(),
     };
-    train(&request, true, monitor)
+    train(&request, if extended.is_some() { Start::Extend } else { Start::Resume }, monitor)
 }
 
 /// A PETS checkpoint as a planner's dynamics in `env` (which must be the env it was trained on); a run still

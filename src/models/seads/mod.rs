@@ -25,7 +25,7 @@ use crate::envs::EnvName;
 use crate::error::{Error, Result};
 use crate::run::dir::Provenance;
 use crate::run::{Monitor, PanelSpec};
-use crate::train::{run_training, training_view, FitOutcome, FitSettings, OpenedCheckpoint};
+use crate::train::{run_training, training_view, FitOutcome, FitSettings, OpenedCheckpoint, Start};
 
 pub const METHOD: &str = "seads";
 pub const ENV_HELP: &str = "lightsout:cursor, tileswap:cursor, lightsout:reacher, tileswap:reacher";
@@ -162,7 +162,7 @@ fn train_game<G: BoardGame>(
             ("SAC", format!("lr {}, batch {}", config.sac_learning_rate, config.sac_batch)),
         ],
     );
-    let outcome = run_training(&request.out, &json, &settings, &mut trainer, resume, &view, monitor)?;
+    let outcome = run_training(&request.out, &json, &settings, &mut trainer, Start::resuming(resume), &view, monitor)?;
     Ok(TrainReport { run, outcome, last: trainer.last.clone(), env_steps: trainer.env_steps() })
 }
 

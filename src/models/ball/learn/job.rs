@@ -13,7 +13,9 @@ use crate::error::{Error, Result};
 use crate::models::ball::BallModelParams;
 use crate::run::dir::Provenance;
 use crate::run::Monitor;
-use crate::train::{loss_panel, run_training, training_view, DataFile, FitOutcome, FitSettings, OpenedCheckpoint};
+use crate::train::{
+    loss_panel, run_training, training_view, DataFile, FitOutcome, FitSettings, OpenedCheckpoint, Start,
+};
 
 pub const METHOD: &str = "ball-ekf";
 /// Steps between checkpoints; a checkpoint costs a few ms next to steps of ~60 ms.
@@ -76,7 +78,8 @@ pub fn train_checkpointed(request: &BallTrainRequest, resume: bool, monitor: &dy
             ("spin prior", if t.launcher_prior { "launcher net (C.1.3)" } else { "broad" }.to_string()),
         ],
     );
-    let outcome = run_training(&request.out, &config, &settings, &mut trainer, resume, &view, monitor)?;
+    let outcome =
+        run_training(&request.out, &config, &settings, &mut trainer, Start::resuming(resume), &view, monitor)?;
     let (params, spin_net) = trainer.current();
     params.validate().map_err(|e| Error::Diverged(format!("ball EKF training ended with unusable parameters: {e}")))?;
     Ok(BallTrainReport { run, outcome, params, spin_net })
