@@ -17,7 +17,7 @@ use mbrl::models::tradyn;
 use mbrl::run::dir::{Provenance, METRICS_FILE};
 use mbrl::train::config::apply_toml_file;
 use mbrl::train::data_file::scalar_history;
-use mbrl::train::{loss_history, OpenedCheckpoint, Start};
+use mbrl::train::{loss_history, Extension, OpenedCheckpoint, Start};
 use mbrl::util::table::write_csv;
 
 use crate::common::{command_line, file_stem, run_job, GlobalArgs};
@@ -161,7 +161,8 @@ pub fn run(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
         bail!("--steps must be at least 1");
     }
     if let Some(dir) = &args.resume {
-        return resume(global, dir, args.steps);
+        let extension = args.steps.map(|steps| Extension { steps, command_line: command_line() });
+        return resume(global, dir, extension.as_ref());
     }
     match args.method.expect("clap requires --method without --resume") {
         Method::Pets => train_pets(global, args),
@@ -173,7 +174,7 @@ pub fn run(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
     }
 }
 
-fn resume(global: &GlobalArgs, dir: &Path, extend_to: Option<u64>) -> anyhow::Result<()> {
+fn resume(global: &GlobalArgs, dir: &Path, extend_to: Option<&Extension>) -> anyhow::Result<()> {
     let method = OpenedCheckpoint::open(dir)?.manifest.method;
     // Training that depends on its total (context's p_ctx schedule, ball-ekf's and seads' budgets) cannot be
     // lengthened without changing what was already trained.

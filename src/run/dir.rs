@@ -51,10 +51,14 @@ pub struct Provenance {
     pub command_line: String,
     pub seed: u64,
     pub threads: usize,
+    /// The commands that trained the run on past the total it was started with (`train --resume DIR --steps
+    /// N`), oldest first; absent for runs that kept their total.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub extended_by: Vec<String>,
 }
 
 impl Provenance {
     pub fn new(command_line: String, seed: u64, threads: usize) -> Self {
-        Provenance { mbrl_version: crate::VERSION.to_string(), command_line, seed, threads }
+        Provenance { mbrl_version: crate::VERSION.to_string(), command_line, seed, threads, extended_by: Vec::new() }
     }
 }

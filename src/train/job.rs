@@ -36,10 +36,17 @@ impl Start {
     }
 }
 
-/// Whether `train --resume DIR --steps N` extends the run in `opened` (whose config asks for `config_steps`):
-/// the new total, or `None` for a plain resume. A smaller total is refused: a run is never cut short.
-pub fn extension(opened: &OpenedCheckpoint, config_steps: u64, requested: Option<u64>) -> Result<Option<u64>> {
-    match requested {
+/// `train --resume DIR --steps N`: the total asked for, and the command, which the run's provenance keeps.
+#[derive(Clone, Debug)]
+pub struct Extension {
+    pub steps: u64,
+    pub command_line: String,
+}
+
+/// Whether `requested` extends the run in `opened` (whose config asks for `config_steps`): the new total, or
+/// `None` for a plain resume. A smaller total is refused: a run is never cut short.
+pub fn extension(opened: &OpenedCheckpoint, config_steps: u64, requested: Option<&Extension>) -> Result<Option<u64>> {
+    match requested.map(|e| e.steps) {
         None => Ok(None),
         Some(total) if total == config_steps => Ok(None),
         Some(total) if total < config_steps => Err(Error::bad_file(

@@ -21,8 +21,8 @@ use crate::run::dir::Provenance;
 use crate::run::Monitor;
 use crate::train::tensors::TensorData;
 use crate::train::{
-    extension, loss_panel, run_training, training_view, Accept, DataFile, FitOutcome, FitSettings, OpenedCheckpoint,
-    Start, TrainingProgress, MODEL_FILE,
+    extension, loss_panel, run_training, training_view, Accept, DataFile, Extension, FitOutcome, FitSettings,
+    OpenedCheckpoint, Start, TrainingProgress, MODEL_FILE,
 };
 use crate::util::seeding::rng_for;
 
@@ -170,7 +170,7 @@ fn read_run(opened: &OpenedCheckpoint) -> Result<DlgpdRun> {
 /// `extend_to`, on to that many steps in total (the run may be finished: its training does not depend on the
 /// total, so its weights end as those of a run started with that total, provided its old total fell on a
 /// validation).
-pub fn resume(dir: &Path, extend_to: Option<u64>, monitor: &dyn Monitor) -> Result<TrainReport> {
+pub fn resume(dir: &Path, extend_to: Option<&Extension>, monitor: &dyn Monitor) -> Result<TrainReport> {
     let opened = OpenedCheckpoint::open(dir)?;
     let run = read_run(&opened)?;
     opened.expect_total_steps(run.config.steps as u64)?;
@@ -187,7 +187,14 @@ pub fn resume(dir: &Path, extend_to: Option<u64>, monitor: &dyn Monitor) -> Resu
             None => run.config.clone(),
         },
         seed: run.seed,
-        provenance: run.provenance.clone(),
+        provenance: match (extended, extend_to) {
+            (Some(_), Some(e)) => {
+                let mut provenance = run.provenance.clone();
+                provenance.extended_by.push(e.command_line.clone());
+                provenance
+            }
+            _ => run.provenance.clone(),
+        },
     };
     train(&request, if extended.is_some() { Start::Extend } else { Start::Resume }, monitor)
 }
