@@ -212,7 +212,8 @@ pub fn evaluate(
             plan.push((variant.clone(), "mismatching", PendulumVariant::Standard));
         }
     }
-    let predictions = prediction_checks(trained, &plan, largest, seed, images, &monitor)?;
+    let mut first_pools: Vec<(PendulumVariant, Dataset)> = Vec::new();
+    let predictions = prediction_checks(trained, &plan, largest, seed, images, &mut first_pools, &monitor)?;
     let total = (plan.len() * settings.evidence_rollouts.len() * settings.runs) as u64;
     let mut outcomes = Vec::new();
     for run in (0..settings.runs).filter(|_| settings.swing_ups) {
@@ -220,7 +221,9 @@ pub fn evaluate(
         let control_seed = derive_seed(seed, &[CONTROL_STREAM, run as u64]);
         // One pool per run and source env, shared by the settings that use it; smaller evidence sets are its
         // first rollouts, as the authors' buckets.
-        let mut pools: Vec<(PendulumVariant, Dataset)> = Vec::new();
+        // Run 0's pools are the ones the prediction checks rendered.
+        let mut pools: Vec<(PendulumVariant, Dataset)> =
+            if run == 0 { std::mem::take(&mut first_pools) } else { Vec::new() };
         for (variant, kind, source) in &plan {
             let pool = cached(&mut pools, source, || evidence_rollouts(source, largest, pool_seed, images))?;
             for &rollouts in &settings.evidence_rollouts {
@@ -266,13 +269,15 @@ pub fn evaluate(
 }
 
 /// For every setting, the model conditioned on run 0's largest evidence set predicts the rewards of held-out
-/// rollouts of the system at hand (the same held-out rollouts for matching and mismatching evidence).
+/// rollouts of the system at hand (the same held-out rollouts for matching and mismatching evidence). Run 0's
+/// evidence pools are left in `pools` for the swing-ups.
 fn prediction_checks(
     trained: &TrainedDlgpd,
     plan: &[(PendulumVariant, &'static str, PendulumVariant)],
     largest: usize,
     seed: u64,
     images: bool,
+    pools: &mut Vec<(PendulumVariant, Dataset)>,
     monitor: &dyn Monitor,
 ) -> Result<Vec<PredictionCheck>> {
     let pool_seed = derive_seed(seed, &[EVIDENCE_STREAM, 0]);
@@ -285,9 +290,8 @@ fn prediction_checks(
         if monitor.is_cancelled() {
             return Err(Error::Cancelled);
         }
-        let dynamics = cached(&mut conditioned, source, || {
-            condition_on(trained, &evidence_rollouts(source, largest, pool_seed, images)?, pool_seed)
-        })?;
+        let pool = cached(pools, source, || evidence_rollouts(source, largest, pool_seed, images))?;
+        let dynamics = cached(&mut conditioned, source, || condition_on(trained, pool, pool_seed))?;
         let held_out =
             cached(&mut held_outs, variant, || evidence_rollouts(variant, HELD_OUT_ROLLOUTS, held_out_seed, images))?;
         let prediction = reward_prediction(trained, dynamics, held_out, variant, held_out_seed)?;
