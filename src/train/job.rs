@@ -7,6 +7,7 @@ use super::checkpoint::CheckpointDir;
 use super::fit::{fit, FitOutcome, FitSettings, TrainingMethod, CONFIG_FILE, STATE_FILE};
 use super::OpenedCheckpoint;
 use crate::error::{Error, Result};
+use crate::run::dir::Provenance;
 use crate::run::dir::METRICS_FILE;
 use crate::run::{Event, JsonlMonitor, Monitor, Tee};
 
@@ -43,24 +44,46 @@ pub struct Extension {
     pub command_line: String,
 }
 
-/// Whether `requested` extends the run in `opened` (whose config asks for `config_steps`): the new total, or
-/// `None` for a plain resume. A smaller total is refused: a run is never cut short.
-pub fn extension(opened: &OpenedCheckpoint, config_steps: u64, requested: Option<&Extension>) -> Result<Option<u64>> {
-    match requested.map(|e| e.steps) {
-        None => Ok(None),
-        Some(total) if total == config_steps => Ok(None),
-        Some(total) if total < config_steps => Err(Error::bad_file(
+/// How a resumed run goes on: plainly, or extended to a new total with the extending command in its provenance.
+pub struct Continuation {
+    pub start: Start,
+    pub steps: u64,
+    pub provenance: Provenance,
+}
+
+/// The continuation of the run in `opened` (whose config asks for `config_steps`) that `requested` asks for. A
+/// smaller total is refused: a run is never cut short.
+pub fn continuation(
+    opened: &OpenedCheckpoint,
+    config_steps: u64,
+    provenance: &Provenance,
+    requested: Option<&Extension>,
+) -> Result<Continuation> {
+    let plain = Continuation { start: Start::Resume, steps: config_steps, provenance: provenance.clone() };
+    let Some(extension) = requested else {
+        return Ok(plain);
+    };
+    let total = extension.steps;
+    if total == config_steps {
+        return Ok(plain);
+    }
+    if total < config_steps {
+        return Err(Error::bad_file(
             opened.dir.path(),
             format!(
                 "was started for {config_steps} steps; --steps {total} would shorten it (with --resume, --steps only \
                  extends a run)"
             ),
-        )),
-        Some(total) if total > MAX_TRAIN_STEPS => Err(Error::config(format!(
-            "--steps {total}: at most {MAX_TRAIN_STEPS} (months on any machine mbrl runs on)"
-        ))),
-        Some(total) => Ok(Some(total)),
+        ));
     }
+    if total > MAX_TRAIN_STEPS {
+        return Err(Error::config(format!(
+            "--steps {total}: at most {MAX_TRAIN_STEPS} (months on any machine mbrl runs on)"
+        )));
+    }
+    let mut provenance = provenance.clone();
+    provenance.extended_by.push(extension.command_line.clone());
+    Ok(Continuation { start: Start::Extend, steps: total, provenance })
 }
 
 /// Runs `method` to the end in `dir`. A fresh run writes `config` (the full description a resumed run is rebuilt

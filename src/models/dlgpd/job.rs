@@ -21,7 +21,7 @@ use crate::run::dir::Provenance;
 use crate::run::Monitor;
 use crate::train::tensors::TensorData;
 use crate::train::{
-    extension, loss_panel, run_training, training_view, Accept, DataFile, Extension, FitOutcome, FitSettings,
+    continuation, loss_panel, run_training, training_view, Accept, DataFile, Extension, FitOutcome, FitSettings,
     OpenedCheckpoint, Start, TrainingProgress, MODEL_FILE,
 };
 use crate::util::seeding::rng_for;
@@ -174,7 +174,7 @@ pub fn resume(dir: &Path, extend_to: Option<&Extension>, monitor: &dyn Monitor) 
     let opened = OpenedCheckpoint::open(dir)?;
     let run = read_run(&opened)?;
     opened.expect_total_steps(run.config.steps as u64)?;
-    let extended = extension(&opened, run.config.steps, extend_to)?;
+    let next = continuation(&opened, run.config.steps, &run.provenance, extend_to)?;
     for file in &run.data {
         file.verify_unchanged()?;
     }
@@ -182,21 +182,11 @@ pub fn resume(dir: &Path, extend_to: Option<&Extension>, monitor: &dyn Monitor) 
         out: dir.to_path_buf(),
         data: run.data.iter().map(|f| f.path.clone()).collect(),
         env: Some(run.env.clone()),
-        config: match extended {
-            Some(steps) => DlgpdConfig { steps, ..run.config.clone() },
-            None => run.config.clone(),
-        },
+        config: DlgpdConfig { steps: next.steps, ..run.config.clone() },
         seed: run.seed,
-        provenance: match (extended, extend_to) {
-            (Some(_), Some(e)) => {
-                let mut provenance = run.provenance.clone();
-                provenance.extended_by.push(e.command_line.clone());
-                provenance
-            }
-            _ => run.provenance.clone(),
-        },
+        provenance: next.provenance,
     };
-    train(&request, if extended.is_some() { Start::Extend } else { Start::Resume }, monitor)
+    train(&request, next.start, monitor)
 }
 
 /// A finished DLGPD checkpoint: the VAE on the inference device, the GPs' trained hyperparameters and the

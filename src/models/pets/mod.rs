@@ -24,7 +24,7 @@ use crate::run::dir::Provenance;
 use crate::run::Monitor;
 use crate::train::tensors::{to_params, TensorData};
 use crate::train::{
-    extension, loss_panel, run_training, training_view, validation_panel, Accept, DataFile, Extension, FitOutcome,
+    continuation, loss_panel, run_training, training_view, validation_panel, Accept, DataFile, Extension, FitOutcome,
     FitSettings, OpenedCheckpoint, Start, MODEL_FILE,
 };
 
@@ -243,7 +243,7 @@ pub fn resume(dir: &Path, extend_to: Option<&Extension>, monitor: &dyn Monitor) 
     let opened = OpenedCheckpoint::open(dir)?;
     let run = read_run(&opened)?;
     opened.expect_total_steps(run.config.steps as u64)?;
-    let extended = extension(&opened, run.config.steps, extend_to)?;
+    let next = continuation(&opened, run.config.steps, &run.provenance, extend_to)?;
     for file in &run.data {
         file.verify_unchanged()?;
     }
@@ -251,21 +251,11 @@ pub fn resume(dir: &Path, extend_to: Option<&Extension>, monitor: &dyn Monitor) 
         out: dir.to_path_buf(),
         data: run.data.iter().map(|f| f.path.clone()).collect(),
         env: Some(run.env.clone()),
-        config: match extended {
-            Some(steps) => PetsConfig { steps, ..run.config.clone() },
-            None => run.config.clone(),
-        },
+        config: PetsConfig { steps: next.steps, ..run.config.clone() },
         seed: run.seed,
-        provenance: match (extended, extend_to) {
-            (Some(_), Some(e)) => {
-                let mut provenance = run.provenance.clone();
-                provenance.extended_by.push(e.command_line.clone());
-                provenance
-            }
-            _ => run.provenance.clone(),
-        },
+        provenance: next.provenance,
     };
-    train(&request, if extended.is_some() { Start::Extend } else { Start::Resume }, monitor)
+    train(&request, next.start, monitor)
 }
 
 /// A PETS checkpoint as a planner's dynamics in `env` (which must be the env it was trained on); a run still
