@@ -3,12 +3,11 @@
 
 use std::path::Path;
 
-use super::checkpoint::CheckpointDir;
+use super::checkpoint::{CheckpointDir, FileEntry};
 use super::fit::{fit, FitOutcome, FitSettings, TrainingMethod, CONFIG_FILE, STATE_FILE};
 use super::OpenedCheckpoint;
 use crate::error::{Error, Result};
-use crate::run::dir::Provenance;
-use crate::run::dir::METRICS_FILE;
+use crate::run::dir::{Provenance, METRICS_FILE};
 use crate::run::{Event, JsonlMonitor, Monitor, Tee};
 
 /// A billion optimizer steps: beyond any training budget, so a larger count is a typo or a corrupt config.
@@ -110,52 +109,38 @@ pub fn run_training(
     for event in view {
         monitor.emit(event);
     }
-    if start == Start::Extend {
+    if start != Start::Fresh {
         let opened = OpenedCheckpoint::open(dir)?;
-        if settings.total_steps <= opened.manifest.total_steps {
+        // The config entry the run keeps: the checkpoint's own when resuming; when extending, none yet (the new
+        // config is staged once everything has been read from the checkpoint).
+        let kept_entry = if start == Start::Resume {
+            Some(check_resumable(&opened, settings, &config_bytes)?)
+        } else if settings.total_steps <= opened.manifest.total_steps {
             return Err(Error::config(format!(
                 "extending {} to {} steps: the run already has {}",
                 dir.display(),
                 settings.total_steps,
                 opened.manifest.total_steps
             )));
-        }
-        opened.dir.settle()?;
-        method.restore(&opened.tensors(STATE_FILE)?)?;
-        // Everything is read from the checkpoint before the new config is staged beside it.
-        let point = opened.resume_point()?;
-        let entry = opened.dir.write_file(CONFIG_FILE, &config_bytes)?;
-        return continue_run(&opened, settings, method, &entry, point, monitor);
-    }
-    if start == Start::Resume {
-        let opened = OpenedCheckpoint::open(dir)?;
-        if opened.manifest.total_steps != settings.total_steps {
-            return Err(Error::bad_file(
-                &opened.dir.file(CONFIG_FILE),
-                format!(
-                    "asks for {} steps, but the checkpoint belongs to a run of {}: the config was changed",
-                    settings.total_steps, opened.manifest.total_steps
-                ),
-            ));
-        }
-        if opened.manifest.complete {
-            return Err(Error::bad_file(
-                dir,
-                format!(
-                    "training already finished ({} of {} steps); nothing to resume",
-                    opened.manifest.step, opened.manifest.total_steps
-                ),
-            ));
-        }
-        let entry = opened.manifest.files.get(CONFIG_FILE).cloned().expect("checked by OpenedCheckpoint::open");
-        if opened.dir.read_verified(CONFIG_FILE, &entry)? != config_bytes {
-            return Err(Error::bad_file(&opened.dir.file(CONFIG_FILE), "differs from the run being resumed"));
-        }
+        } else {
+            None
+        };
         // A checkpoint killed halfway into place is finished first, so this run stages its own cleanly.
         opened.dir.settle()?;
         method.restore(&opened.tensors(STATE_FILE)?)?;
         let point = opened.resume_point()?;
-        return continue_run(&opened, settings, method, &entry, point, monitor);
+        let entry = match kept_entry {
+            Some(entry) => entry,
+            None => opened.dir.write_file(CONFIG_FILE, &config_bytes)?,
+        };
+        let metrics_path = opened.dir.file(METRICS_FILE);
+        let metrics = JsonlMonitor::resume(&metrics_path, opened.manifest.metrics_bytes)
+            .map_err(|e| Error::io(&metrics_path, e))?;
+        monitor.message(&format!("resuming at step {} of {}", point.step, settings.total_steps));
+        let tee = Tee { first: monitor, second: &metrics };
+        let outcome = fit(method, settings, &opened.dir, &entry, Some(point), &metrics, &tee)?;
+        metrics.emit(&Event::Finished { ok: true });
+        return Ok(outcome);
     }
     let ckpt = CheckpointDir::start(dir)?;
     let entry = ckpt.write_file(CONFIG_FILE, &config_bytes)?;
@@ -170,23 +155,31 @@ pub fn run_training(
     Ok(outcome)
 }
 
-/// Continues the restored `method` from the checkpoint in `opened`, its metrics log cut back to that checkpoint.
-fn continue_run(
-    opened: &OpenedCheckpoint,
-    settings: &FitSettings,
-    method: &mut dyn TrainingMethod,
-    config_entry: &super::checkpoint::FileEntry,
-    point: super::ResumePoint,
-    monitor: &dyn Monitor,
-) -> Result<FitOutcome> {
-    let metrics_path = opened.dir.file(METRICS_FILE);
-    let metrics =
-        JsonlMonitor::resume(&metrics_path, opened.manifest.metrics_bytes).map_err(|e| Error::io(&metrics_path, e))?;
-    monitor.message(&format!("resuming at step {} of {}", point.step, settings.total_steps));
-    let tee = Tee { first: monitor, second: &metrics };
-    let outcome = fit(method, settings, &opened.dir, config_entry, Some(point), &metrics, &tee)?;
-    metrics.emit(&Event::Finished { ok: true });
-    Ok(outcome)
+/// A plain resume needs an unfinished checkpoint of exactly this config; returns the config's manifest entry.
+fn check_resumable(opened: &OpenedCheckpoint, settings: &FitSettings, config_bytes: &[u8]) -> Result<FileEntry> {
+    if opened.manifest.total_steps != settings.total_steps {
+        return Err(Error::bad_file(
+            &opened.dir.file(CONFIG_FILE),
+            format!(
+                "asks for {} steps, but the checkpoint belongs to a run of {}: the config was changed",
+                settings.total_steps, opened.manifest.total_steps
+            ),
+        ));
+    }
+    if opened.manifest.complete {
+        return Err(Error::bad_file(
+            opened.dir.path(),
+            format!(
+                "training already finished ({} of {} steps); nothing to resume",
+                opened.manifest.step, opened.manifest.total_steps
+            ),
+        ));
+    }
+    let entry = opened.manifest.files.get(CONFIG_FILE).cloned().expect("checked by OpenedCheckpoint::open");
+    if opened.dir.read_verified(CONFIG_FILE, &entry)? != config_bytes {
+        return Err(Error::bad_file(&opened.dir.file(CONFIG_FILE), "differs from the run being resumed"));
+    }
+    Ok(entry)
 }
 
 fn config_bytes(config: &serde_json::Value) -> Result<Vec<u8>> {
