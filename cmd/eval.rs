@@ -156,6 +156,9 @@ struct SeadsArgs {
     /// Report directory (default: reports/seads-<checkpoint name>).
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Take runs still in training (the weights of their last checkpoint); the report says how far each got.
+    #[arg(long)]
+    allow_incomplete: bool,
 }
 
 #[derive(Args, Debug)]
@@ -366,6 +369,9 @@ struct TradynArgs {
     /// Report directory.
     #[arg(long, default_value = "reports/tradyn")]
     out: PathBuf,
+    /// Take runs still in training (their best-validation weights so far); the report says how far each got.
+    #[arg(long)]
+    allow_incomplete: bool,
 }
 
 fn eval_tradyn(global: &GlobalArgs, provenance: &Provenance, a: TradynArgs) -> anyhow::Result<()> {
@@ -386,9 +392,15 @@ fn eval_tradyn(global: &GlobalArgs, provenance: &Provenance, a: TradynArgs) -> a
         }
     }
     let models = TradynEvalModels {
-        terrain: mbrl::models::tradyn::TradynModel::load(&a.model_terrain)?,
-        no_terrain: mbrl::models::tradyn::TradynModel::load(&a.model_no_terrain)?,
+        terrain: mbrl::models::tradyn::TradynModel::load_accepting(&a.model_terrain, accepting(a.allow_incomplete))?,
+        no_terrain: mbrl::models::tradyn::TradynModel::load_accepting(
+            &a.model_no_terrain,
+            accepting(a.allow_incomplete),
+        )?,
     };
+    for model in [&models.terrain, &models.no_terrain] {
+        report_unfinished(&model.loaded.dir, &model.loaded.progress);
+    }
     models.check()?;
     let maps = mbrl::data::terrain_set::read_terrain_set(&a.maps, Some(mbrl::envs::terrain::TerrainSplit::Test))?;
     let mut navigation = NavigationSettings::thesis();
@@ -593,7 +605,14 @@ fn eval_seads(global: &GlobalArgs, provenance: &Provenance, a: SeadsArgs) -> any
     if a.model.len() > 1 && names.windows(2).any(|w| w[0] == w[1]) {
         bail!("--model directories to compare need distinct names (each gets a report subdirectory of that name)");
     }
-    let loaded: Vec<_> = a.model.iter().map(|m| mbrl::models::seads::planner::load(m)).collect::<Result<_, _>>()?;
+    let loaded: Vec<_> = a
+        .model
+        .iter()
+        .map(|m| mbrl::models::seads::planner::load_accepting(m, accepting(a.allow_incomplete)))
+        .collect::<Result<_, _>>()?;
+    for model in &loaded {
+        report_unfinished(&model.dir, &model.progress);
+    }
     let settings = SeadsEvalSettings {
         max_depth: a.max_depth,
         boards_per_depth: a.boards,

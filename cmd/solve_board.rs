@@ -12,9 +12,10 @@ use mbrl::planning::board_view::layout;
 use mbrl::planning::solve_board::{execute_plan, plan_board, SearchKind};
 use mbrl::util::seeding::rng_for;
 
-use mbrl::models::seads::planner::{load as load_seads, solve_with_skills, LoadedSeads};
+use mbrl::models::seads::planner::{load_accepting as load_seads, solve_with_skills, LoadedSeads};
 
 use crate::common::{run_job, GlobalArgs};
+use crate::model_args::{accepting, report_unfinished};
 
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
 pub enum SplitChoice {
@@ -101,6 +102,9 @@ pub struct SolveBoardArgs {
     /// Replans allowed when a skill's outcome differs from the model's prediction (SEADS --model).
     #[arg(long, default_value_t = 10)]
     max_replans: usize,
+    /// Take a SEADS run still in training (the weights of its last checkpoint); a warning says how far it got.
+    #[arg(long)]
+    allow_incomplete: bool,
     /// Play the plan with this manipulator's scripted controller.
     #[arg(long, value_enum)]
     embodiment: Option<EmbodimentChoice>,
@@ -121,6 +125,9 @@ pub struct SolveBoardArgs {
 pub fn run(global: &GlobalArgs, args: SolveBoardArgs) -> anyhow::Result<()> {
     if args.model != "true" {
         return run_learned(global, &args);
+    }
+    if args.allow_incomplete {
+        bail!("--allow-incomplete takes a SEADS checkpoint as --model; `--model true` plans with the game's rules");
     }
     let game = args.game.as_deref().context("--game is required with --model true")?;
     match GameSpec::parse(game)? {
@@ -149,7 +156,8 @@ fn run_learned(global: &GlobalArgs, args: &SolveBoardArgs) -> anyhow::Result<()>
     if !dir.is_dir() {
         bail!("--model '{}': expected `true` or a SEADS checkpoint directory", args.model);
     }
-    let loaded = load_seads(dir)?;
+    let loaded = load_seads(dir, accepting(args.allow_incomplete))?;
+    report_unfinished(dir, &loaded.progress);
     if let Some(game) = &args.game {
         if GameSpec::parse(game)? != loaded.env.game {
             bail!("--game {game} differs from the checkpoint's game ({}); leave --game out", loaded.env.game.name());

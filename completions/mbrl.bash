@@ -1037,7 +1037,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__seads)
-            opts="-q -h -V --model --max-depth --boards --coverage-boards --max-replans --split --max-nodes --out --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --model --max-depth --boards --coverage-boards --max-replans --split --max-nodes --out --allow-incomplete --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1095,7 +1095,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__tradyn)
-            opts="-q -h -V --model-terrain --model-no-terrain --maps --tasks --transitions --steps --horizon --candidates --elites --iters --prediction-steps --out --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --model-terrain --model-no-terrain --maps --tasks --transitions --steps --horizon --candidates --elites --iters --prediction-steps --out --allow-incomplete --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1719,7 +1719,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__solve__subcmd__board)
-            opts="-q -h -V --game --board --random-depth --split --model --max-replans --embodiment --search --max-depth --max-nodes --max-memory-mib --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --game --board --random-depth --split --model --max-replans --allow-incomplete --embodiment --search --max-depth --max-nodes --max-memory-mib --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0

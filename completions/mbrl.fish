@@ -207,6 +207,7 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l max-memory-mib
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l allow-incomplete -d 'Take a SEADS run still in training (the weights of its last checkpoint); a warning says how far it got'
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -s q -l quiet -d 'Print only results and errors'
@@ -331,6 +332,7 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -l allow-incomplete -d 'Take runs still in training (their best-validation weights so far); the report says how far each got'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -s q -l quiet -d 'Print only results and errors'
@@ -348,6 +350,7 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l allow-incomplete -d 'Take runs still in training (the weights of their last checkpoint); the report says how far each got'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -s q -l quiet -d 'Print only results and errors'

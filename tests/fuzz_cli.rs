@@ -345,6 +345,11 @@ fn targets() -> Vec<Target> {
             )
         },
         target("seads-resume", Input::Checkpoint { dir: "seads-resume", files: RESUME_FILES }, "train --resume {in}"),
+        target(
+            "seads-eval-incomplete",
+            Input::Checkpoint { dir: "seads-resume", files: MODEL_FILES },
+            "eval seads --model {in} --max-depth 1 --boards 1 --coverage-boards 1 --allow-incomplete --out {out}",
+        ),
     ]
 }
 

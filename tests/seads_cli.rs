@@ -133,7 +133,30 @@ fn bad_input_is_one_line() {
     std::fs::write(&manifest, text.replace("\"complete\": true", "\"complete\": false")).unwrap();
     let err = run_err(d, &["solve-board", "--model", "s", "--random-depth", "1"]);
     assert!(err.contains("--resume") && err.trim().lines().count() == 1, "{err}");
+    let eval = ["eval", "seads", "--model", "s", "--max-depth", "1", "--boards", "1", "--coverage-boards", "1"];
+    let err = run_err(d, &[&eval[..], &["--out", "partial-report"]].concat());
+    assert!(err.contains("--resume") && err.trim().lines().count() == 1, "{err}");
+    assert!(!d.join("partial-report").exists());
+    // ...unless the user asks to look at it while it trains: then every output says how far it got.
+    let out = mbrl(d)
+        .args(["solve-board", "--model", "s", "--board", "0,1,2,3,4,5,6,7,8", "--allow-incomplete", "--no-tui"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr_of(&out));
+    assert!(stderr_of(&out).contains("warning: s: "), "{}", stderr_of(&out));
+    assert!(stderr_of(&out).contains("(training still in progress)"), "{}", stderr_of(&out));
+    run_ok(d, &[&eval[..], &["--out", "partial-report", "--allow-incomplete"]].concat());
+    let report = std::fs::read_to_string(d.join("partial-report/report.md")).unwrap();
+    assert!(report.contains("(training still in progress)"), "{report}");
+    let err = run_err(
+        d,
+        &["solve-board", "--model", "true", "--game", "tileswap", "--random-depth", "1", "--allow-incomplete"],
+    );
+    assert!(err.contains("--allow-incomplete") && err.trim().lines().count() == 1, "{err}");
     std::fs::write(&manifest, text).unwrap();
+    run_ok(d, &[&eval[..], &["--out", "report"]].concat());
+    let report = std::fs::read_to_string(d.join("report/report.md")).unwrap();
+    assert!(report.contains("Model `s`, trained ") && !report.contains("in progress"), "{report}");
     let err = run_err(d, &["plan", "--env", "pendulum", "--model", "s"]);
     assert!(err.trim().lines().count() == 1, "{err}");
 }

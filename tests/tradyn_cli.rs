@@ -134,6 +134,22 @@ fn train_calibrate_and_navigate_with_and_without_terrain_lookup() {
     for file in ["report.md", "table_5_2.csv", "energy_wilcoxon.csv", "prediction.csv", "prediction.png", "paths.png"] {
         assert!(d.join("report").join(file).is_file(), "{file} missing");
     }
+    let report = std::fs::read_to_string(d.join("report/report.md")).unwrap();
+    assert!(report.contains("+T: `models/t`, trained 20 steps; −T: `models/nt`, trained 20 steps."), "{report}");
+
+    // A run still in training is refused, or with --allow-incomplete evaluated with its progress in the report.
+    let manifest = d.join("models/nt/checkpoint.json");
+    let finished = std::fs::read_to_string(&manifest).unwrap();
+    std::fs::write(&manifest, finished.replace("\"complete\": true", "\"complete\": false")).unwrap();
+    let partial: Vec<&str> = args.iter().map(|a| if *a == "report" { "partial-report" } else { a }).collect();
+    fails_with(d, &partial, "training stopped at step 20 of 20");
+    assert!(!d.join("partial-report").exists());
+    let out = run(d, &[&partial[..], &["--allow-incomplete"]].concat());
+    assert!(out.status.success(), "{}", stderr_of(&out));
+    assert!(stderr_of(&out).contains("warning: models/nt: 20 of 20 steps"), "{}", stderr_of(&out));
+    let report = std::fs::read_to_string(d.join("partial-report/report.md")).unwrap();
+    assert!(report.contains("−T: `models/nt`, trained 20 of 20 steps (training still in progress)."), "{report}");
+    std::fs::write(&manifest, finished).unwrap();
     let swapped =
         ["eval", "tradyn", "--model-terrain", "models/nt", "--model-no-terrain", "models/t", "--maps", "maps"];
     fails_with(d, &swapped, "--no-terrain");

@@ -62,6 +62,8 @@ pub struct DepthRow {
 #[derive(Clone, Debug, Serialize)]
 pub struct SeadsEvalSummary {
     pub env: String,
+    /// The checkpoint and how far it was trained, as the report names it.
+    pub model: String,
     pub skills: Vec<SkillRow>,
     /// Distinct game moves among the skills' most frequent moves (Table 7.3's figure).
     pub distinct_moves: usize,
@@ -201,7 +203,7 @@ fn report_game<G: BoardGame>(
     let run = RunDir::create(out_dir)?;
     run.write_config(&serde_json::json!({
         "job": "eval seads", "env": loaded.env.name(), "settings": settings, "provenance": provenance,
-        "model": loaded.run,
+        "model": loaded.run, "training": loaded.progress,
     }))?;
     let metrics = run.metrics()?;
     let monitor = Tee { first: monitor, second: &metrics };
@@ -217,6 +219,7 @@ fn report_game<G: BoardGame>(
     let depths = success_rows(game, loaded, &pool, settings, seed, &monitor)?;
     let summary = SeadsEvalSummary {
         env: loaded.env.name(),
+        model: format!("`{}`, trained {}", loaded.dir.display(), loaded.progress.describe()),
         distinct_moves: modes.len(),
         moves: game.num_moves(),
         skills,
@@ -311,11 +314,12 @@ fn write_files<G: BoardGame>(game: &G, s: &SeadsEvalSummary, settings: &SeadsEva
         &groups,
     )?;
     let mut md = format!(
-        "# SEADS on {}\n\nSkill coverage (thesis Table 7.3): {} of {} game moves are the most frequent move of some skill, \
+        "# SEADS on {}\n\nModel {}.\n\nSkill coverage (thesis Table 7.3): {} of {} game moves are the most frequent move of some skill, \
          each skill executed with its deterministic policy from {} {}-split boards of depth 1-{}. \
          Thesis (Cursor, 500k steps): 24.94 / 25 LightsOut, 11.99 / 12 TileSwap.\n\n\
          | skill | most frequent move | share | no move | mean steps |\n|---|---|---|---|---|\n",
         s.env,
+        s.model,
         s.distinct_moves,
         s.moves,
         settings.coverage_boards,

@@ -127,6 +127,12 @@ impl TradynEvalModels {
         Ok(())
     }
 
+    /// Which checkpoints the report compares, and how far each was trained.
+    fn describe(&self) -> String {
+        let one = |m: &TradynModel| format!("`{}`, trained {}", m.loaded.dir.display(), m.loaded.progress.describe());
+        format!("+T: {}; −T: {}", one(&self.terrain), one(&self.no_terrain))
+    }
+
     fn of(&self, terrain: bool) -> &TradynModel {
         if terrain {
             &self.terrain
@@ -180,6 +186,7 @@ pub fn evaluate(
         "provenance": provenance,
         "model_terrain": models.terrain.loaded.dir,
         "model_no_terrain": models.no_terrain.loaded.dir,
+        "training": {"terrain": models.terrain.loaded.progress, "no_terrain": models.no_terrain.loaded.progress},
         "maps": maps.iter().map(|m| serde_json::json!({"name": m.name, "crc32": m.crc32})).collect::<Vec<_>>(),
         "settings": settings,
     }))?;
@@ -202,7 +209,7 @@ pub fn evaluate(
         tasks.push(task);
     }
     monitor.progress("tasks", settings.tasks as u64, settings.tasks as u64);
-    write_report(&run, settings, &tasks)
+    write_report(&run, settings, &models.describe(), &tasks)
 }
 
 fn run_task(
@@ -313,7 +320,12 @@ fn prediction_errors(dynamics: &TradynDynamics, truth: &Rollout) -> Vec<[f64; 3]
         .collect()
 }
 
-fn write_report(run: &RunDir, settings: &TradynEvalSettings, tasks: &[Task]) -> Result<TradynEvalSummary> {
+fn write_report(
+    run: &RunDir,
+    settings: &TradynEvalSettings,
+    models: &str,
+    tasks: &[Task],
+) -> Result<TradynEvalSummary> {
     let names: Vec<String> = VARIANTS.iter().map(|v| variant_name(*v)).collect();
     let column =
         |v: usize, f: &dyn Fn(&Outcome) -> f64| -> Vec<f64> { tasks.iter().map(|t| f(&t.outcomes[v])).collect() };
@@ -504,13 +516,14 @@ fn write_report(run: &RunDir, settings: &TradynEvalSettings, tasks: &[Task]) -> 
 
     write_text(
         &run.file("report.md"),
-        &markdown(settings, &names, &table, &pairs, summary.prediction_tests, tasks.len()),
+        &markdown(settings, models, &names, &table, &pairs, summary.prediction_tests, tasks.len()),
     )?;
     Ok(summary)
 }
 
 fn markdown(
     settings: &TradynEvalSettings,
+    models: &str,
     names: &[String],
     table: &[Vec<String>],
     pairs: &[Vec<String>],
@@ -520,6 +533,7 @@ fn markdown(
     let nav = &settings.navigation;
     let mut md = String::new();
     let _ = writeln!(md, "# TRADYN evaluation (thesis 5.5)\n");
+    let _ = writeln!(md, "Models {models}.\n");
     let _ = writeln!(
         md,
         "{tasks} tasks on test maps: a robot drawn from Table 5.1, start and goal in [0.1, 0.9]², heading U[−π, π], \

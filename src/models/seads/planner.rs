@@ -2,7 +2,7 @@
 //! most likely successors, each planned skill executed by the skill policy in the embodiment, and a new plan
 //! whenever the board turns out differently from the model's prediction (up to a replanning budget).
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
@@ -21,7 +21,7 @@ use crate::planning::bfs::{bidirectional, breadth_first, SearchLimits, SearchRes
 use crate::planning::board_view::{plan_text, show_boards, EffectorTrace};
 use crate::rl::sac::Sac;
 use crate::run::{Event, Monitor};
-use crate::train::{OpenedCheckpoint, MODEL_FILE};
+use crate::train::{Accept, OpenedCheckpoint, TrainingProgress, MODEL_FILE};
 
 /// A trained SEADS checkpoint: the skill policy and the forward model.
 pub struct LoadedSeads {
@@ -29,9 +29,18 @@ pub struct LoadedSeads {
     pub env: EmbodiedGame,
     pub policy: Sac,
     pub model: FlipModel,
+    pub dir: PathBuf,
+    pub progress: TrainingProgress,
 }
 
+/// A finished SEADS run.
 pub fn load(dir: &Path) -> Result<LoadedSeads> {
+    load_accepting(dir, Accept::Finished)
+}
+
+/// A SEADS run, finished or (with [`Accept::InProgress`]) still training: then the weights of its last
+/// checkpoint, as SEADS has no validation to pick a best from.
+pub fn load_accepting(dir: &Path, accept: Accept) -> Result<LoadedSeads> {
     let opened = OpenedCheckpoint::open(dir)?;
     if opened.manifest.method != METHOD {
         return Err(Error::bad_file(
@@ -42,7 +51,7 @@ pub fn load(dir: &Path) -> Result<LoadedSeads> {
             ),
         ));
     }
-    opened.expect_finished(METHOD)?;
+    opened.expect(METHOD, accept)?;
     let run = read_run(&opened)?;
     let env = EmbodiedGame::parse(&run.env)?;
     let weights = opened.tensors(MODEL_FILE)?;
@@ -66,7 +75,7 @@ pub fn load(dir: &Path) -> Result<LoadedSeads> {
     }
     let model = FlipModel::from_params(&params, run.board_bits, run.config.skills)
         .map_err(|e| Error::bad_file(&dir.join(MODEL_FILE), e.to_string()))?;
-    Ok(LoadedSeads { run, env, policy, model })
+    Ok(LoadedSeads { run, env, policy, model, dir: dir.to_path_buf(), progress: opened.progress() })
 }
 
 /// The learned forward model as a successor model: a skill leads to the most likely next board; a prediction
