@@ -557,13 +557,12 @@ fn write_report(
     let _ = writeln!(md, "# Explore the Context: calibration on {}\n", env.canonical());
     let _ = writeln!(
         md,
-        "Model `{}`, trained {}. {} unseen contexts (instances), per context {} random validation rollouts of {} \
+        "Model {}. {} unseen contexts (instances), per context {} random validation rollouts of {} \
          steps; every strategy starts from the same state and collects {} transitions. EIG planning: CEM {} candidates / \
          {} elites / {} iterations, {} β samples, MPC horizon min({}, N − n). Predictions: open loop from each validation \
          rollout's first state with the mean of q(β | calibration transitions); error = squared error averaged over the \
          model-space state dimensions{}.\n",
-        model.dir.display(),
-        model.progress.describe(),
+        model.progress.name_model(&model.dir),
         outcomes.len(),
         settings.validation_rollouts,
         settings.validation_steps,

@@ -219,7 +219,7 @@ fn report_game<G: BoardGame>(
     let depths = success_rows(game, loaded, &pool, settings, seed, &monitor)?;
     let summary = SeadsEvalSummary {
         env: loaded.env.name(),
-        model: format!("`{}`, trained {}", loaded.dir.display(), loaded.progress.describe()),
+        model: loaded.progress.name_model(&loaded.dir),
         distinct_moves: modes.len(),
         moves: game.num_moves(),
         skills,

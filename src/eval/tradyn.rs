@@ -129,7 +129,7 @@ impl TradynEvalModels {
 
     /// Which checkpoints the report compares, and how far each was trained.
     fn describe(&self) -> String {
-        let one = |m: &TradynModel| format!("`{}`, trained {}", m.loaded.dir.display(), m.loaded.progress.describe());
+        let one = |m: &TradynModel| m.loaded.progress.name_model(&m.loaded.dir);
         format!("+T: {}; −T: {}", one(&self.terrain), one(&self.no_terrain))
     }
 

@@ -48,6 +48,11 @@ impl TrainingProgress {
         }
     }
 
+    /// "`models/x`, trained 3000 steps": how a report names the checkpoint it evaluated.
+    pub fn name_model(&self, dir: &Path) -> String {
+        format!("`{}`, trained {}", dir.display(), self.describe())
+    }
+
     /// Empty for a finished run, else ", trained 11200 of 30000 steps (training still in progress)": appended to
     /// a model's one-line description, so planner output never passes a run in progress off as done.
     pub fn unfinished_note(&self) -> String {
