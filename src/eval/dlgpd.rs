@@ -11,7 +11,7 @@ use serde::Serialize;
 
 use super::dlgpd_action_response::RESPONSE_HORIZONS;
 use super::dlgpd_prediction::{reward_prediction, RewardPrediction};
-use super::plot::{line_plot, line_plot_in, rising_line_plot, Series};
+use super::plot::{line_plot, line_plot_in, rising_line_plot, strip_plot, Series, StripDot};
 use super::stats::{wilcoxon_signed_rank, Alternative};
 use crate::data::collect::{collect_random, CollectSettings};
 use crate::data::collect_frames::add_pendulum_frames;
@@ -392,7 +392,9 @@ fn write_report(
     if settings.swing_ups {
         write_swing_up_section(settings, run_dir, findings, &mut md)?;
         files.push("`results.csv` (every run)".into());
-        files.extend(["summary.csv", "wilcoxon.csv", "returns.png", "success.png"].map(|f| format!("`{f}`")));
+        files.extend(
+            ["summary.csv", "wilcoxon.csv", "returns.png", "success.png", "runs.png"].map(|f| format!("`{f}`")),
+        );
     }
     write_prediction_section(run_dir, findings.predictions, &mut md)?;
     files.extend(["prediction.csv", "prediction.png", "action_response.csv"].map(|f| format!("`{f}`")));
@@ -401,6 +403,34 @@ fn write_report(
     }
     md.push_str(&format!("\nFiles: {}.\n", files.join(", ")));
     std::fs::write(run_dir.file("report.md"), md).map_err(|e| Error::io(&run_dir.file("report.md"), e))
+}
+
+/// Every run's return at the largest evidence size, the one the claims are about: with one evidence size
+/// `returns.png` shows a single mean per setting.
+fn write_runs_plot(run_dir: &RunDir, outcomes: &[Outcome]) -> Result<()> {
+    let largest = outcomes.iter().map(|o| o.rollouts).max().unwrap_or(0);
+    let kinds = ["matching", "mismatching"];
+    let mut groups: Vec<String> = Vec::new();
+    let mut dots = Vec::new();
+    for o in outcomes.iter().filter(|o| o.rollouts == largest) {
+        let group = match groups.iter().position(|g| *g == o.env) {
+            Some(i) => i,
+            None => {
+                groups.push(o.env.clone());
+                groups.len() - 1
+            }
+        };
+        let kind = kinds.iter().position(|k| *k == o.evidence).unwrap_or(0);
+        dots.push(StripDot { group, kind, value: o.total_return, filled: o.success });
+    }
+    strip_plot(
+        &run_dir.file("runs.png"),
+        &format!("DLGPD return of every run, {largest} evidence rollouts (filled: swung up)"),
+        "return",
+        &groups,
+        &kinds.map(|k| format!("{k} evidence")),
+        &dots,
+    )
 }
 
 fn write_swing_up_section(
@@ -474,6 +504,7 @@ fn write_swing_up_section(
         &curves(&|p| p.successes as f64 / p.runs as f64),
         (-0.05, 1.05),
     )?;
+    write_runs_plot(run_dir, outcomes)?;
     md.push_str(&format!(
         "## Swing-ups\n\nCEM: {} candidates, {} elites, ≤ {} iterations (stopping at first-action std ≤ 0.01), \
          horizon {}; {} steps from the hanging position; success = each of the last 25 rewards > −1. Each point \

@@ -439,6 +439,86 @@ pub fn box_plot(path: &Path, title: &str, x_label: &str, y_label: &str, groups: 
     })
 }
 
+/// One value of `strip_plot`: its column (`group`), its sub-column and colour (`kind`), and whether it is
+/// drawn filled (an outcome that reached its goal) or hollow.
+pub struct StripDot {
+    pub group: usize,
+    pub kind: usize,
+    pub value: f64,
+    pub filled: bool,
+}
+
+/// Every value as its own dot, so that six runs read as six runs and not as one mean: one column per group
+/// (x labels), split into one sub-column per kind (colour and legend), each sub-column's mean a bar.
+pub fn strip_plot(
+    path: &Path,
+    title: &str,
+    y_label: &str,
+    groups: &[String],
+    kinds: &[String],
+    dots: &[StripDot],
+) -> Result<()> {
+    let (y0, y1) = bounds(dots.iter().map(|d| d.value));
+    // Room under the lowest dots for the legend, so it never hides one.
+    let y0 = y0 - 0.25 * (y1 - y0);
+    let n = groups.len().max(1);
+    let width = 0.7 / kinds.len().max(1) as f64;
+    let column = |d: &StripDot| d.group as f64 - 0.35 + width * (d.kind as f64 + 0.5);
+    render_atomic(path, |tmp| {
+        let root = BitMapBackend::new(tmp, SIZE).into_drawing_area();
+        let mut chart = titled_chart(&root, path, title, -0.5..n as f64 - 0.5, y0..y1)?;
+        chart
+            .configure_mesh()
+            .x_labels(n)
+            .x_label_formatter(&|x| {
+                let i = x.round();
+                if (x - i).abs() < 1e-6 && i >= 0.0 {
+                    groups.get(i as usize).cloned().unwrap_or_default()
+                } else {
+                    String::new()
+                }
+            })
+            .y_desc(y_label)
+            .draw()
+            .map_err(|e| plot_err(path, e))?;
+        for (kind, name) in kinds.iter().enumerate() {
+            let color = series_color(kind);
+            let mut placed: Vec<(f64, f64, bool)> = Vec::new();
+            let mut bars: Vec<PathElement<(f64, f64)>> = Vec::new();
+            for group in 0..groups.len() {
+                let cell: Vec<&StripDot> =
+                    dots.iter().filter(|d| d.group == group && d.kind == kind && d.value.is_finite()).collect();
+                let Some(first) = cell.first() else { continue };
+                let center = column(first);
+                // Dots fan out across the sub-column in run order, so equal returns stay visible.
+                let spread = width * 0.6;
+                for (j, d) in cell.iter().enumerate() {
+                    let offset = if cell.len() > 1 { spread * (j as f64 / (cell.len() - 1) as f64 - 0.5) } else { 0.0 };
+                    placed.push((center + offset, d.value, d.filled));
+                }
+                let mean = cell.iter().map(|d| d.value).sum::<f64>() / cell.len() as f64;
+                let half = width * 0.45;
+                bars.push(PathElement::new(vec![(center - half, mean), (center + half, mean)], color.stroke_width(3)));
+            }
+            // A hollow dot is a white disc inside a ring: a thick stroked circle alone renders as a blot.
+            chart
+                .draw_series(placed.iter().filter(|p| !p.2).map(|&(x, y, _)| Circle::new((x, y), 5, WHITE.filled())))
+                .map_err(|e| plot_err(path, e))?;
+            chart
+                .draw_series(placed.iter().map(|&(x, y, filled)| {
+                    Circle::new((x, y), 5, if filled { color.filled() } else { color.stroke_width(1) })
+                }))
+                .map_err(|e| plot_err(path, e))?
+                .label(name.clone())
+                .legend(move |(x, y)| Circle::new((x + 8, y), 5, color.filled()));
+            chart.draw_series(bars).map_err(|e| plot_err(path, e))?;
+        }
+        draw_legend(&mut chart, path, SeriesLabelPosition::LowerRight, None)?;
+        root.present().map_err(|e| plot_err(path, e))?;
+        Ok(())
+    })
+}
+
 pub fn histogram(path: &Path, title: &str, x_label: &str, values: &[f64], bins: usize) -> Result<()> {
     let finite: Vec<f64> = values.iter().copied().filter(|v| v.is_finite()).collect();
     let (lo, hi) = bounds(finite.iter().copied());
@@ -564,7 +644,12 @@ mod tests {
         histogram(&dir.path().join("h.png"), "h", "v", &[1.0, 2.0, 2.5, f64::NAN], 5).unwrap();
         let groups = vec![("a".to_string(), vec![1.0, 2.0, 3.0, 40.0]), ("empty".to_string(), vec![])];
         box_plot(&dir.path().join("box.png"), "b", "group", "v", &groups).unwrap();
-        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 4, "no temporary files left");
+        // A group whose every value is missing, and a kind with no values at all, leave their slots empty.
+        let dots = [(0, 0, -500.0, true), (0, 0, -1200.0, false), (0, 1, -1150.0, false), (1, 0, f64::NAN, false)]
+            .map(|(group, kind, value, filled)| StripDot { group, kind, value, filled });
+        let (groups, kinds) = (["a".to_string(), "b".to_string()], ["x".to_string(), "y".to_string(), "z".to_string()]);
+        strip_plot(&dir.path().join("strip.png"), "s", "v", &groups, &kinds, &dots).unwrap();
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 5, "no temporary files left");
     }
 
     #[test]

@@ -137,6 +137,9 @@ pub struct DlgpdTrainer {
     train_rows: Vec<usize>,
     valid_rows: Vec<usize>,
     last: Option<StepLoss>,
+    /// The frozen standardization of the current weights: an improving validation needs it twice (the
+    /// prediction check and the saved weights), and at image size it costs a thousand encodings.
+    frozen_scale_of_weights: std::cell::RefCell<Option<LatentScale>>,
 }
 
 impl DlgpdTrainer {
@@ -172,6 +175,7 @@ impl DlgpdTrainer {
             train_rows,
             valid_rows,
             last: None,
+            frozen_scale_of_weights: std::cell::RefCell::new(None),
         })
     }
 
@@ -206,6 +210,15 @@ impl DlgpdTrainer {
 
     /// The standardization planning freezes: mean and std (+0.01) of encoder samples on training transitions.
     pub fn frozen_scale(&self) -> Result<LatentScale> {
+        if let Some(scale) = self.frozen_scale_of_weights.borrow().as_ref() {
+            return Ok(scale.clone());
+        }
+        let scale = self.compute_frozen_scale()?;
+        *self.frozen_scale_of_weights.borrow_mut() = Some(scale.clone());
+        Ok(scale)
+    }
+
+    fn compute_frozen_scale(&self) -> Result<LatentScale> {
         let mut rng = rng_for(self.seed, &[SCALE_STREAM]);
         let count = self.train_rows.len().min(SCALE_ROWS);
         let rows: Vec<usize> =
@@ -240,6 +253,7 @@ impl TrainingMethod for DlgpdTrainer {
             &self.device,
         )?;
         let mut vae_grads = std::mem::take(&mut loss.vae_gradients);
+        *self.frozen_scale_of_weights.get_mut() = None;
         self.vae_adam.update(&mut self.params.values_mut(), &mut vae_grads)?;
         let vae = self.vae.take().expect("present between steps");
         self.vae = Some(vae.with_params(&self.params, &self.device)?);
@@ -327,6 +341,7 @@ impl TrainingMethod for DlgpdTrainer {
 
     fn restore(&mut self, saved: &[StoredTensor]) -> Result<()> {
         state::restore(saved, &mut self.params, &mut self.vae_adam)?;
+        *self.frozen_scale_of_weights.get_mut() = None;
         let vae = self.vae.take().expect("present between steps");
         self.vae = Some(vae.with_params(&self.params, &self.device)?);
         let has_gps = saved.iter().any(|t| t.name.starts_with(&format!("live.{REWARD_GP}.")));
