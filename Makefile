@@ -17,6 +17,16 @@ bench:
 
 $(MBRL): build
 
+# `$(call train_or_resume,DIR,TRAIN FLAGS,RESUME FLAGS)`: a new run in DIR, or, where an interrupted make left a
+# stopped run there, that run resumed (a fresh `train` refuses to replace it), so re-running a long target
+# loses none of its training.
+train_or_resume = if cat $(1)/checkpoint.json $(1)/.mbrl-next/checkpoint.json 2>/dev/null | grep -q '"complete": false'; then \
+		echo "resuming the stopped run in $(1)"; \
+		$(MBRL) train --resume $(1) $(3) --no-tui -q; \
+	else \
+		$(MBRL) train $(2) --no-tui -q --out $(1); \
+	fi
+
 # The README's main job: a small reproduction of every implemented method (reports/quick/).
 repro-quick: build
 	$(MBRL) eval quick --seed $(SEED) --no-tui
@@ -81,11 +91,11 @@ repro-context: build
 		done; \
 	done
 	$(MBRL) collect --env pendulum:quadrant --instances 10000 --steps 100 --seed $(SEED) --no-tui -q --out datasets/context/pendulum-quadrant.mcap
-	$(MBRL) train --method context --data datasets/context/pendulum-quadrant.mcap --preset $(CONTEXT_PRESET) --seed $(SEED) --no-tui -q --out models/context/pendulum-quadrant
+	$(call train_or_resume,models/context/pendulum-quadrant,--method context --data datasets/context/pendulum-quadrant.mcap --preset $(CONTEXT_PRESET) --seed $(SEED))
 	$(MBRL) eval context --model models/context/pendulum-quadrant --env pendulum:quadrant --transitions 30 --horizon 20 \
 		--contexts $(CONTEXT_CONTEXTS) $(CONTEXT_CEM) $(CONTEXT_SWINGUP) --seed $(SEED) --no-tui -q --out reports/context/pendulum-quadrant
 	$(MBRL) collect --env mountaincar --instances 5000 --steps 100 --seed $(SEED) --no-tui -q --out datasets/context/mountaincar.mcap
-	$(MBRL) train --method context --data datasets/context/mountaincar.mcap --preset $(CONTEXT_PRESET) --seed $(SEED) --no-tui -q --out models/context/mountaincar
+	$(call train_or_resume,models/context/mountaincar,--method context --data datasets/context/mountaincar.mcap --preset $(CONTEXT_PRESET) --seed $(SEED))
 	$(MBRL) eval context --model models/context/mountaincar --env mountaincar --transitions 50 --horizon 30 \
 		--contexts $(CONTEXT_CONTEXTS) $(CONTEXT_CEM) --seed $(SEED) --no-tui -q --out reports/context/mountaincar
 
@@ -95,7 +105,7 @@ repro-context: build
 # figures in the README are this run's, seed 0).
 repro-context-mountaincar: build
 	$(MBRL) collect --env mountaincar --instances 10000 --steps 100 --seed $(SEED) --no-tui -q --out datasets/context/mountaincar-10k.mcap
-	$(MBRL) train --method context --data datasets/context/mountaincar-10k.mcap --preset small --steps 30000 --seed $(SEED) --no-tui -q --out models/context/mountaincar-small
+	$(call train_or_resume,models/context/mountaincar-small,--method context --data datasets/context/mountaincar-10k.mcap --preset small --steps 30000 --seed $(SEED))
 	$(MBRL) eval context --model models/context/mountaincar-small --env mountaincar --transitions 50 --horizon 30 --contexts 50 \
 		--candidates 300 --elites 30 --iters 4 --beta-samples 10 --threads 1 --seed $(SEED) --no-tui -q --out reports/context/mountaincar-small
 
@@ -136,16 +146,17 @@ repro-seads: build
 # evidence rollouts; standard, inverted, light, heavy) are DLGPD_EVAL="--evidence-rollouts 5,10,20 --runs 2
 # --candidates 300 --elites 30 --iters 10" (hours). The medium preset's 3000 steps reconstruct the pole but
 # do not swing up; DLGPD_STEPS=30000 (about 12 h of one core) is the length of the run the README reports,
-# with one thread as there. A finished run is trained further with `mbrl train --resume DIR --steps N`.
+# with one thread as there; an interrupted make resumes the stopped run. A finished run is trained further
+# with `mbrl train --resume DIR --steps N`.
 DLGPD_PRESET ?= medium
 DLGPD_STEPS ?=
 DLGPD_THREADS ?= 1
 DLGPD_EVAL ?= --env pendulum --env pendulum:inverted --evidence-rollouts 20 --runs 6 --candidates 200 --elites 20 --iters 8
 repro-dlgpd: build
 	$(MBRL) collect --env pendulum --images --rollouts 500 --steps 29 --seed $(SEED) --no-tui -q --out datasets/dlgpd/pendulum-frames.mcap
-	$(MBRL) train --method dlgpd --data datasets/dlgpd/pendulum-frames.mcap --preset $(DLGPD_PRESET) \
-		$(if $(DLGPD_STEPS),--steps $(DLGPD_STEPS)) --threads $(DLGPD_THREADS) --seed $(SEED) --no-tui -q \
-		--out models/dlgpd-$(DLGPD_PRESET)
+	$(call train_or_resume,models/dlgpd-$(DLGPD_PRESET),--method dlgpd --data datasets/dlgpd/pendulum-frames.mcap \
+		--preset $(DLGPD_PRESET) $(if $(DLGPD_STEPS),--steps $(DLGPD_STEPS)) --threads $(DLGPD_THREADS) --seed $(SEED),\
+		--threads $(DLGPD_THREADS))
 	$(MBRL) eval dlgpd --model models/dlgpd-$(DLGPD_PRESET) $(DLGPD_EVAL) --threads $(DLGPD_THREADS) --seed $(SEED) \
 		--no-tui -q --out reports/dlgpd
 

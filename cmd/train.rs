@@ -174,6 +174,27 @@ pub fn run(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
     }
 }
 
+/// A fresh run starts by clearing its directory, so pointing it at a stopped run would throw away every hour
+/// that run trained (a re-run Makefile target after an interruption, say): that is refused, naming the two
+/// ways on. A finished run or a directory without a checkpoint is replaced as before.
+fn fresh_run_dir(out: PathBuf) -> anyhow::Result<PathBuf> {
+    if let Ok(opened) = OpenedCheckpoint::open(&out) {
+        let manifest = &opened.manifest;
+        if !manifest.complete {
+            bail!(
+                "{}: holds a {} run stopped at step {} of {}; continue it with `mbrl train --resume {}`, or remove \
+                 the directory to start over",
+                out.display(),
+                manifest.method,
+                manifest.step,
+                manifest.total_steps,
+                out.display()
+            );
+        }
+    }
+    Ok(out)
+}
+
 fn resume(global: &GlobalArgs, dir: &Path, extend_to: Option<&Extension>) -> anyhow::Result<()> {
     let method = OpenedCheckpoint::open(dir)?.manifest.method;
     // Training that depends on its total (context's p_ctx schedule, ball-ekf's and seads' budgets) cannot be
@@ -271,7 +292,8 @@ fn train_pets(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
     if args.reward.is_none() && args.config.is_none() && mbrl::envs::parse_env(&env)?.known_reward().is_none() {
         config.reward = RewardSource::Learned;
     }
-    let out = args.out.clone().unwrap_or_else(|| PathBuf::from(format!("models/pets-{}", file_stem(&env))));
+    let out =
+        fresh_run_dir(args.out.clone().unwrap_or_else(|| PathBuf::from(format!("models/pets-{}", file_stem(&env)))))?;
     let request = pets::TrainRequest {
         out: out.clone(),
         data: args.data.clone(),
@@ -370,7 +392,9 @@ fn train_context(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
         bail!("{}: unicycle data trains TRADYN, which reads the terrain: `mbrl train --method tradyn`", data.display());
     }
     let config = context_config(&args, &env)?;
-    let out = args.out.clone().unwrap_or_else(|| PathBuf::from(format!("models/context-{}", file_stem(&env_name))));
+    let out = fresh_run_dir(
+        args.out.clone().unwrap_or_else(|| PathBuf::from(format!("models/context-{}", file_stem(&env_name)))),
+    )?;
     let request = context::TrainRequest {
         method: context::METHOD.into(),
         space: context::StateSpace::EnvState,
@@ -405,7 +429,7 @@ fn train_tradyn(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
     }
     let config = context_config(&args, &env)?;
     let variant = if args.no_terrain { "no-terrain" } else { "terrain" };
-    let out = args.out.clone().unwrap_or_else(|| PathBuf::from(format!("models/tradyn-{variant}")));
+    let out = fresh_run_dir(args.out.clone().unwrap_or_else(|| PathBuf::from(format!("models/tradyn-{variant}"))))?;
     let request = context::TrainRequest {
         method: tradyn::METHOD.into(),
         space: tradyn::state_space(!args.no_terrain),
@@ -472,7 +496,7 @@ fn train_ball(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
     let [data] = args.data.as_slice() else {
         bail!("ball-ekf trains on one --data file, got {}", args.data.len());
     };
-    let out = args.out.clone().unwrap_or_else(|| PathBuf::from("models/ball-ekf"));
+    let out = fresh_run_dir(args.out.clone().unwrap_or_else(|| PathBuf::from("models/ball-ekf")))?;
     let steps = args.steps.unwrap_or(1000);
     let batch = args.batch.unwrap_or(64);
     let lr = args.lr.unwrap_or(5e-3);
@@ -597,7 +621,9 @@ fn train_seads(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
     let env_name = args.env.as_deref().context(format!("seads needs --env ({})", seads::ENV_HELP))?;
     let env = EmbodiedGame::parse(env_name)?;
     let config = seads_config(&args, &env)?;
-    let out = args.out.clone().unwrap_or_else(|| PathBuf::from(format!("models/seads-{}", file_stem(&env.name()))));
+    let out = fresh_run_dir(
+        args.out.clone().unwrap_or_else(|| PathBuf::from(format!("models/seads-{}", file_stem(&env.name())))),
+    )?;
     let request = seads::TrainRequest {
         out: out.clone(),
         env,
@@ -678,7 +704,7 @@ fn train_dlgpd(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
     if args.data.is_empty() {
         bail!("dlgpd needs --data: pendulum rollouts (`mbrl collect --env pendulum [--images]`)");
     }
-    let out = args.out.clone().unwrap_or_else(|| PathBuf::from("models/dlgpd-pendulum"));
+    let out = fresh_run_dir(args.out.clone().unwrap_or_else(|| PathBuf::from("models/dlgpd-pendulum")))?;
     let request = dlgpd::TrainRequest {
         out: out.clone(),
         data: args.data.clone(),

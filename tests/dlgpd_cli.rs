@@ -152,6 +152,14 @@ fn resume_ends_with_the_bytes_of_an_uninterrupted_run() {
     let report = std::fs::read_to_string(dir.path().join("partial/report.md")).unwrap();
     assert!(report.contains("20 of 30 steps (training still in progress)"), "{report}");
 
+    // Starting a new run over the stopped one is refused and leaves it as it was: the resumed run below
+    // still ends with the uninterrupted run's bytes.
+    let fresh = mbrl(dir.path())
+        .args(["train", "--method", "dlgpd", "--data", "train.mcap", "--steps", "30", "--out", "stopped", "--no-tui"])
+        .output()
+        .unwrap();
+    assert_one_line_error(&fresh, &["stopped", "stopped at step 20 of 30", "mbrl train --resume stopped"]);
+
     let out = mbrl(dir.path()).args(["train", "--resume", "stopped", "--no-tui"]).output().unwrap();
     assert!(out.status.success(), "{}", stderr_of(&out));
     // The CLI adds its loss report after training; the library run writes none.
