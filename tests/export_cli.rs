@@ -159,6 +159,21 @@ fn ball_recordings_and_filter_estimates_export_with_missing_frames_as_nan() {
     }
     let _: ArrayD<f64> = npz(&d.join("est-x.npz")).by_name("mean").unwrap();
     let _: ndarray::Array<f64, Ix2> = npz(&d.join("ball-x.npz")).by_name("recording_side_info").unwrap();
+
+    // The exported CSV goes back into the filter: both trajectories, the same estimates as from the MCAP.
+    mbrl(d)
+        .args(["filter", "--model", "thesis", "--input", "ball-x.csv", "--out", "est-from-csv.csv", "-q", "--no-tui"])
+        .assert()
+        .success();
+    let (header, from_csv) = csv_rows(&d.join("est-from-csv.csv"));
+    assert_eq!(from_csv.len(), own.len());
+    let trajectory = column(&header, "trajectory");
+    assert_eq!(from_csv.last().unwrap()[trajectory], "1");
+    let (px, own_px) = (column(&header, "px"), column(&own_header, "px"));
+    for (x, y) in own.iter().zip(&from_csv) {
+        let (x, y): (f64, f64) = (x[own_px].parse().unwrap(), y[px].parse().unwrap());
+        assert!((x - y).abs() <= 1e-9 * x.abs().max(1.0), "{x} vs {y}");
+    }
 }
 
 /// NumPy itself opens the archives with the documented keys, shapes and dtypes, when it is installed.

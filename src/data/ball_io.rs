@@ -209,10 +209,11 @@ fn check_enough_measurements(path: &Path, r: &Recording) -> Result<()> {
 /// Larger than any recording (a 10-minute capture at 180 Hz is ~5 MB); an endless input stops here.
 pub const MAX_BALL_CSV_BYTES: u64 = 256 << 20;
 
-/// Reads a CSV recording: a header with `frame` (camera frame index) or `t` (seconds), then `x`, `y`,
+/// Reads CSV recordings: a header with `frame` (camera frame index) or `t` (seconds), then `x`, `y`,
 /// `z` in metres (empty cells = lost frame), optionally the seven side-information columns
-/// `SIDE_INFO_COLUMNS` (read from the first row).
-pub fn read_ball_csv(path: &Path) -> Result<Recording> {
+/// `SIDE_INFO_COLUMNS` (read from a trajectory's first row) and a `trajectory` column (as `export`
+/// writes it) whose runs of equal ids are the recordings; without it the file is one recording.
+pub fn read_ball_csv(path: &Path) -> Result<Vec<Recording>> {
     use std::io::Read;
     let file = crate::util::bounded_read::open_regular(path)?;
     let size = file.metadata().map_err(|e| Error::io(path, e))?.len();
@@ -237,8 +238,16 @@ pub fn read_ball_csv(path: &Path) -> Result<Recording> {
         ));
     };
     let side_columns: Option<Vec<usize>> = SIDE_INFO_COLUMNS.iter().map(|c| column(c)).collect();
-    let mut rec =
-        Recording { id: 0, frames: Vec::new(), positions: Vec::new(), truth: None, info: RecordingInfo::default() };
+    let trajectory_column = column("trajectory");
+    let empty = |id: u32| Recording {
+        id,
+        frames: Vec::new(),
+        positions: Vec::new(),
+        truth: None,
+        info: RecordingInfo::default(),
+    };
+    let mut done: Vec<Recording> = Vec::new();
+    let mut rec = empty(0);
     for (i, row) in reader.records().enumerate() {
         let line = i + 2;
         let row = row.map_err(|e| Error::bad_file(path, format!("row {line}: {e}")))?;
@@ -257,6 +266,24 @@ pub fn read_ball_csv(path: &Path) -> Result<Recording> {
             }
             Ok(v)
         };
+        if let Some(c) = trajectory_column {
+            let id: u32 = row[c].parse().map_err(|_| {
+                Error::bad_file(path, format!("row {line}: trajectory '{}' is not a non-negative integer", &row[c]))
+            })?;
+            if id != rec.id || rec.frames.is_empty() {
+                if done.iter().any(|r| r.id == id) {
+                    return Err(Error::bad_file(
+                        path,
+                        format!("row {line}: trajectory {id} appears again after other trajectories; keep its rows together"),
+                    ));
+                }
+                if !rec.frames.is_empty() {
+                    check_enough_measurements(path, &rec)?;
+                    done.push(std::mem::replace(&mut rec, empty(id)));
+                }
+                rec.id = id;
+            }
+        }
         let stamp = number(tc, if is_frame { "frame" } else { "t" })?;
         let frame = if is_frame { stamp } else { stamp * FRAME_RATE };
         if frame < 0.0 || (frame - frame.round()).abs() > 0.05 {
@@ -288,14 +315,15 @@ pub fn read_ball_csv(path: &Path) -> Result<Recording> {
         rec.positions.push(position);
     }
     check_enough_measurements(path, &rec)?;
-    Ok(rec)
+    done.push(rec);
+    Ok(done)
 }
 
 /// Recordings from a `.mcap` ball dataset, a single `.csv` recording, or (built with the `hdf5` feature)
 /// an `.hdf5`/`.h5` file in the layout of the authors' release.
 pub fn read_recordings(path: &Path) -> Result<Vec<Recording>> {
     match path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).as_deref() {
-        Some("csv") => Ok(vec![read_ball_csv(path)?]),
+        Some("csv") => read_ball_csv(path),
         Some("mcap") => Ok(read_ball_dataset(path)?.recordings),
         Some("hdf5" | "h5") => read_hdf5(path),
         _ => Err(Error::bad_file(path, "expected a .mcap ball dataset, a .csv recording or an .hdf5 release file")),
@@ -334,10 +362,33 @@ mod tests {
             "a.csv",
             &format!("{header}\n3,0.1,2.0,0.3,0,1,0.5,0.8,0.1,0.15,0.16\n4,,,,,,,,,,\n6,0.12,1.9,0.31,,,,,,,\n"),
         );
-        let r = read_ball_csv(&p).unwrap();
+        let r = read_ball_csv(&p).unwrap().remove(0);
         assert_eq!(r.frames, vec![3, 4, 6]);
         assert_eq!(r.positions[1], None);
         assert_eq!(r.info.side_info.unwrap()[2], 0.5);
+    }
+
+    #[test]
+    fn csv_trajectory_column_splits_recordings() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = write(dir.path(), "t.csv", "trajectory,frame,x,y,z\n4,0,0,0,0\n4,1,0,0,1\n7,0,1,1,1\n7,2,1,1,2\n");
+        let recordings = read_ball_csv(&p).unwrap();
+        let ids: Vec<u32> = recordings.iter().map(|r| r.id).collect();
+        assert_eq!(ids, vec![4, 7]);
+        assert_eq!(recordings[1].frames, vec![0, 2]);
+        let p = write(
+            dir.path(),
+            "again.csv",
+            "trajectory,frame,x,y,z\n0,0,0,0,0\n0,1,0,0,1\n1,0,0,0,0\n1,1,0,0,0\n0,5,0,0,0\n",
+        );
+        let err = read_ball_csv(&p).unwrap_err().to_string();
+        assert!(err.contains("row 6: trajectory 0 appears again"), "{err}");
+        let p = write(dir.path(), "short.csv", "trajectory,frame,x,y,z\n0,0,0,0,0\n1,0,0,0,0\n1,1,0,0,0\n");
+        let err = read_ball_csv(&p).unwrap_err().to_string();
+        assert!(err.contains("trajectory 0: 1 measured positions"), "{err}");
+        let p = write(dir.path(), "neg.csv", "trajectory,frame,x,y,z\n-1,0,0,0,0\n");
+        let err = read_ball_csv(&p).unwrap_err().to_string();
+        assert!(err.contains("row 2: trajectory '-1' is not a non-negative integer"), "{err}");
     }
 
     #[test]
