@@ -156,7 +156,7 @@ fn plan_dlgpd(
     let Some(evidence_path) = &args.evidence else {
         bail!(
             "{} is a DLGPD model: pass --evidence ROLLOUTS.mcap (rollouts of the system at hand, e.g. `mbrl collect \
-             --env {} --rollouts 20 --steps 29 --images`)",
+             --env {} --rollouts 20 --steps 29`, adding --images for a model trained on frames)",
             args.model.model,
             args.env
         );

@@ -269,7 +269,12 @@ fn solve<G: DenseIndex>(global: &GlobalArgs, args: &SolveBoardArgs, game: G) -> 
     })?;
     let plan = result.plan.unwrap_or_default();
     say!("board {} ({}):\n{}", game.canonical_string(board), game.name(), game.render(board));
-    say!("plan ({} moves): {}", plan.len(), plan.iter().map(|&m| game.move_name(m)).collect::<Vec<_>>().join(", "));
+    say!(
+        "plan ({} move{}): {}",
+        plan.len(),
+        if plan.len() == 1 { "" } else { "s" },
+        plan.iter().map(|&m| game.move_name(m)).collect::<Vec<_>>().join(", ")
+    );
     let s = result.stats;
     say!(
         "search: {}, {} states expanded, {} generated, {} stored, {:.1} MiB",
