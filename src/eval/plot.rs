@@ -384,6 +384,16 @@ impl BoxStats {
     }
 }
 
+/// The name of the category whose column sits at `x` (columns at 0, 1, …); between columns, none.
+fn category_label(names: &[String], x: f64) -> String {
+    let i = x.round();
+    if (x - i).abs() < 1e-6 && i >= 0.0 {
+        names.get(i as usize).cloned().unwrap_or_default()
+    } else {
+        String::new()
+    }
+}
+
 /// One box per named group, left to right; groups without values leave their slot empty.
 pub fn box_plot(path: &Path, title: &str, x_label: &str, y_label: &str, groups: &[(String, Vec<f64>)]) -> Result<()> {
     let stats: Vec<Option<BoxStats>> = groups.iter().map(|(_, v)| BoxStats::of(v)).collect();
@@ -396,14 +406,7 @@ pub fn box_plot(path: &Path, title: &str, x_label: &str, y_label: &str, groups: 
         chart
             .configure_mesh()
             .x_labels(n)
-            .x_label_formatter(&|x| {
-                let i = x.round();
-                if (x - i).abs() < 1e-6 && i >= 0.0 {
-                    names.get(i as usize).cloned().unwrap_or_default()
-                } else {
-                    String::new()
-                }
-            })
+            .x_label_formatter(&|x| category_label(&names, *x))
             .x_desc(x_label)
             .y_desc(y_label)
             .draw()
@@ -470,14 +473,7 @@ pub fn strip_plot(
         chart
             .configure_mesh()
             .x_labels(n)
-            .x_label_formatter(&|x| {
-                let i = x.round();
-                if (x - i).abs() < 1e-6 && i >= 0.0 {
-                    groups.get(i as usize).cloned().unwrap_or_default()
-                } else {
-                    String::new()
-                }
-            })
+            .x_label_formatter(&|x| category_label(groups, *x))
             .y_desc(y_label)
             .draw()
             .map_err(|e| plot_err(path, e))?;
