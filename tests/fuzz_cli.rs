@@ -189,6 +189,8 @@ fn targets() -> Vec<Target> {
         target("estimates-export", mcap("filtered.mcap"), "export --input {in} --format npz --out {out}"),
         target("images-export", mcap("img.mcap"), "export --input {in} --format npz --out {out}"),
         target("ball-csv", text("ball.csv"), "filter --model thesis --input {in} --out {out}"),
+        // A dataset exported to CSV: its trajectory column splits the recordings.
+        target("ball-csv-trajectories", text("ball-traj.csv"), "predict --model thesis --input {in} --out {out}"),
         target("actions-pendulum", text("actions.csv"), "collect --env pendulum --actions {in} --out {out}"),
         // Terrain: a user's map, and a map set (its manifest, or a map the manifest vouches for).
         target("terrain-map", png("map.png"), "collect --env unicycle --map {in} --rollouts 1 --steps 3 --out {out}"),
@@ -417,6 +419,7 @@ fn generate_seeds(dir: &Path) {
     make(dir, "collect --env toy:inner --instances 4 --steps 12 --out ctx.mcap");
     make(dir, "collect --env pendulum:quadrant --instances 4 --steps 12 --out quad.mcap");
     make(dir, "collect --env ball --trajectories 2 --out ball.mcap");
+    make(dir, "export --input ball.mcap --out ball-traj.csv");
     make(dir, "collect --env lightsout --boards --max-depth 2 --out boards.mcap");
     make(dir, "collect --env terrain --maps 2 --out terrain");
     fs::copy(dir.join("terrain/map000.png"), dir.join("map.png")).unwrap();

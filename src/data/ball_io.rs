@@ -247,6 +247,8 @@ pub fn read_ball_csv(path: &Path) -> Result<Vec<Recording>> {
         info: RecordingInfo::default(),
     };
     let mut done: Vec<Recording> = Vec::new();
+    // Ids already closed: a set, since a file of two-row trajectories has millions of them.
+    let mut seen = std::collections::BTreeSet::new();
     let mut rec = empty(0);
     for (i, row) in reader.records().enumerate() {
         let line = i + 2;
@@ -270,16 +272,17 @@ pub fn read_ball_csv(path: &Path) -> Result<Vec<Recording>> {
             let id: u32 = row[c].parse().map_err(|_| {
                 Error::bad_file(path, format!("row {line}: trajectory '{}' is not a non-negative integer", &row[c]))
             })?;
-            if id != rec.id || rec.frames.is_empty() {
-                if done.iter().any(|r| r.id == id) {
+            if id != rec.id && !rec.frames.is_empty() {
+                check_enough_measurements(path, &rec)?;
+                seen.insert(rec.id);
+                done.push(std::mem::replace(&mut rec, empty(id)));
+            }
+            if rec.frames.is_empty() {
+                if seen.contains(&id) {
                     return Err(Error::bad_file(
                         path,
                         format!("row {line}: trajectory {id} appears again after other trajectories; keep its rows together"),
                     ));
-                }
-                if !rec.frames.is_empty() {
-                    check_enough_measurements(path, &rec)?;
-                    done.push(std::mem::replace(&mut rec, empty(id)));
                 }
                 rec.id = id;
             }
