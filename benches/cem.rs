@@ -2,8 +2,9 @@
 //! 10 iterations). Target: ≥ 100 MPC steps/s on 2 cores.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use mbrl::control::ReturnObjective;
 use mbrl::envs::pendulum::{PendulumDynamics, PendulumParams};
-use mbrl::planning::{Cem, CemConfig, NoiseKind, ReturnObjective};
+use mbrl::planning::{Cem, CemConfig, NoiseKind};
 
 fn mpc_step(c: &mut Criterion) {
     let dynamics = PendulumDynamics { params: PendulumParams::default() };

@@ -4,6 +4,8 @@
 //! checkpoint (1000 × 20 × 10 iterations). PyTorch figures: benches/pytorch/context_reference.py.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use mbrl::control::Objective;
+use mbrl::control::ReturnObjective;
 use mbrl::data::collect::{collect_instance_pairs, InstancePairSettings};
 use mbrl::data::write_dataset;
 use mbrl::envs::parse_env;
@@ -17,8 +19,7 @@ use mbrl::models::context::ContextTrainer;
 use mbrl::models::context::{load, train, TrainRequest};
 use mbrl::nn::tensor::inference_device;
 use mbrl::nn::ParamSet;
-use mbrl::planning::Objective;
-use mbrl::planning::{Cem, CemConfig, ReturnObjective};
+use mbrl::planning::{Cem, CemConfig};
 use mbrl::run::dir::Provenance;
 use mbrl::run::NullMonitor;
 use mbrl::train::TrainingMethod;

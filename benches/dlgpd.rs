@@ -48,10 +48,10 @@ fn gp(c: &mut Criterion) {
 /// three transition GPs (with predictive variances) and scored by the reward GP at 5 latent samples per step,
 /// with 280 and 1400 evidence points (10 and 50 evidence rollouts of 28 transitions).
 fn planning(c: &mut Criterion) {
+    use mbrl::control::Objective;
     use mbrl::models::dlgpd::control::LatentObjective;
     use mbrl::models::dlgpd::dynamics::{Evidence, LatentDynamics};
     use mbrl::models::dlgpd::latent_gp::LatentScale;
-    use mbrl::planning::Objective;
     let mut group = c.benchmark_group("dlgpd_cem_iteration_1000x20");
     group.sample_size(10);
     for points in [280usize, 1400] {

@@ -5,14 +5,16 @@
 
 use burn::tensor::Device;
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use mbrl::control::ReturnObjective;
+use mbrl::control::{BatchDynamics, RewardFn};
 use mbrl::envs::pendulum::dynamics::PendulumReward;
-use mbrl::envs::{BatchDynamics, RewardFn};
-use mbrl::models::pets::data::{feature_dim, features, Transitions};
+use mbrl::models::pets::data::Transitions;
 use mbrl::models::pets::net::{torch_name, PetsNet};
 use mbrl::models::pets::{PetsConfig, PetsDynamics, PetsTrainer, Preset, Propagation};
+use mbrl::nn::features::{feature_dim, features};
 use mbrl::nn::tensor::{inference_device, tensor, values};
 use mbrl::nn::{Normalizer, ParamSet};
-use mbrl::planning::{Cem, CemConfig, ReturnObjective};
+use mbrl::planning::{Cem, CemConfig};
 use mbrl::train::TrainingMethod;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;

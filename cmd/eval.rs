@@ -306,8 +306,11 @@ pub fn run(global: &GlobalArgs, args: EvalArgs) -> anyhow::Result<()> {
             let variant = pendulum_variant(&a.env)?;
             let model = a.model.load(&mbrl::envs::parse_env(&a.env)?)?;
             let model = model.as_deref();
-            if a.episodes == 0 || a.steps < swingup::SUCCESS_WINDOW {
-                bail!("--episodes must be at least 1 and --steps at least {}", swingup::SUCCESS_WINDOW);
+            if a.episodes == 0 || a.steps < mbrl::envs::pendulum::swingup::SUCCESS_WINDOW {
+                bail!(
+                    "--episodes must be at least 1 and --steps at least {}",
+                    mbrl::envs::pendulum::swingup::SUCCESS_WINDOW
+                );
             }
             mbrl::util::budget::check(
                 &format!("--episodes {} × --steps {}", a.episodes, a.steps),

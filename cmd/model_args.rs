@@ -5,7 +5,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::bail;
 use clap::{Args, ValueEnum};
-use mbrl::envs::{BatchDynamics, EnvName};
+use mbrl::control::BatchDynamics;
+use mbrl::envs::EnvName;
 use mbrl::models::pets::Propagation;
 use mbrl::models::{load_planning_model, RolloutOptions};
 use mbrl::train::{Accept, OpenedCheckpoint, TrainingProgress};

@@ -5,10 +5,11 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use anyhow::bail;
+use mbrl::control::BatchDynamics;
 use mbrl::data::{write_dataset, Dataset};
 use mbrl::envs::terrain::TerrainMap;
 use mbrl::envs::unicycle::UnicycleTerrain;
-use mbrl::envs::{instance_env, BatchDynamics, EnvName};
+use mbrl::envs::{instance_env, EnvName};
 use mbrl::models::context::calibration::read_context;
 use mbrl::models::tradyn::navigation::{layout, navigate, NavigationSettings, NavigationTask};
 use mbrl::models::tradyn::{self, TradynDynamics, TradynModel};

@@ -1,6 +1,7 @@
 //! mbrl: model-based reinforcement learning as a library. The `mbrl` binary (in `cmd/`) is a thin shell
 //! over these modules; see ARCHITECTURE.md for how the rooms fit together.
 
+pub mod control;
 pub mod data;
 pub mod envs;
 pub mod error;
@@ -16,6 +17,9 @@ pub mod tui;
 pub mod util;
 
 pub use error::{Error, Result};
+
+#[cfg(test)]
+mod layering;
 
 /// The version written into datasets and run directories.
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");

@@ -7,11 +7,11 @@ use std::path::Path;
 use base64::Engine;
 use serde::{Deserialize, Serialize};
 
-use super::frames_png::{decode_rgb, encode_rgb};
 use super::mcap_io::{message_clock, ExtraChannel, Layout};
 use super::rollout::Timestep;
 use super::schema::{FRAME_SCHEMA, FRAME_SCHEMA_NAME, FRAME_TOPIC};
 use crate::error::{Error, Result};
+use crate::util::png::{decode_rgb, encode_rgb};
 
 /// What the metadata says about a dataset's frames (field `frames`, absent when it has none).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

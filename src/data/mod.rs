@@ -13,7 +13,6 @@ pub mod collect_frames;
 pub mod dataset;
 pub mod export;
 pub mod frames;
-pub mod frames_png;
 pub mod mcap_io;
 pub mod rollout;
 pub mod scene;

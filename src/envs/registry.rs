@@ -145,11 +145,11 @@ impl EnvName {
         }
     }
 
-    /// The reward in closed form, where the env has one that learned models may use instead of learning it.
-    pub fn known_reward(&self) -> Option<Box<dyn super::RewardFn>> {
+    /// The reward in closed form, where the env has one that learned models may use instead of learning it
+    /// (the pendulum family's; `control::known_reward` hands it to models as a reward seam).
+    pub fn known_reward(&self) -> Option<super::pendulum::dynamics::PendulumReward> {
         match self {
-            EnvName::Pendulum(v) => super::pendulum::dynamics::PendulumReward::for_params(&v.fixed_params())
-                .map(|r| Box::new(r) as Box<dyn super::RewardFn>),
+            EnvName::Pendulum(v) => super::pendulum::dynamics::PendulumReward::for_params(&v.fixed_params()),
             // The toy has no task; MountainCar's reward depends on the hidden terrain.
             EnvName::Toy(_)
             | EnvName::MountainCar

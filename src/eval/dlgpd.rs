@@ -15,7 +15,6 @@ use super::plot::{line_plot, line_plot_in, rising_line_plot, strip_plot, Series,
 use super::stats::{wilcoxon_signed_rank, Alternative};
 use crate::data::collect::{collect_random, CollectSettings};
 use crate::data::collect_frames::add_pendulum_frames;
-use crate::data::frames_png::encode_rgb;
 use crate::data::Dataset;
 use crate::envs::pendulum::PendulumVariant;
 use crate::envs::EnvName;
@@ -28,6 +27,7 @@ use crate::models::dlgpd::vae::encode_rows;
 use crate::nn::tensor::{inference_device, tensor};
 use crate::run::dir::{Provenance, RunDir};
 use crate::run::{Event, Monitor, NullMonitor, Tee};
+use crate::util::png::encode_rgb;
 use crate::util::seeding::derive_seed;
 use crate::util::table::write_csv;
 

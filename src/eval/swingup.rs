@@ -7,9 +7,10 @@ use serde::Serialize;
 
 use super::plot::{histogram, line_plot, Series};
 use super::stats::{mean, quantile};
+use crate::control::BatchDynamics;
 use crate::data::{write_dataset, Dataset, DatasetLayout, DatasetMeta, Rollout};
 use crate::envs::pendulum::{angle_normalize, Pendulum, PendulumVariant, StartDistribution};
-use crate::envs::{BatchDynamics, Env};
+use crate::envs::Env;
 use crate::error::Result;
 use crate::planning::mpc::run_mpc_episode;
 use crate::planning::{Cem, CemConfig};
@@ -19,13 +20,7 @@ use crate::util::atomic::write_text;
 use crate::util::seeding::{derive_seed, rng_for};
 use crate::util::table::write_csv;
 
-pub const SUCCESS_WINDOW: usize = 25;
-pub const SUCCESS_MIN_REWARD: f64 = -1.0;
-
-/// The thesis' success criterion: every one of the last 25 rewards above −1.
-pub fn is_success(rewards: &[f64]) -> bool {
-    rewards.len() >= SUCCESS_WINDOW && rewards[rewards.len() - SUCCESS_WINDOW..].iter().all(|&r| r > SUCCESS_MIN_REWARD)
-}
+use crate::envs::pendulum::swingup::{is_success, SUCCESS_MIN_REWARD, SUCCESS_WINDOW};
 
 #[derive(Clone, Debug, Serialize)]
 pub struct SwingupSettings {
@@ -336,19 +331,4 @@ fn report_markdown(
     }
     md.push_str("\n![angle over time](angle.png)\n\n![returns](returns.png)\n\nPer-episode values: `episodes.csv`; executed rollouts: `rollouts.mcap`.\n");
     md
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn success_needs_all_last_25_rewards_above_minus_one() {
-        let mut r = vec![-5.0; 125];
-        r.extend(vec![-0.5; 25]);
-        assert!(is_success(&r));
-        r[130] = -1.0;
-        assert!(!is_success(&r));
-        assert!(!is_success(&[-0.1; 10]));
-    }
 }

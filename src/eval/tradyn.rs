@@ -14,11 +14,12 @@ use serde::Serialize;
 
 use super::plot::{band_panels, map_paths, Band, ColorGrid, MapPanel, Series};
 use super::stats::{quantile, wilcoxon_signed_rank, Alternative};
+use crate::control::BatchDynamics;
 use crate::data::collect::exploration_actions;
 use crate::data::Rollout;
 use crate::envs::terrain::TerrainMap;
 use crate::envs::unicycle::{Unicycle, UnicycleTerrain};
-use crate::envs::{BatchDynamics, Env};
+use crate::envs::Env;
 use crate::error::{Error, Result};
 use crate::models::context::calibration::{calibrate, context_rows, CalibrationSettings, Strategy};
 use crate::models::tradyn::navigation::{navigate, NavigationSettings, NavigationTask};

@@ -8,7 +8,8 @@ pub mod tradyn;
 
 use std::path::Path;
 
-use crate::envs::{BatchDynamics, EnvName};
+use crate::control::BatchDynamics;
+use crate::envs::EnvName;
 use crate::error::{Error, Result};
 use crate::train::OpenedCheckpoint;
 

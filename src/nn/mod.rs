@@ -12,6 +12,7 @@ pub mod conv;
 pub mod dense;
 pub mod ensemble;
 pub mod fast;
+pub mod features;
 pub mod gaussian;
 pub mod gru;
 pub mod init;

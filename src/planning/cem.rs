@@ -8,7 +8,7 @@ use rustfft::num_complex::Complex;
 use serde::{Deserialize, Serialize};
 
 use super::colored_noise::ColoredNoise;
-use super::Objective;
+use crate::control::Objective;
 use crate::error::{Error, Result};
 use crate::util::budget;
 use crate::util::seeding::rng_for;

@@ -4,6 +4,7 @@
 pub mod checkpoint;
 pub mod config;
 pub mod data_file;
+pub mod datasets;
 pub mod fit;
 pub mod job;
 pub mod state;

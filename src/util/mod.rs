@@ -8,6 +8,7 @@ pub mod budget;
 pub mod colored_noise;
 pub mod fast_exp;
 pub mod interrupt;
+pub mod png;
 pub mod rk45;
 pub mod seeding;
 pub mod table;

@@ -1,7 +1,7 @@
 //! The pendulum's transition and reward as pure functions, shared by the environment and by planners.
 
 use super::params::{angle_normalize, quadrant_of, PendulumParams};
-use crate::envs::{Dynamics, RewardFn};
+use crate::envs::Dynamics;
 
 /// One simulator step of gym Pendulum-v0. The order matters: the reward is computed on the pre-step
 /// state, θ advances with the *unclipped* new velocity, and only then is θ̇ clipped (gymnasium v1 clips
@@ -75,8 +75,8 @@ impl PendulumReward {
     }
 }
 
-impl RewardFn for PendulumReward {
-    fn reward(&self, state: &[f64], action: &[f64], _next_state: &[f64]) -> f64 {
+impl PendulumReward {
+    pub fn reward_of(&self, state: &[f64], action: &[f64]) -> f64 {
         let torque = action[0].clamp(-self.max_torque, self.max_torque);
         -(angle_normalize(state[0]).powi(2) + 0.1 * state[1].powi(2) + 0.001 * torque.powi(2))
     }
@@ -92,8 +92,8 @@ pub struct NominalPendulumReward {
     pub action_repeat: usize,
 }
 
-impl RewardFn for NominalPendulumReward {
-    fn reward(&self, state: &[f64], action: &[f64], _next_state: &[f64]) -> f64 {
+impl NominalPendulumReward {
+    pub fn reward_of(&self, state: &[f64], action: &[f64]) -> f64 {
         let torque = action[0].clamp(-self.max_torque, self.max_torque);
         let cost = angle_normalize(state[0]).powi(2) + 0.1 * state[1].powi(2) + 0.001 * torque.powi(2);
         -cost * self.action_repeat as f64
@@ -113,7 +113,7 @@ mod reward_tests {
             for (theta, speed, action) in [(3.0, 0.5, 1.5), (-0.2, -7.0, -3.0), (7.5, 2.0, 0.3)] {
                 let mut s = [theta, speed];
                 let r = env_step(&p, &mut s, action);
-                assert!((reward.reward(&[theta, speed], &[action], &s) - r).abs() < 1e-12, "{name}");
+                assert!((reward.reward_of(&[theta, speed], &[action]) - r).abs() < 1e-12, "{name}");
             }
         }
         assert!(PendulumReward::for_params(&PendulumVariant::parse("quadrant").unwrap().fixed_params()).is_none());

@@ -3,6 +3,7 @@
 pub mod dynamics;
 pub mod params;
 pub mod render;
+pub mod swingup;
 pub mod variant;
 
 use rand::Rng;

@@ -141,7 +141,7 @@ impl TerrainMap {
     }
 
     pub fn png_bytes(&self) -> Result<Vec<u8>> {
-        crate::data::frames_png::encode_rgb(MAP_SIZE as u32, MAP_SIZE as u32, &self.rgb)
+        crate::util::png::encode_rgb(MAP_SIZE as u32, MAP_SIZE as u32, &self.rgb)
     }
 }
 

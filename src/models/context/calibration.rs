@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 use super::eig::EigObjective;
 use super::fast::{gaussian_entropy, max_into};
 use super::LoadedModel;
+use crate::control::{run_episode, Agent, Transition};
 use crate::data::Rollout;
 use crate::envs::Env;
 use crate::error::{Error, Result};
@@ -114,6 +115,112 @@ pub fn context_rows(model: &LoadedModel, rollout: &Rollout) -> Result<Vec<f32>> 
     Ok(rows)
 }
 
+/// Calibration as an agent: random actions drawn up front, or CEM on the expected information gain (the whole
+/// sequence once, or replanned each step); after each transition the context belief pools it.
+pub struct CalibrationAgent<'a> {
+    model: &'a LoadedModel,
+    settings: &'a CalibrationSettings,
+    seed: u64,
+    monitor: &'a dyn Monitor,
+    cem_config: Box<dyn Fn(usize) -> CemConfig + 'a>,
+    action_dim: usize,
+    random_actions: Vec<Vec<f64>>,
+    plan: Vec<f64>,
+    pooled: Vec<f32>,
+    entropies: Vec<f64>,
+}
+
+impl<'a> CalibrationAgent<'a> {
+    /// `env` is where the random actions are drawn for (its bounds and exploration noise).
+    pub fn new(
+        model: &'a LoadedModel,
+        env: &dyn Env,
+        settings: &'a CalibrationSettings,
+        seed: u64,
+        monitor: &'a dyn Monitor,
+    ) -> Self {
+        let spec = env.spec();
+        let pooled = vec![0.0f32; model.fast.transition_features];
+        let entropies = vec![gaussian_entropy(&model.fast.belief(&pooled, 1).std)];
+        let random_actions = match settings.strategy {
+            Strategy::Random => {
+                crate::data::collect::exploration_actions(env, &mut rng_for(seed, &[0]), settings.transitions)
+            }
+            _ => Vec::new(),
+        };
+        let action_dim = spec.action_dim();
+        let cem_config = Box::new(move |horizon: usize| CemConfig {
+            horizon,
+            candidates: settings.candidates,
+            elites: settings.elites,
+            iterations: settings.iterations,
+            action_low: spec.action_low.clone(),
+            action_high: spec.action_high.clone(),
+            init_std: spec.action_low.iter().zip(&spec.action_high).map(|(l, h)| l.abs().max(h.abs())).collect(),
+            noise: NoiseKind::White,
+            warm_start: false,
+            stop_std: None,
+        });
+        CalibrationAgent {
+            model,
+            settings,
+            seed,
+            monitor,
+            cem_config,
+            action_dim,
+            random_actions,
+            plan: Vec::new(),
+            pooled,
+            entropies,
+        }
+    }
+
+    /// H[q(β | transitions so far)] before any transition (index 0) and after each one.
+    pub fn entropies(&self) -> &[f64] {
+        &self.entropies
+    }
+}
+
+impl Agent for CalibrationAgent<'_> {
+    fn act(&mut self, t: usize, state: &[f64], _observation: &[f64]) -> Result<Vec<f64>> {
+        let (settings, monitor) = (self.settings, self.monitor);
+        let n = settings.transitions;
+        let a = self.action_dim;
+        if settings.strategy == Strategy::Random {
+            return Ok(self.random_actions.get(t).cloned().unwrap_or_default());
+        }
+        let mpc = settings.strategy == Strategy::Mpc;
+        if mpc || t == 0 {
+            let horizon = if mpc { settings.horizon_max.min(n - t) } else { n };
+            let objective = EigObjective::new(
+                &self.model.fast,
+                self.model.features(state),
+                self.pooled.clone(),
+                settings.beta_samples,
+                derive_seed(self.seed, &[1, t as u64]),
+            );
+            let mut cem = Cem::new((self.cem_config)(horizon), derive_seed(self.seed, &[2, t as u64]))?;
+            let phase = format!("step {}/{n}: EIG planning", t + 1);
+            self.plan = cem.plan(&objective, |it| {
+                monitor.scalar("cem/best_entropy", it.iteration as u64, it.best_cost);
+                monitor.progress(&phase, it.iteration as u64 + 1, settings.iterations as u64);
+            });
+            self.plan.truncate(horizon * a);
+        }
+        let offset = if mpc { 0 } else { t };
+        Ok(self.plan[offset * a..(offset + 1) * a].to_vec())
+    }
+
+    fn observe(&mut self, step: &Transition) -> Result<()> {
+        let mut row = self.model.model_state(&step.state, Some(&step.observation))?;
+        row.extend(step.action.iter().map(|a| *a as f32));
+        row.extend(self.model.model_state(&step.next_state, Some(&step.next_observation))?);
+        max_into(&mut self.pooled, &self.model.fast.pool(&row));
+        self.entropies.push(gaussian_entropy(&self.model.fast.belief(&self.pooled, 1).std));
+        Ok(())
+    }
+}
+
 /// Runs `settings.strategy` in `env` from its current state. `seed` keys random actions, β samples and CEM.
 pub fn calibrate(
     model: &LoadedModel,
@@ -130,74 +237,21 @@ pub fn calibrate(
             model.run.method
         )));
     }
-    let spec = env.spec();
-    let fast = &model.fast;
     let n = settings.transitions;
-    let mut pooled = vec![0.0f32; fast.transition_features];
-    let mut entropies = vec![gaussian_entropy(&fast.belief(&pooled, 1).std)];
-    let mut rollout = Rollout::start(env.state(), env.observe());
-    let cem_config = |horizon: usize| CemConfig {
-        horizon,
-        candidates: settings.candidates,
-        elites: settings.elites,
-        iterations: settings.iterations,
-        action_low: spec.action_low.clone(),
-        action_high: spec.action_high.clone(),
-        init_std: spec.action_low.iter().zip(&spec.action_high).map(|(l, h)| l.abs().max(h.abs())).collect(),
-        noise: NoiseKind::White,
-        warm_start: false,
-        stop_std: None,
-    };
-    let random_actions = match settings.strategy {
-        Strategy::Random => crate::data::collect::exploration_actions(env, &mut rng_for(seed, &[0]), n),
-        _ => Vec::new(),
-    };
-    let mut observation = env.observe();
-    let mut open_loop_plan: Vec<f64> = Vec::new();
-    for t in 0..n {
-        if monitor.is_cancelled() {
-            return Err(Error::Cancelled);
-        }
-        let state = env.state();
-        let action: Vec<f64> = match settings.strategy {
-            Strategy::Random => random_actions.get(t).cloned().unwrap_or_default(),
-            Strategy::OpenLoop | Strategy::Mpc => {
-                let replan = settings.strategy == Strategy::Mpc || t == 0;
-                if replan {
-                    let horizon = if settings.strategy == Strategy::Mpc { settings.horizon_max.min(n - t) } else { n };
-                    let objective = EigObjective::new(
-                        fast,
-                        model.features(&state),
-                        pooled.clone(),
-                        settings.beta_samples,
-                        derive_seed(seed, &[1, t as u64]),
-                    );
-                    let mut cem = Cem::new(cem_config(horizon), derive_seed(seed, &[2, t as u64]))?;
-                    let phase = format!("step {}/{n}: EIG planning", t + 1);
-                    open_loop_plan = cem.plan(&objective, |it| {
-                        monitor.scalar("cem/best_entropy", it.iteration as u64, it.best_cost);
-                        monitor.progress(&phase, it.iteration as u64 + 1, settings.iterations as u64);
-                    });
-                    open_loop_plan.truncate(horizon * spec.action_dim());
-                }
-                let offset = if settings.strategy == Strategy::Mpc { 0 } else { t };
-                open_loop_plan[offset * spec.action_dim()..(offset + 1) * spec.action_dim()].to_vec()
-            }
-        };
-        let step = env.step(&action);
-        let next_state = env.state();
-        let mut row = model.model_state(&state, Some(&observation))?;
-        row.extend(action.iter().map(|a| *a as f32));
-        row.extend(model.model_state(&next_state, Some(&step.obs))?);
-        observation = step.obs.clone();
-        max_into(&mut pooled, &fast.pool(&row));
-        let entropy = gaussian_entropy(&fast.belief(&pooled, 1).std);
-        entropies.push(entropy);
-        on_step(&CalibrationStep { t, state: &state, action: &action, next_state: &next_state, entropy });
-        monitor.progress("calibration transitions", t as u64 + 1, n as u64);
-        rollout.push(action, step.reward, next_state, step.obs);
-    }
-    Ok(Calibration { rollout, entropies })
+    let mut agent = CalibrationAgent::new(model, env, settings, seed, monitor);
+    let rollout = run_episode(env, &mut agent, n, monitor, |step, _, agent| {
+        let entropy = *agent.entropies().last().expect("the belief before any transition is recorded");
+        on_step(&CalibrationStep {
+            t: step.t,
+            state: &step.state,
+            action: &step.action,
+            next_state: &step.next_state,
+            entropy,
+        });
+        monitor.progress("calibration transitions", step.t as u64 + 1, n as u64);
+        Ok(())
+    })?;
+    Ok(Calibration { rollout, entropies: agent.entropies })
 }
 
 /// The start of a calibration when the user gives none: the thesis' x = 0 (toy), x = ẋ = 0 (MountainCar) and,

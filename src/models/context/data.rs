@@ -8,7 +8,7 @@ use rand_distr::StandardNormal;
 
 use crate::data::Rollout;
 use crate::error::{Error, Result};
-use crate::models::pets::data::features;
+use crate::nn::features::features;
 use crate::util::seeding::rng_for;
 
 /// One rollout in model space: states as features (angles as cos/sin), row-major.

@@ -3,8 +3,9 @@
 
 use super::fast::RolloutScratch;
 use super::LoadedModel;
+use crate::control::{par_candidate_blocks, BatchDynamics, RewardFn};
 use crate::envs::pendulum::dynamics::{NominalPendulumReward, PendulumReward};
-use crate::envs::{par_candidate_blocks, BatchDynamics, EnvName, RewardFn};
+use crate::envs::EnvName;
 use crate::error::{Error, Result};
 
 const CANDIDATES_PER_BLOCK: usize = 64;

@@ -8,7 +8,7 @@ use rand_distr::StandardNormal;
 use rayon::prelude::*;
 
 use super::fast::{FastContextModel, RolloutScratch};
-use crate::planning::Objective;
+use crate::control::Objective;
 use crate::util::seeding::rng_for;
 
 /// Candidates one worker rolls out together (times the β samples = rows per GEMM). Fixed, so results do not

@@ -169,7 +169,7 @@ pub fn train(request: &TrainRequest, resume: bool, monitor: &dyn Monitor) -> Res
     request.config.validate()?;
     let file = DataFile::fingerprint(&request.data)?;
     let dataset = read_dataset(&request.data)?;
-    let env = crate::models::pets::env_of(&dataset, request.env.as_deref(), &request.data)?;
+    let env = crate::train::datasets::env_of(&dataset, request.env.as_deref(), &request.data)?;
     let model = model_spec(&request.space, &env, &dataset, &request.data)?;
     let all = instance_pairs(&dataset, &request.data, &model)?;
     let (train_data, valid_data) = all.split(request.config.validation_fraction, request.seed);
@@ -359,7 +359,7 @@ impl LoadedModel {
     /// Model-space features of an env state (a model of the env's state; TRADYN models observations).
     pub fn features(&self, state: &[f64]) -> Vec<f32> {
         let mut out = Vec::with_capacity(self.run.model.feature_dim);
-        crate::models::pets::data::features(state, &[], &self.run.model.angular, &mut out);
+        crate::nn::features::features(state, &[], &self.run.model.angular, &mut out);
         out
     }
 }

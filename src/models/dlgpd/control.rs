@@ -15,14 +15,16 @@ use super::dynamics::LatentDynamics;
 use super::evidence::condition_on_rows;
 use super::job::TrainedDlgpd;
 use super::vae::encode_rows;
+use crate::control::Objective;
+use crate::control::{run_episode, Agent, Transition};
 use crate::data::{Dataset, Rollout};
 use crate::envs::pendulum::render::PendulumRenderer;
+use crate::envs::pendulum::swingup::is_success;
 use crate::envs::pendulum::{Pendulum, PendulumVariant, StartDistribution};
 use crate::envs::Env;
 use crate::error::{Error, Result};
-use crate::eval::swingup::is_success;
 use crate::nn::tensor::inference_device;
-use crate::planning::{Cem, CemConfig, Objective};
+use crate::planning::{Cem, CemConfig};
 use crate::run::Monitor;
 use crate::util::seeding::{derive_seed, rng_for};
 
@@ -185,6 +187,48 @@ pub struct ControlEpisode {
     pub iterations: Vec<usize>,
 }
 
+/// CEM on the conditioned GPs from the encoded last two noisy observations; the observer renders the next one
+/// after every step, as the camera would.
+pub struct ImageAgent<'a> {
+    trained: &'a TrainedDlgpd,
+    dynamics: &'a LatentDynamics,
+    cem: Cem,
+    observer: Observer,
+    previous: Vec<f32>,
+    current: Vec<f32>,
+    seed: u64,
+    monitor: &'a dyn Monitor,
+    /// CEM iterations per step (the early stop makes them vary).
+    iterations: Vec<usize>,
+}
+
+impl Agent for ImageAgent<'_> {
+    fn act(&mut self, t: usize, _state: &[f64], _observation: &[f64]) -> Result<Vec<f64>> {
+        let monitor = self.monitor;
+        let input: Vec<f32> = self.previous.iter().chain(&self.current).copied().collect();
+        let width = self.trained.run.observation.input_len();
+        let (mean, std) = encode_rows(&self.trained.vae, &input, width, &inference_device());
+        let mean: Vec<f64> = mean.into_iter().map(f64::from).collect();
+        let variance: Vec<f64> = std.into_iter().map(|s| f64::from(s) * f64::from(s)).collect();
+        let objective =
+            LatentObjective::new(self.dynamics, mean, variance, derive_seed(self.seed, &[OBJECTIVE_STREAM, t as u64]));
+        let mut used = 0;
+        let plan = self.cem.plan(&objective, |it| {
+            used += 1;
+            monitor.scalar("cem/best_cost", it.iteration as u64, it.best_cost);
+            monitor.scalar("cem/elite_mean_cost", it.iteration as u64, it.elite_mean_cost);
+        });
+        self.iterations.push(used);
+        Ok(plan[..1].to_vec())
+    }
+
+    fn observe(&mut self, step: &Transition) -> Result<()> {
+        let next = self.observer.observe(step.next_state[0]);
+        self.previous = std::mem::replace(&mut self.current, next);
+        Ok(())
+    }
+}
+
 /// One swing-up from the hanging position in `settings.variant`, planned on `dynamics`. Before planning,
 /// one step with a small random action (0.1 · U[−2, 2], as the authors') gives the second observation.
 pub fn swing_up(
@@ -199,43 +243,31 @@ pub fn swing_up(
     let mut rng = rng_for(seed, &[EPISODE_STREAM]);
     env.reset(&mut rng);
     let mut observer = Observer::new(trained.run.observation, seed);
-    let mut previous = observer.observe(env.state()[0]);
+    let previous = observer.observe(env.state()[0]);
     let warm_up = 0.1 * rng.random_range(-2.0..2.0);
     env.step(&[warm_up]);
-    let mut current = observer.observe(env.state()[0]);
-    let mut rollout = Rollout::start(env.state(), env.observe());
-    let mut cem = Cem::new(settings.cem.clone(), derive_seed(seed, &[PLANNER_STREAM]))?;
-    let device = inference_device();
-    let width = trained.run.observation.input_len();
-    let mut iterations = Vec::with_capacity(settings.steps);
+    let current = observer.observe(env.state()[0]);
+    let mut agent = ImageAgent {
+        trained,
+        dynamics,
+        cem: Cem::new(settings.cem.clone(), derive_seed(seed, &[PLANNER_STREAM]))?,
+        observer,
+        previous,
+        current,
+        seed,
+        monitor,
+        iterations: Vec::with_capacity(settings.steps),
+    };
     let phase = "MPC steps";
-    for t in 0..settings.steps {
-        if monitor.is_cancelled() {
-            return Err(Error::Cancelled);
-        }
-        let input: Vec<f32> = previous.iter().chain(&current).copied().collect();
-        let (mean, std) = encode_rows(&trained.vae, &input, width, &device);
-        let mean: Vec<f64> = mean.into_iter().map(f64::from).collect();
-        let variance: Vec<f64> = std.into_iter().map(|s| f64::from(s) * f64::from(s)).collect();
-        let objective =
-            LatentObjective::new(dynamics, mean, variance, derive_seed(seed, &[OBJECTIVE_STREAM, t as u64]));
-        let mut used = 0;
-        let plan = cem.plan(&objective, |it| {
-            used += 1;
-            monitor.scalar("cem/best_cost", it.iteration as u64, it.best_cost);
-            monitor.scalar("cem/elite_mean_cost", it.iteration as u64, it.elite_mean_cost);
-        });
-        iterations.push(used);
-        let action = plan[..1].to_vec();
-        let step = env.step(&action);
-        monitor.scalar("pendulum/angle", t as u64, crate::envs::pendulum::angle_normalize(env.state()[0]));
-        monitor.scalar("pendulum/action", t as u64, action[0]);
-        monitor.scalar("pendulum/reward", t as u64, step.reward);
-        rollout.push(action, step.reward, env.state(), step.obs);
-        previous = std::mem::replace(&mut current, observer.observe(env.state()[0]));
-        monitor.progress(phase, t as u64 + 1, settings.steps as u64);
-    }
+    let rollout = run_episode(&mut env, &mut agent, settings.steps, monitor, |step, env, _| {
+        let t = step.t as u64;
+        monitor.scalar("pendulum/angle", t, crate::envs::pendulum::angle_normalize(env.state()[0]));
+        monitor.scalar("pendulum/action", t, step.action[0]);
+        monitor.scalar("pendulum/reward", t, step.reward);
+        monitor.progress(phase, t + 1, settings.steps as u64);
+        Ok(())
+    })?;
     let total_return = rollout.total_reward();
     let success = is_success(&rollout.rewards);
-    Ok(ControlEpisode { rollout, total_return, success, iterations })
+    Ok(ControlEpisode { rollout, total_return, success, iterations: agent.iterations })
 }

@@ -15,10 +15,10 @@ use super::train::{f64_tensor, gps_from_stored, DlgpdTrainer, SCALE_MEAN, SCALE_
 use super::vae::VaeNet;
 use crate::error::{Error, Result};
 use crate::models::gp::GpHypers;
-use crate::models::pets::{env_of, load_datasets, TransitionCounts};
 use crate::nn::tensor::inference_device;
 use crate::run::dir::Provenance;
 use crate::run::Monitor;
+use crate::train::datasets::{env_of, load_datasets, TransitionCounts};
 use crate::train::tensors::TensorData;
 use crate::train::{
     continuation, loss_panel, run_training, training_view, Accept, DataFile, Extension, FitOutcome, FitSettings,

@@ -6,24 +6,8 @@ use rand::seq::SliceRandom;
 use super::config::RewardSource;
 use crate::data::Dataset;
 use crate::error::{Error, Result};
+use crate::nn::features::{feature_dim, features};
 use crate::util::seeding::rng_for;
-
-/// Input features of one (state, action) pair.
-pub fn features(state: &[f64], action: &[f64], angular: &[bool], out: &mut Vec<f32>) {
-    for (x, is_angle) in state.iter().zip(angular) {
-        if *is_angle {
-            out.push(x.cos() as f32);
-            out.push(x.sin() as f32);
-        } else {
-            out.push(*x as f32);
-        }
-    }
-    out.extend(action.iter().map(|a| *a as f32));
-}
-
-pub fn feature_dim(angular: &[bool], action_dim: usize) -> usize {
-    angular.iter().map(|a| if *a { 2 } else { 1 }).sum::<usize>() + action_dim
-}
 
 /// Row-major inputs and targets.
 #[derive(Clone, Debug, Default)]

@@ -7,11 +7,11 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::config::{PetsConfig, RewardSource};
-use super::data::{feature_dim, features};
-use crate::envs::{BatchDynamics, RewardFn};
+use crate::control::{BatchDynamics, RewardFn};
 use crate::error::{Error, Result};
 use crate::nn::activation::{fast_exp, fast_softplus};
 use crate::nn::fast::{FastEnsembleMlp, Scratch};
+use crate::nn::features::{feature_dim, features};
 use crate::nn::{Normalizer, ParamSet};
 use crate::util::seeding::rng_for;
 

@@ -16,12 +16,12 @@ pub use config::{PetsConfig, Preset, RewardSource};
 pub use dynamics::{PetsDynamics, Propagation};
 pub use train::PetsTrainer;
 
-use crate::data::{read_dataset, Dataset};
-use crate::envs::{parse_env, EnvName};
+use crate::envs::EnvName;
 use crate::error::{Error, Result};
 use crate::nn::Normalizer;
 use crate::run::dir::Provenance;
 use crate::run::Monitor;
+use crate::train::datasets::{env_of, load_datasets, TransitionCounts};
 use crate::train::tensors::{to_params, TensorData};
 use crate::train::{
     continuation, loss_panel, run_training, training_view, validation_panel, Accept, DataFile, Extension, FitOutcome,
@@ -55,15 +55,6 @@ pub struct PetsRun {
     pub provenance: Provenance,
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct TransitionCounts {
-    pub train: usize,
-    pub valid: usize,
-    pub train_rollouts: usize,
-    pub valid_rollouts: usize,
-}
-
 pub struct TrainRequest {
     pub out: PathBuf,
     pub data: Vec<PathBuf>,
@@ -78,53 +69,6 @@ pub struct TrainReport {
     pub run: PetsRun,
     pub outcome: FitOutcome,
     pub parameters: usize,
-}
-
-/// Reads and concatenates datasets of one env (rollout ids renumbered so they stay distinct).
-pub fn load_datasets(paths: &[PathBuf]) -> Result<(Dataset, Vec<DataFile>)> {
-    let mut merged: Option<Dataset> = None;
-    let mut files = Vec::new();
-    for path in paths {
-        files.push(DataFile::fingerprint(path)?);
-        let mut dataset = read_dataset(path)?;
-        match &mut merged {
-            None => merged = Some(dataset),
-            Some(m) => {
-                if dataset.meta.env != m.meta.env
-                    || dataset.meta.state_names != m.meta.state_names
-                    || dataset.meta.action_dim != m.meta.action_dim
-                {
-                    return Err(Error::bad_file(
-                        path,
-                        format!("is a dataset of '{}'; the first dataset is of '{}'", dataset.meta.env, m.meta.env),
-                    ));
-                }
-                let offset = m.steps.iter().map(|s| s.rollout + 1).max().unwrap_or(0);
-                for step in &mut dataset.steps {
-                    step.rollout =
-                        step.rollout.checked_add(offset).ok_or_else(|| Error::bad_file(path, "too many rollouts"))?;
-                }
-                m.steps.extend(dataset.steps);
-            }
-        }
-    }
-    let dataset = merged.ok_or_else(|| Error::config("no dataset given; pass --data FILE.mcap"))?;
-    Ok((dataset, files))
-}
-
-/// The env a dataset was collected in, checked against the one the user named (shared by every trainer).
-pub fn env_of(dataset: &Dataset, requested: Option<&str>, data: &Path) -> Result<EnvName> {
-    let env = parse_env(&dataset.meta.env).map_err(|e| Error::bad_file(data, format!("dataset env: {e}")))?;
-    if let Some(requested) = requested {
-        let requested_env = parse_env(requested)?;
-        if requested_env.canonical() != env.canonical() {
-            return Err(Error::bad_file(
-                data,
-                format!("holds '{}' rollouts; --env asked for '{}'", env.canonical(), requested_env.canonical()),
-            ));
-        }
-    }
-    Ok(env)
 }
 
 /// Trains a PETS ensemble into `request.out`, fresh or continuing the run there (see [`Start`]).
@@ -219,7 +163,7 @@ impl ModelSpec {
                 self.action_dim
             )));
         }
-        let input = data::feature_dim(&self.angular, self.action_dim);
+        let input = crate::nn::features::feature_dim(&self.angular, self.action_dim);
         let target = states + usize::from(reward == RewardSource::Learned);
         if self.angular.len() != states || self.input_dim != input || self.target_dim != target {
             return Err(Error::config(format!(
@@ -291,7 +235,7 @@ pub fn load_dynamics(
     let weights: Vec<_> = stored.iter().filter(|t| !t.name.starts_with("input_normalizer.")).cloned().collect();
     let weights = to_params(&model_path, &weights, &layout)?;
     let reward = match run.config.reward {
-        RewardSource::Known => Some(env.known_reward().ok_or_else(|| {
+        RewardSource::Known => Some(crate::control::known_reward(&env).ok_or_else(|| {
             Error::config(format!("env '{}' has no closed-form reward for this model", env.canonical()))
         })?),
         RewardSource::Learned => None,

@@ -12,6 +12,7 @@ use super::collect::policy_input;
 use super::forward_model::{FlipModel, FlipScratch};
 use super::trainer::MODEL_PREFIX;
 use super::{read_run, EmbodiedGame, SeadsRun, METHOD};
+use crate::control::{run_episode, Agent};
 use crate::envs::boards::BoardGame;
 use crate::envs::embodiments::embodied::EmbodiedBoard;
 use crate::envs::Env;
@@ -220,6 +221,25 @@ pub fn plan_with_model<G: BoardGame>(
     Ok((breadth_first(&one_sided, board, |s| *s == game.goal(), limits, |_| {})?, false))
 }
 
+/// One skill played by the deterministic skill policy until the embodiment says the skill is over.
+struct SkillAgent<'a> {
+    policy: &'a Sac,
+    skill: usize,
+    skills: usize,
+    rng: &'a mut ChaCha8Rng,
+    input: Vec<f32>,
+}
+
+impl Agent for SkillAgent<'_> {
+    fn act(&mut self, _t: usize, _state: &[f64], observation: &[f64]) -> Result<Vec<f64>> {
+        self.input.clear();
+        let obs: Vec<f32> = observation.iter().map(|&x| x as f32).collect();
+        policy_input(&obs, self.skill, self.skills, &mut self.input);
+        let action = self.policy.try_act(&self.input, 1, true, &mut *self.rng)?;
+        Ok(action.iter().map(|&a| a as f64).collect())
+    }
+}
+
 /// Algorithm 4: plan, execute skill by skill with the deterministic policy, replan when the board differs from
 /// the prediction, at most `max_replans` times.
 #[allow(clippy::too_many_arguments)]
@@ -247,7 +267,6 @@ pub fn solve_with_skills<G: BoardGame>(
         planning_seconds: 0.0,
         bidirectional: false,
     };
-    let mut input = Vec::new();
     let mut trace = EffectorTrace::default();
     show_boards(monitor, game, board, None);
     while !out.solved && out.plans.len() <= max_replans {
@@ -271,25 +290,15 @@ pub fn solve_with_skills<G: BoardGame>(
             let expected = successors.predict(before, skill);
             env.set_board(before);
             let mut performed = None;
-            let mut steps = 0;
-            loop {
-                if monitor.is_cancelled() {
-                    return Err(Error::Cancelled);
-                }
-                input.clear();
-                let obs: Vec<f32> = env.observe().iter().map(|&x| x as f32).collect();
-                policy_input(&obs, skill, k, &mut input);
-                let action: Vec<f64> = loaded.policy.act(&input, 1, true, rng).iter().map(|&a| a as f64).collect();
-                let step = env.step(&action);
+            let mut agent = SkillAgent { policy: &loaded.policy, skill, skills: k, rng: &mut *rng, input: Vec::new() };
+            let executed = run_episode(&mut env, &mut agent, usize::MAX, monitor, |_, env, _| {
                 trace.record(monitor, env.manipulator().effector());
-                steps += 1;
                 if env.board() != before {
                     performed = (0..game.num_moves()).find(|&m| game.apply(before, m) == env.board());
                 }
-                if step.done {
-                    break;
-                }
-            }
+                Ok(())
+            })?;
+            let steps = executed.len();
             out.control_steps += steps;
             out.executed.push(ExecutedSkill { skill, performed, steps });
             monitor.progress(&phase, i as u64 + 1, plan.len() as u64);

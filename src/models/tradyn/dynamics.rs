@@ -5,9 +5,9 @@
 use std::sync::Arc;
 
 use super::{MapLookup, TradynModel};
+use crate::control::{par_candidate_blocks, BatchDynamics};
 use crate::envs::terrain::TerrainMap;
 use crate::envs::unicycle::{clip_action, observation, MAX_SPEED};
-use crate::envs::{par_candidate_blocks, BatchDynamics};
 use crate::models::context::fast::{LocalFeatures, RolloutScratch};
 
 const CANDIDATES_PER_BLOCK: usize = 64;

@@ -3,11 +3,13 @@
 //! that neither term's scale depends on the task. The planner's dynamics may be a TRADYN model or the simulator
 //! itself (an oracle).
 
+use crate::control::Objective;
+use crate::control::{run_episode, Agent, BatchDynamics};
 use crate::data::Rollout;
 use crate::envs::terrain::TerrainMap;
-use crate::envs::{BatchDynamics, Env};
+use crate::envs::Env;
 use crate::error::{Error, Result};
-use crate::planning::{Cem, CemConfig, NoiseKind, Objective};
+use crate::planning::{Cem, CemConfig, NoiseKind};
 use crate::run::{Background, Event, Monitor, PanelSpec, PathView};
 use crate::util::seeding::derive_seed;
 
@@ -168,6 +170,59 @@ pub fn layout(title: &str, map: &TerrainMap, goal: [f64; 2]) -> Event {
     }
 }
 
+/// Receding-horizon CEM on eq. 5.13: at step `t` a fresh CEM with horizon min(H, steps − t) plans from the
+/// env state, and the planned sequence's predicted states are kept for the caller (the live view draws them).
+pub struct NavigationAgent<'a> {
+    dynamics: &'a dyn BatchDynamics,
+    goal: [f64; 2],
+    settings: &'a NavigationSettings,
+    seed: u64,
+    monitor: &'a dyn Monitor,
+    planned: Vec<f64>,
+}
+
+impl<'a> NavigationAgent<'a> {
+    pub fn new(
+        dynamics: &'a dyn BatchDynamics,
+        goal: [f64; 2],
+        settings: &'a NavigationSettings,
+        seed: u64,
+        monitor: &'a dyn Monitor,
+    ) -> Self {
+        NavigationAgent { dynamics, goal, settings, seed, monitor, planned: Vec::new() }
+    }
+
+    /// The last plan's predicted states (horizon × state dim).
+    pub fn planned(&self) -> &[f64] {
+        &self.planned
+    }
+}
+
+impl Agent for NavigationAgent<'_> {
+    fn act(&mut self, t: usize, state: &[f64], _observation: &[f64]) -> Result<Vec<f64>> {
+        let (settings, monitor) = (self.settings, self.monitor);
+        let horizon = settings.horizon.min(settings.steps - t);
+        let objective = NavigationObjective { dynamics: self.dynamics, init: state, goal: self.goal };
+        let mut cem = Cem::new(CemConfig { horizon, ..settings.cem.clone() }, derive_seed(self.seed, &[t as u64]))?;
+        let phase = format!("step {}/{}: planning", t + 1, settings.steps);
+        let plan = cem.plan(&objective, |it| {
+            monitor.scalar("cem/best_cost", it.iteration as u64, it.best_cost);
+            monitor.scalar("cem/elite_mean_cost", it.iteration as u64, it.elite_mean_cost);
+            monitor.progress(&phase, it.iteration as u64 + 1, settings.cem.iterations as u64);
+        });
+        let d = self.dynamics.state_dim();
+        self.planned = vec![0.0; horizon * d];
+        self.dynamics.rollout(state, &plan, horizon, 0, &mut [0.0], Some(&mut self.planned));
+        monitor.scalar("plan/x", 0, state[0]);
+        monitor.scalar("plan/y", 0, state[1]);
+        for (k, p) in self.planned.chunks(d).enumerate() {
+            monitor.scalar("plan/x", k as u64 + 1, p[0]);
+            monitor.scalar("plan/y", k as u64 + 1, p[1]);
+        }
+        Ok(plan[..2].to_vec())
+    }
+}
+
 /// Puts `env` at the task's start and drives it for `settings.steps` steps with CEM on `dynamics`.
 pub fn navigate(
     env: &mut dyn Env,
@@ -181,46 +236,21 @@ pub fn navigate(
     task.validate()?;
     settings.validate()?;
     env.set_state(&task.start_state());
-    let mut rollout = Rollout::start(env.state(), env.observe());
-    let mut energy = 0.0;
     let start = env.state();
     monitor.scalar("robot/x", 0, start[0]);
     monitor.scalar("robot/y", 0, start[1]);
     monitor.scalar("navigation/distance", 0, distance(&start, task.goal));
-    for t in 0..settings.steps {
-        if monitor.is_cancelled() {
-            return Err(Error::Cancelled);
-        }
-        let state = env.state();
-        let horizon = settings.horizon.min(settings.steps - t);
-        let objective = NavigationObjective { dynamics, init: &state, goal: task.goal };
-        let mut cem = Cem::new(CemConfig { horizon, ..settings.cem.clone() }, derive_seed(seed, &[t as u64]))?;
-        let phase = format!("step {}/{}: planning", t + 1, settings.steps);
-        let plan = cem.plan(&objective, |it| {
-            monitor.scalar("cem/best_cost", it.iteration as u64, it.best_cost);
-            monitor.scalar("cem/elite_mean_cost", it.iteration as u64, it.elite_mean_cost);
-            monitor.progress(&phase, it.iteration as u64 + 1, settings.cem.iterations as u64);
-        });
-        let d = dynamics.state_dim();
-        let mut planned = vec![0.0; horizon * d];
-        dynamics.rollout(&state, &plan, horizon, 0, &mut [0.0], Some(&mut planned));
-        monitor.scalar("plan/x", 0, state[0]);
-        monitor.scalar("plan/y", 0, state[1]);
-        for (k, p) in planned.chunks(d).enumerate() {
-            monitor.scalar("plan/x", k as u64 + 1, p[0]);
-            monitor.scalar("plan/y", k as u64 + 1, p[1]);
-        }
-        let action = plan[..2].to_vec();
-        energy += crate::envs::unicycle::clip_action(action[0]).powi(2);
-        let step = env.step(&action);
-        let next_state = env.state();
-        on_step(&NavigationStep { t, state: &state, action: &action, next_state: &next_state, planned: &planned });
+    let mut agent = NavigationAgent::new(dynamics, task.goal, settings, seed, monitor);
+    let rollout = run_episode(env, &mut agent, settings.steps, monitor, |step, _, agent| {
+        let (t, next_state) = (step.t, &step.next_state);
+        on_step(&NavigationStep { t, state: &step.state, action: &step.action, next_state, planned: agent.planned() });
         monitor.scalar("robot/x", t as u64 + 1, next_state[0]);
         monitor.scalar("robot/y", t as u64 + 1, next_state[1]);
-        monitor.scalar("navigation/distance", t as u64 + 1, distance(&next_state, task.goal));
-        rollout.push(action, step.reward, next_state, step.obs);
+        monitor.scalar("navigation/distance", t as u64 + 1, distance(next_state, task.goal));
         monitor.progress("navigation steps", t as u64 + 1, settings.steps as u64);
-    }
+        Ok(())
+    })?;
+    let energy = rollout.actions.iter().map(|a| crate::envs::unicycle::clip_action(a[0]).powi(2)).sum();
     let final_distance = distance(rollout.states.last().expect("a rollout has a start"), task.goal);
     Ok(NavigationEpisode { rollout, energy, final_distance, success: final_distance <= settings.success_distance })
 }

@@ -5,15 +5,16 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::navigation::{navigate, NavigationObjective, NavigationSettings, NavigationTask};
+use crate::control::BatchDynamics;
+use crate::control::Objective;
 use crate::envs::terrain::generate_map;
 use crate::envs::unicycle::{RobotParams, Unicycle, UnicycleDynamics, UnicycleTerrain};
-use crate::envs::{BatchDynamics, Env};
+use crate::envs::Env;
 use crate::models::context::config::{ContextConfig, EnvFamily, Preset};
 use crate::models::context::fast::{FastContextModel, LocalFeatures};
 use crate::models::context::net::{param_name, ContextNet};
 use crate::nn::tensor::{inference_device, tensor, values};
 use crate::nn::ParamSet;
-use crate::planning::Objective;
 use crate::run::NullMonitor;
 
 /// A smooth stand-in for a map, so the test sees the lookup follow the predicted position.

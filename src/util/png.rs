@@ -1,5 +1,6 @@
-//! 8-bit RGB frames as PNG bytes, the payload of Foxglove's `CompressedImage` messages. Decoding checks the
-//! size against what the dataset declares before allocating, so a forged header cannot ask for gigabytes.
+//! 8-bit RGB images as PNG bytes: the payload of Foxglove's `CompressedImage` messages in datasets and the terrain
+//! maps' pictures. Decoding checks the size against what the caller declares before allocating, so a forged header
+//! cannot ask for gigabytes.
 
 use crate::error::{Error, Result};
 
