@@ -36,6 +36,7 @@
 //! `eval dataset`, which parses the whole MCAP container before it refuses the file, and to the library's
 //! `read_board_set` in a child process (this test binary re-run as `board_set_reader_child`).
 
+#[path = "cli/common.rs"]
 mod common;
 
 use std::collections::BTreeMap;
