@@ -17,6 +17,10 @@ bench:
 
 $(MBRL): build
 
+# Collected datasets are file targets with an order-only dependency on the binary, so a rerun reuses them (a
+# rebuild of mbrl does not re-collect them). Each seeded dataset has its seed in its path; `collect` writes
+# through a temporary file, so a file that exists is whole.
+
 # `$(call train_or_resume,DIR,TRAIN FLAGS,RESUME FLAGS)`: a new run in DIR, or, where an interrupted make left a
 # stopped run there, that run resumed (a fresh `train` refuses to replace it), so re-running a long target
 # loses none of its training.
@@ -48,9 +52,10 @@ repro-pendulum-data: build
 # 10 iterations, horizon 20; 20 TS-inf particles). Each of 10 seeds trains its own ensemble on its own data
 # and plans one episode; the ground-truth model plans the same 10 episodes for comparison.
 PETS_SEEDS ?= 0 1 2 3 4 5 6 7 8 9
-repro-pets: build
+datasets/pets/random-%.mcap: | $(MBRL)
+	$(MBRL) collect --env pendulum --rollouts 200 --steps 30 --seed $* --no-tui -q --out $@
+repro-pets: build $(PETS_SEEDS:%=datasets/pets/random-%.mcap)
 	for s in $(PETS_SEEDS); do \
-		$(MBRL) collect --env pendulum --rollouts 200 --steps 30 --seed $$s --no-tui -q --out datasets/pets/random-$$s.mcap || exit 1; \
 		$(MBRL) train --method pets --env pendulum --data datasets/pets/random-$$s.mcap --seed $$s --no-tui -q --out models/pets/seed-$$s || exit 1; \
 		$(MBRL) eval pendulum-swingup --model models/pets/seed-$$s --episodes 1 --seed $$s --no-tui -q --out reports/pets/seed-$$s || exit 1; \
 		$(MBRL) eval pendulum-swingup --model true --episodes 1 --seed $$s --no-tui -q --out reports/pets/truth-$$s || exit 1; \
@@ -81,21 +86,28 @@ CONTEXT_PRESET ?= medium
 CONTEXT_CONTEXTS ?= 50
 CONTEXT_CEM ?=
 CONTEXT_SWINGUP ?= --swingup
-repro-context: build
+CONTEXT_DATA = datasets/context/seed-$(SEED)
+$(CONTEXT_DATA)/toy-%.mcap: | $(MBRL)
+	$(MBRL) collect --env toy:$* --instances 5000 --steps 100 --seed $(SEED) --no-tui -q --out $@
+$(CONTEXT_DATA)/pendulum-quadrant.mcap: | $(MBRL)
+	$(MBRL) collect --env pendulum:quadrant --instances 10000 --steps 100 --seed $(SEED) --no-tui -q --out $@
+$(CONTEXT_DATA)/mountaincar.mcap: | $(MBRL)
+	$(MBRL) collect --env mountaincar --instances 5000 --steps 100 --seed $(SEED) --no-tui -q --out $@
+$(CONTEXT_DATA)/mountaincar-10k.mcap: | $(MBRL)
+	$(MBRL) collect --env mountaincar --instances 10000 --steps 100 --seed $(SEED) --no-tui -q --out $@
+repro-context: build $(CONTEXT_DATA)/toy-inner.mcap $(CONTEXT_DATA)/toy-outer.mcap \
+		$(CONTEXT_DATA)/pendulum-quadrant.mcap $(CONTEXT_DATA)/mountaincar.mcap
 	for sq in inner outer; do \
-		$(MBRL) collect --env toy:$$sq --instances 5000 --steps 100 --seed $(SEED) --no-tui -q --out datasets/context/toy-$$sq.mcap || exit 1; \
-		$(MBRL) train --method context --data datasets/context/toy-$$sq.mcap --preset $(CONTEXT_PRESET) --seed $(SEED) --no-tui -q --out models/context/toy-$$sq || exit 1; \
+		$(MBRL) train --method context --data $(CONTEXT_DATA)/toy-$$sq.mcap --preset $(CONTEXT_PRESET) --seed $(SEED) --no-tui -q --out models/context/toy-$$sq || exit 1; \
 		for n in 1 2 3; do \
 			$(MBRL) eval context --model models/context/toy-$$sq --env toy:$$sq --transitions $$n --contexts $(CONTEXT_CONTEXTS) \
 				$(CONTEXT_CEM) --seed $(SEED) --no-tui -q --out reports/context/toy-$$sq-n$$n || exit 1; \
 		done; \
 	done
-	$(MBRL) collect --env pendulum:quadrant --instances 10000 --steps 100 --seed $(SEED) --no-tui -q --out datasets/context/pendulum-quadrant.mcap
-	$(call train_or_resume,models/context/pendulum-quadrant,--method context --data datasets/context/pendulum-quadrant.mcap --preset $(CONTEXT_PRESET) --seed $(SEED))
+	$(call train_or_resume,models/context/pendulum-quadrant,--method context --data $(CONTEXT_DATA)/pendulum-quadrant.mcap --preset $(CONTEXT_PRESET) --seed $(SEED))
 	$(MBRL) eval context --model models/context/pendulum-quadrant --env pendulum:quadrant --transitions 30 --horizon 20 \
 		--contexts $(CONTEXT_CONTEXTS) $(CONTEXT_CEM) $(CONTEXT_SWINGUP) --seed $(SEED) --no-tui -q --out reports/context/pendulum-quadrant
-	$(MBRL) collect --env mountaincar --instances 5000 --steps 100 --seed $(SEED) --no-tui -q --out datasets/context/mountaincar.mcap
-	$(call train_or_resume,models/context/mountaincar,--method context --data datasets/context/mountaincar.mcap --preset $(CONTEXT_PRESET) --seed $(SEED))
+	$(call train_or_resume,models/context/mountaincar,--method context --data $(CONTEXT_DATA)/mountaincar.mcap --preset $(CONTEXT_PRESET) --seed $(SEED))
 	$(MBRL) eval context --model models/context/mountaincar --env mountaincar --transitions 50 --horizon 30 \
 		--contexts $(CONTEXT_CONTEXTS) $(CONTEXT_CEM) --seed $(SEED) --no-tui -q --out reports/context/mountaincar
 
@@ -103,9 +115,8 @@ repro-context: build
 # preset (64 units, batch 64) for 30 000 steps (≈ 25 min), then 50 unseen contexts of 50 calibration
 # transitions with EIG CEM 300 × 30 elites × 4 iterations and 10 β samples on one thread (≈ 25 min; the
 # figures in the README are this run's, seed 0).
-repro-context-mountaincar: build
-	$(MBRL) collect --env mountaincar --instances 10000 --steps 100 --seed $(SEED) --no-tui -q --out datasets/context/mountaincar-10k.mcap
-	$(call train_or_resume,models/context/mountaincar-small,--method context --data datasets/context/mountaincar-10k.mcap --preset small --steps 30000 --seed $(SEED))
+repro-context-mountaincar: build $(CONTEXT_DATA)/mountaincar-10k.mcap
+	$(call train_or_resume,models/context/mountaincar-small,--method context --data $(CONTEXT_DATA)/mountaincar-10k.mcap --preset small --steps 30000 --seed $(SEED))
 	$(MBRL) eval context --model models/context/mountaincar-small --env mountaincar --transitions 50 --horizon 30 --contexts 50 \
 		--candidates 300 --elites 30 --iters 4 --beta-samples 10 --threads 1 --seed $(SEED) --no-tui -q --out reports/context/mountaincar-small
 
@@ -117,17 +128,22 @@ repro-context-mountaincar: build
 TRADYN_STEPS ?= 15000
 TRADYN_TASKS ?= 50
 TRADYN_CEM ?= --candidates 300 --elites 30 --iters 10
-repro-tradyn: build
-	test -f datasets/tradyn/maps/terrain.json || \
-		$(MBRL) collect --env terrain --maps 100 --seed $(SEED) --no-tui -q --out datasets/tradyn/maps
-	$(MBRL) collect --env unicycle --maps datasets/tradyn/maps --split train --instances 10000 --steps 100 \
-		--seed $(SEED) --no-tui -q --out datasets/tradyn/train.mcap
-	$(MBRL) train --method tradyn --data datasets/tradyn/train.mcap --preset small --steps $(TRADYN_STEPS) \
-		--seed $(SEED) --no-tui -q --out models/tradyn/terrain & \
-	$(MBRL) train --method tradyn --no-terrain --data datasets/tradyn/train.mcap --preset small --steps $(TRADYN_STEPS) \
-		--seed $(SEED) --no-tui -q --out models/tradyn/no-terrain; wait
+TRADYN_DATA = datasets/tradyn/seed-$(SEED)
+# The map set is a directory (staged and renamed into place whole); its manifest stands for it.
+$(TRADYN_DATA)/maps/terrain.json: | $(MBRL)
+	$(MBRL) collect --env terrain --maps 100 --seed $(SEED) --no-tui -q --out $(@D)
+$(TRADYN_DATA)/train.mcap: $(TRADYN_DATA)/maps/terrain.json | $(MBRL)
+	$(MBRL) collect --env unicycle --maps $(<D) --split train --instances 10000 --steps 100 \
+		--seed $(SEED) --no-tui -q --out $@
+# The two trainings run side by side; a bare `wait` would return 0 when one of them failed.
+repro-tradyn: build $(TRADYN_DATA)/train.mcap
+	$(MBRL) train --method tradyn --data $(TRADYN_DATA)/train.mcap --preset small --steps $(TRADYN_STEPS) \
+		--seed $(SEED) --no-tui -q --out models/tradyn/terrain & terrain=$$!; \
+	$(MBRL) train --method tradyn --no-terrain --data $(TRADYN_DATA)/train.mcap --preset small --steps $(TRADYN_STEPS) \
+		--seed $(SEED) --no-tui -q --out models/tradyn/no-terrain & no_terrain=$$!; \
+	status=0; wait $$terrain || status=1; wait $$no_terrain || status=1; exit $$status
 	$(MBRL) eval tradyn --model-terrain models/tradyn/terrain --model-no-terrain models/tradyn/no-terrain \
-		--maps datasets/tradyn/maps --tasks $(TRADYN_TASKS) $(TRADYN_CEM) --seed $(SEED) --no-tui --out reports/tradyn
+		--maps $(TRADYN_DATA)/maps --tasks $(TRADYN_TASKS) $(TRADYN_CEM) --seed $(SEED) --no-tui --out reports/tradyn
 
 # Thesis chapter 7: SEADS skills and forward model on both Cursor games, then skill coverage and boards solved
 # per depth with and without replanning (Table 7.3, Fig. 7.9/7.10 analogues).
@@ -152,19 +168,21 @@ DLGPD_PRESET ?= medium
 DLGPD_STEPS ?=
 DLGPD_THREADS ?= 1
 DLGPD_EVAL ?= --env pendulum --env pendulum:inverted --evidence-rollouts 20 --runs 6 --candidates 200 --elites 20 --iters 8
-repro-dlgpd: build
-	$(MBRL) collect --env pendulum --images --rollouts 500 --steps 29 --seed $(SEED) --no-tui -q --out datasets/dlgpd/pendulum-frames.mcap
-	$(call train_or_resume,models/dlgpd-$(DLGPD_PRESET),--method dlgpd --data datasets/dlgpd/pendulum-frames.mcap \
+DLGPD_DATA = datasets/dlgpd/seed-$(SEED)
+$(DLGPD_DATA)/pendulum-frames.mcap: | $(MBRL)
+	$(MBRL) collect --env pendulum --images --rollouts 500 --steps 29 --seed $(SEED) --no-tui -q --out $@
+repro-dlgpd: build $(DLGPD_DATA)/pendulum-frames.mcap
+	$(call train_or_resume,models/dlgpd-$(DLGPD_PRESET),--method dlgpd --data $(DLGPD_DATA)/pendulum-frames.mcap \
 		--preset $(DLGPD_PRESET) $(if $(DLGPD_STEPS),--steps $(DLGPD_STEPS)) --threads $(DLGPD_THREADS) --seed $(SEED),\
 		--threads $(DLGPD_THREADS))
 	$(MBRL) eval dlgpd --model models/dlgpd-$(DLGPD_PRESET) $(DLGPD_EVAL) --threads $(DLGPD_THREADS) --seed $(SEED) \
 		--no-tui -q --out reports/dlgpd
 
 # Thesis chapter 7 environments: depth/split tables, board sets, embodied play with scripted controllers.
-repro-boards: build
+datasets/%-boards-d5.mcap: | $(MBRL)
+	$(MBRL) collect --env $* --boards --max-depth 5 --no-tui --out $@
+repro-boards: build datasets/lightsout-boards-d5.mcap datasets/tileswap-boards-d5.mcap
 	$(MBRL) eval boards --no-tui --out reports/boards
-	$(MBRL) collect --env lightsout --boards --max-depth 5 --no-tui --out datasets/lightsout-boards-d5.mcap
-	$(MBRL) collect --env tileswap --boards --max-depth 5 --no-tui --out datasets/tileswap-boards-d5.mcap
 	for game in lightsout tileswap; do for arm in cursor reacher; do \
 		$(MBRL) eval embodied --game $$game --embodiment $$arm --max-depth 5 --boards 500 --seed $(SEED) \
 			--no-tui --out reports/embodied-$$game-$$arm || exit 1; \
@@ -173,13 +191,16 @@ repro-boards: build
 # Thesis chapter 6: train the ball EKF on simulated default-pose shots, with rotation augmentation (with
 # and without the launcher spin network) and without augmentation, and compare with the thesis' parameters
 # and the black-box baseline on default and unseen launcher poses.
-repro-ball: build
-	$(MBRL) collect --env ball --trajectories 108 --augment-rotations 19 --seed $(SEED) --no-tui --out datasets/ball-train.mcap
-	$(MBRL) collect --env ball --trajectories 108 --seed $(SEED) --no-tui --out datasets/ball-train-noaug.mcap
-	$(MBRL) train --method ball-ekf --data datasets/ball-train.mcap --steps 2000 --seed $(SEED) --no-tui --out models/ball-ekf
-	$(MBRL) train --method ball-ekf --data datasets/ball-train.mcap --steps 2000 --launcher-prior --seed $(SEED) --no-tui \
+BALL_DATA = datasets/ball/seed-$(SEED)
+$(BALL_DATA)/train.mcap: | $(MBRL)
+	$(MBRL) collect --env ball --trajectories 108 --augment-rotations 19 --seed $(SEED) --no-tui --out $@
+$(BALL_DATA)/train-noaug.mcap: | $(MBRL)
+	$(MBRL) collect --env ball --trajectories 108 --seed $(SEED) --no-tui --out $@
+repro-ball: build $(BALL_DATA)/train.mcap $(BALL_DATA)/train-noaug.mcap
+	$(MBRL) train --method ball-ekf --data $(BALL_DATA)/train.mcap --steps 2000 --seed $(SEED) --no-tui --out models/ball-ekf
+	$(MBRL) train --method ball-ekf --data $(BALL_DATA)/train.mcap --steps 2000 --launcher-prior --seed $(SEED) --no-tui \
 		--out models/ball-ekf-launch
-	$(MBRL) train --method ball-ekf --data datasets/ball-train-noaug.mcap --steps 2000 --seed $(SEED) --no-tui \
+	$(MBRL) train --method ball-ekf --data $(BALL_DATA)/train-noaug.mcap --steps 2000 --seed $(SEED) --no-tui \
 		--out models/ball-ekf-noaug
 	$(MBRL) eval ball --model models/ball-ekf-launch --model models/ball-ekf --model models/ball-ekf-noaug --model thesis \
 		--seed $(SEED) --no-tui --out reports/ball

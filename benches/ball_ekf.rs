@@ -11,6 +11,11 @@ use mbrl::models::ball::track::filter_recording;
 use mbrl::models::ball::{initial_belief, BallModel, BallModelParams, Phase, SpinPrior};
 use rand::SeedableRng;
 
+// The binary runs on mimalloc (cmd/main.rs) and these figures are meant to be its: the library no longer
+// chooses the process allocator, so each benchmark declares the same one.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 fn bench(c: &mut Criterion) {
     let model = BallModel::new(BallModelParams::thesis_learned()).unwrap();
     // High above the table: a free-flight step, the common case.

@@ -7,6 +7,11 @@ use mbrl::envs::ball::Orientation;
 use mbrl::models::ball::learn::{train, TrainSettings};
 use mbrl::run::NullMonitor;
 
+// The binary runs on mimalloc (cmd/main.rs) and these figures are meant to be its: the library no longer
+// chooses the process allocator, so each benchmark declares the same one.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 fn bench(c: &mut Criterion) {
     let settings = BallCollectSettings {
         trajectories: 40,

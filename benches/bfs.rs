@@ -8,6 +8,11 @@ use mbrl::envs::boards::sets::boards_at;
 use mbrl::envs::boards::{BoardGame, LightsOut, TileSwap};
 use mbrl::planning::bfs::{bidirectional, breadth_first, GameRules, SearchLimits};
 
+// The binary runs on mimalloc (cmd/main.rs) and these figures are meant to be its: the library no longer
+// chooses the process allocator, so each benchmark declares the same one.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 fn first_board_at<G: mbrl::envs::boards::depth::DenseIndex>(game: &G, depth: u8) -> G::State {
     let table = DepthTable::build(game).unwrap();
     boards_at(game, &table, depth, None)[0]

@@ -6,6 +6,11 @@ use mbrl::control::ReturnObjective;
 use mbrl::envs::pendulum::{PendulumDynamics, PendulumParams};
 use mbrl::planning::{Cem, CemConfig, NoiseKind};
 
+// The binary runs on mimalloc (cmd/main.rs) and these figures are meant to be its: the library no longer
+// chooses the process allocator, so each benchmark declares the same one.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 fn mpc_step(c: &mut Criterion) {
     let dynamics = PendulumDynamics { params: PendulumParams::default() };
     let init = [std::f64::consts::PI, 0.0];

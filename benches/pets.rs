@@ -20,6 +20,11 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
 
+// The binary runs on mimalloc (cmd/main.rs) and these figures are meant to be its: the library no longer
+// chooses the process allocator, so each benchmark declares the same one.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 const ANGULAR: [bool; 2] = [true, false];
 
 fn config(preset: Preset) -> PetsConfig {

@@ -7,6 +7,11 @@ use mbrl::rl::sac::{Sac, SacConfig, TransitionBatch};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
+// The binary runs on mimalloc (cmd/main.rs) and these figures are meant to be its: the library no longer
+// chooses the process allocator, so each benchmark declares the same one.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 const OBS: usize = 53;
 
 fn config() -> SacConfig {

@@ -17,6 +17,11 @@ use mbrl::train::TrainingMethod;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
+// The binary runs on mimalloc (cmd/main.rs) and these figures are meant to be its: the library no longer
+// chooses the process allocator, so each benchmark declares the same one.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 /// A board whose shortest solution has `depth` presses (distinct presses up to 11 are always optimal on 5×5:
 /// the quiet patterns that would allow a shorter solution have 12 or more lights).
 fn board_at(game: &LightsOut, depth: usize) -> <LightsOut as BoardGame>::State {

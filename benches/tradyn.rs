@@ -18,6 +18,11 @@ use mbrl::planning::{Cem, CemConfig};
 use mbrl::run::dir::Provenance;
 use mbrl::run::NullMonitor;
 
+// The binary runs on mimalloc (cmd/main.rs) and these figures are meant to be its: the library no longer
+// chooses the process allocator, so each benchmark declares the same one.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 /// A one-step-trained checkpoint of `width` units (+T), loaded as the CLI loads it.
 fn model(dir: &std::path::Path, width: usize) -> TradynModel {
     let map = generate_map(0, 0);

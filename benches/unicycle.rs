@@ -10,6 +10,11 @@ use mbrl::envs::terrain::generate_map;
 use mbrl::envs::unicycle::{RobotParams, UnicycleDynamics};
 use mbrl::envs::Dynamics;
 
+// The binary runs on mimalloc (cmd/main.rs) and these figures are meant to be its: the library no longer
+// chooses the process allocator, so each benchmark declares the same one.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 fn bench(c: &mut Criterion) {
     let dynamics = UnicycleDynamics {
         robot: RobotParams { mass: 2.5, k_throttle: 750.0, k_steer: 0.6 },

@@ -30,6 +30,11 @@ use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
 use common::GlobalArgs;
 
+// mimalloc, tuned by `mbrl::util::alloc` (which says why); declared here, not in the library, so that programs
+// linking the library choose their own.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 const ABOUT: &str = "Model-based reinforcement learning: simulators, learned models, planners and filters.";
 
 const AFTER_HELP: &str = "\

@@ -3,11 +3,13 @@
 //! step faults the pages in again and the kernel zeroes them: 40 % of a step in perf, 650 ms instead of 390 ms
 //! at batch 64. mimalloc with purging switched off keeps freed memory for reuse; the price is that a process
 //! keeps its peak footprint until it exits, which suits a command-line run.
+//!
+//! The `#[global_allocator]` itself is declared by the programs (the `mbrl` binary in `cmd/main.rs`, and the
+//! benchmarks, whose figures are meant to be the binary's): a library that picks the process allocator
+//! forces it on every program linking it. Where the allocator is not mimalloc, `keep_freed_memory` sets an
+//! option nobody reads, and nothing else changes.
 
 use std::sync::Once;
-
-#[global_allocator]
-static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 /// mimalloc's `mi_option_purge_delay` (position 15 of `mi_option_e` in both v2 and v3; libmimalloc-sys names
 /// the options around it but not this one).

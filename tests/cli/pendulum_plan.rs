@@ -1,8 +1,6 @@
 //! End to end: collecting, planning and evaluating the pendulum from the command line.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use mbrl::data::{read_dataset, Rollout};
 
 #[test]

@@ -1,12 +1,10 @@
 //! TRADYN's world from the command line: terrain map sets, unicycle datasets on one split of them, replays of
 //! given actions on a user's map, and the errors bad maps and start states give.
 
-mod common;
-
 use std::path::Path;
 use std::sync::Arc;
 
-use common::*;
+use crate::common::*;
 use mbrl::data::{instance_pairs, read_dataset};
 use mbrl::envs::terrain::TerrainMap;
 use mbrl::envs::unicycle::UnicycleTerrain;

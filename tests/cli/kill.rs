@@ -4,16 +4,14 @@
 //! back complete, a model either loads and equals the uninterrupted run's or is refused with the
 //! "not finished" error and resumes to the uninterrupted run's bytes, and a report's files all parse.
 //!
-//! CI runs a short slice; `MBRL_KILL_TRIALS=60 cargo test --release --test kill_cli -- --nocapture` runs a
+//! CI runs a short slice; `MBRL_KILL_TRIALS=60 cargo test --release --test cli kill:: -- --nocapture` runs a
 //! campaign.
-
-mod common;
 
 use std::path::Path;
 use std::process::{Command, ExitStatus};
 use std::time::{Duration, Instant};
 
-use common::*;
+use crate::common::*;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 

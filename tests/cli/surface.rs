@@ -1,9 +1,7 @@
 //! The command-line surface: help with examples on every subcommand, and committed completions that
 //! match the current flags.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 
 const SUBCOMMANDS: &[&[&str]] = &[
     &["collect"],

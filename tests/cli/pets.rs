@@ -1,10 +1,8 @@
 //! End to end: collect → train a PETS ensemble → plan with it, resume, and the errors a user can run into.
 
-mod common;
-
 use std::path::Path;
 
-use common::*;
+use crate::common::*;
 use mbrl::data::{read_dataset, write_dataset};
 use mbrl::models::pets::{self, PetsConfig, Preset};
 use mbrl::run::dir::Provenance;

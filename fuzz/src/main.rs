@@ -1,42 +1,4 @@
-//! Process-level fuzzing of every file and string reader of the `mbrl` binary.
-//!
-//! Seed inputs are made by the binary itself (tiny datasets, board sets, ball recordings, CSVs, TOML configs and
-//! checkpoints of every training method) in `target/tmp/fuzz-seeds/`. Each target then mutates one kind of input
-//! with a seeded ChaCha8 generator (the same target, mutant index and `MBRL_FUZZ_SEED` always give the same
-//! bytes) and runs the subcommand that reads it, under a 4 GiB address-space limit (`ulimit -v`) and a 20 s wall
-//! bound. Outcomes:
-//!
-//! | outcome | meaning | counts as |
-//! |---|---|---|
-//! | ok | exit 0 | fine |
-//! | error | exit 1 or 2, stderr's first line starts with `error:` | fine |
-//! | panic | exit 101, or `panicked` on stderr | failure |
-//! | abort | killed by a signal (SIGABRT from a failed allocation, SIGSEGV, …) | failure |
-//! | hang | still running after 20 s | failure |
-//! | unclean | any other exit (a non-zero exit without an `error:` line) | failure |
-//!
-//! The binary is copied into the seed directory first, so that a rebuild during a long campaign does not change
-//! what is tested. Every failing mutant is saved under `target/fuzz-failures/<target>/` as `<index>.<ext>` (a
-//! file), `<index>.ckpt/` (a mutated checkpoint directory) or `<index>.arg` (a mutated argument), next to
-//! `<index>.cmd`, a shell script that runs it again with the same limits and the same binary
-//! (`MBRL=/abs/path/to/mbrl` to try another build). The scripts run in `target/fuzz-failures/seeds/`, a copy of
-//! the seeds and the binary.
-//!
-//! ```sh
-//! cargo test --release --test fuzz_cli -- --nocapture                            # the CI slice
-//! MBRL_FUZZ_MUTANTS=300 cargo test --release --test fuzz_cli fuzz_every -- --nocapture   # 13 200 mutants
-//! ```
-//!
-//! Environment: `MBRL_FUZZ_MUTANTS` (mutants per target, default 100: 4400 runs, about 40 s on two cores),
-//! `MBRL_FUZZ_SEED` (another family of mutants, default 0), `MBRL_FUZZ_TARGETS` (comma-separated substrings of
-//! target names), `MBRL_FUZZ_JOBS` (parallel runs, default one per core), `MBRL_FUZZ_BIN` (fuzz another `mbrl`
-//! binary), `MBRL_FUZZ_VERBOSE` (set: print every run's outcome and first stderr line).
-//!
-//! No subcommand reads a board set (`collect --boards` writes them for other tools), so board sets are fed to
-//! `eval dataset`, which parses the whole MCAP container before it refuses the file, and to the library's
-//! `read_board_set` in a child process (this test binary re-run as `board_set_reader_child`).
-
-mod common;
+#![doc = include_str!("../README.md")]
 
 use std::collections::BTreeMap;
 use std::ffi::{OsStr, OsString};
@@ -44,12 +6,13 @@ use std::fs;
 use std::os::unix::ffi::{OsStrExt, OsStringExt};
 use std::os::unix::process::ExitStatusExt;
 use std::path::{Path, PathBuf};
-use std::process::{Command, ExitStatus, Stdio};
+use std::process::{Command, ExitCode, ExitStatus, Stdio};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Mutex, OnceLock};
 use std::time::{Duration, Instant};
 
 use base64::Engine;
+use clap::{Parser, Subcommand};
 use rand::seq::{IndexedMutRandom, IndexedRandom};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -60,8 +23,6 @@ const MEMORY_LIMIT_KIB: u64 = 4 << 20;
 const TIME_LIMIT: Duration = Duration::from_secs(20);
 /// Mutants per target in the CI slice.
 const DEFAULT_MUTANTS: u64 = 100;
-/// Set in the environment of the child that reads a board set through the library.
-const BOARD_SET_CHILD_ENV: &str = "MBRL_FUZZ_BOARD_SET";
 
 // ---------------------------------------------------------------------------------------------------------------
 // Targets
@@ -98,7 +59,7 @@ enum Kind {
 enum Program {
     /// `mbrl --threads 1 -q <args>`.
     Mbrl,
-    /// This test binary as `board_set_reader_child`, reading the board set named in its environment.
+    /// This binary as `read-board-set <args>`, reading the board set through the library.
     BoardSetReader,
 }
 
@@ -106,8 +67,8 @@ struct Target {
     name: &'static str,
     input: Input,
     program: Program,
-    /// The command after `mbrl --threads 1 -q`, split at spaces; `{in}` is the mutant (one argument whatever it
-    /// holds), `{out}` a fresh output path.
+    /// The command after `mbrl --threads 1 -q` (or after this binary), split at spaces; `{in}` is the mutant
+    /// (one argument whatever it holds), `{out}` a fresh output path.
     args: &'static str,
     /// The unmutated seed is refused with a clean error by design (a board set is not a dataset).
     seed_is_refused: bool,
@@ -181,7 +142,7 @@ fn targets() -> Vec<Target> {
             seed_is_refused: true,
             ..target("boardset-eval", mcap("boards.mcap"), "eval dataset --input {in} --out {out}")
         },
-        Target { program: Program::BoardSetReader, ..target("boardset-read", mcap("boards.mcap"), "") },
+        Target { program: Program::BoardSetReader, ..target("boardset-read", mcap("boards.mcap"), "read-board-set {in}") },
         target("ball-filter", mcap("ball.mcap"), "filter --model thesis --input {in} --out {out}"),
         target("ball-predict", mcap("ball.mcap"), "predict --model ekf --input {in} --horizon 0.2s"),
         target("ball-train", mcap("ball.mcap"), "train --method ball-ekf --data {in} --steps 1 --batch 4 --out {out}"),
@@ -363,86 +324,116 @@ const RESUME_FILES: &[&str] =
 // Seeds
 // ---------------------------------------------------------------------------------------------------------------
 
-/// Tiny PETS network (as tests/pets_cli.rs).
+/// Tiny PETS network (as tests/cli/pets.rs).
 const PETS_TOML: &str = "hidden_layers = 2\nhidden_units = 16\nvalidate_every = 10\ncheckpoint_every = 20\n";
-/// Tiny context model (as tests/context_cli.rs).
+/// Tiny context model (as tests/cli/context.rs).
 const CONTEXT_TOML: &str = "embedding = 16\nhidden_units = 16\ntransition_features = 8\nchunk_states = 10\n\
                             context_max = 4\nbatch_size = 8\nvalidate_every = 10\ncheckpoint_every = 10\n";
-/// Tiny SEADS networks and memory (as tests/seads_cli.rs).
+/// Tiny SEADS networks and memory (as tests/cli/seads.rs).
 const SEADS_TOML: &str = "episodes_per_epoch = 4\nsampled_episodes = 8\nepisode_memory = 8\nmodel_hidden = 8\n\
                           sac_hidden = [8]\nsac_batch = 8\n";
 
 /// The binary under test, copied into the seed directory (and with it next to saved failures).
 const SNAPSHOT: &str = "bin/mbrl";
+/// This binary, copied beside it: the child that reads board sets through the library.
+const SELF_SNAPSHOT: &str = "bin/mbrl-fuzz";
 
-/// The seed directory, generated once per test process (every test of this file shares it).
-fn seeds() -> &'static Path {
-    static SEEDS: OnceLock<PathBuf> = OnceLock::new();
-    SEEDS.get_or_init(|| {
-        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("fuzz-seeds");
-        let _ = fs::remove_dir_all(&dir);
-        fs::create_dir_all(dir.join("bin")).unwrap();
-        // A private copy of the binary: a rebuild during a long campaign must not change what is tested.
-        let source =
-            std::env::var_os("MBRL_FUZZ_BIN").map_or_else(|| PathBuf::from(env!("CARGO_BIN_EXE_mbrl")), PathBuf::from);
-        fs::copy(&source, dir.join(SNAPSHOT)).unwrap();
-        let start = Instant::now();
-        generate_seeds(&dir);
-        eprintln!("fuzz: seeds generated in {:.1} s in {}", start.elapsed().as_secs_f64(), dir.display());
-        dir
-    })
+/// `--dir`: the seeds go to `tmp/fuzz-seeds/` in it, the failures to `fuzz-failures/`.
+static WORK: OnceLock<PathBuf> = OnceLock::new();
+
+fn work() -> &'static Path {
+    WORK.get().expect("the work directory is set before the campaign")
 }
 
-/// Runs the binary to make a seed (`args` split at spaces); seeds must come out, so a failure stops the test.
-fn make(dir: &Path, args: &str) {
+/// The seed directory, generated once at the start of a campaign.
+fn seeds() -> &'static Path {
+    static SEEDS: OnceLock<PathBuf> = OnceLock::new();
+    SEEDS.get_or_init(|| work().join("tmp").join("fuzz-seeds"))
+}
+
+/// Makes the seed directory: private copies of the binaries, then every seed input.
+fn generate(binary: &Path) -> Result<(), String> {
+    let dir = seeds();
+    let _ = fs::remove_dir_all(dir);
+    let io = |e: std::io::Error| format!("{}: {e}", dir.display());
+    fs::create_dir_all(dir.join("bin")).map_err(io)?;
+    // Private copies: a rebuild during a long campaign must not change what is tested.
+    fs::copy(binary, dir.join(SNAPSHOT)).map_err(|e| format!("copying {}: {e}", binary.display()))?;
+    let this = std::env::current_exe().map_err(io)?;
+    fs::copy(&this, dir.join(SELF_SNAPSHOT)).map_err(|e| format!("copying {}: {e}", this.display()))?;
+    let start = Instant::now();
+    generate_seeds(dir)?;
+    eprintln!("fuzz: seeds generated in {:.1} s in {}", start.elapsed().as_secs_f64(), dir.display());
+    Ok(())
+}
+
+/// Runs the binary to make a seed (`args` split at spaces); seeds must come out, so a failure stops the campaign.
+fn make(dir: &Path, args: &str) -> Result<(), String> {
     let out = Command::new(dir.join(SNAPSHOT))
         .args(["--threads", "1", "-q", "--no-tui"])
         .args(args.split_whitespace())
         .current_dir(dir)
         .env("NO_COLOR", "1")
         .output()
-        .unwrap();
-    assert!(out.status.success(), "seeding failed: mbrl {args}\n{}", common::stderr_of(&out));
+        .map_err(|e| format!("seeding: mbrl {args}: {e}"))?;
+    if !out.status.success() {
+        return Err(format!("seeding failed: mbrl {args}\n{}", String::from_utf8_lossy(&out.stderr)));
+    }
+    Ok(())
 }
 
-fn generate_seeds(dir: &Path) {
+/// A falling ball sampled at 180 Hz for 40 frames, frame 5 lost (the recording of tests/cli/common.rs).
+fn falling_ball_csv() -> String {
+    let mut text = String::from("frame,x,y,z\n");
+    for f in 0..40u32 {
+        let t = f as f64 / 180.0;
+        if f == 5 {
+            text += &format!("{f},,,\n");
+        } else {
+            text += &format!("{f},{:.5},{:.5},{:.5}\n", 0.1, 2.5 - 4.0 * t, 0.3 + 1.0 * t - 4.9 * t * t);
+        }
+    }
+    text
+}
+
+fn generate_seeds(dir: &Path) -> Result<(), String> {
     let write = |name: &str, text: &str| fs::write(dir.join(name), text).unwrap();
     write("pets.toml", PETS_TOML);
     write("context.toml", CONTEXT_TOML);
     write("seads.toml", SEADS_TOML);
-    write("ball.csv", &common::falling_ball_csv());
+    write("ball.csv", &falling_ball_csv());
     write("actions.csv", "u\n0.5\n-2\n1.5\n1e-3\n");
     write("cursor.csv", "dx,dy,push\n0.2,-0.2,-1\n0.1,-0.1,0.9\n0,0,-1\n");
 
-    make(dir, "collect --env pendulum --rollouts 3 --steps 10 --out roll.mcap");
-    make(dir, "collect --env pendulum --images --rollouts 2 --steps 4 --out img.mcap");
-    make(dir, "collect --env toy:inner --instances 4 --steps 12 --out ctx.mcap");
-    make(dir, "collect --env pendulum:quadrant --instances 4 --steps 12 --out quad.mcap");
-    make(dir, "collect --env ball --trajectories 2 --out ball.mcap");
-    make(dir, "export --input ball.mcap --out ball-traj.csv");
-    make(dir, "collect --env lightsout --boards --max-depth 2 --out boards.mcap");
-    make(dir, "collect --env terrain --maps 2 --out terrain");
+    make(dir, "collect --env pendulum --rollouts 3 --steps 10 --out roll.mcap")?;
+    make(dir, "collect --env pendulum --images --rollouts 2 --steps 4 --out img.mcap")?;
+    make(dir, "collect --env toy:inner --instances 4 --steps 12 --out ctx.mcap")?;
+    make(dir, "collect --env pendulum:quadrant --instances 4 --steps 12 --out quad.mcap")?;
+    make(dir, "collect --env ball --trajectories 2 --out ball.mcap")?;
+    make(dir, "export --input ball.mcap --out ball-traj.csv")?;
+    make(dir, "collect --env lightsout --boards --max-depth 2 --out boards.mcap")?;
+    make(dir, "collect --env terrain --maps 2 --out terrain")?;
     fs::copy(dir.join("terrain/map000.png"), dir.join("map.png")).unwrap();
 
-    make(dir, "train --method pets --data roll.mcap --config pets.toml --ensemble 2 --steps 5 --out pets");
-    make(dir, "train --method context --data ctx.mcap --config context.toml --steps 5 --out context-model");
-    make(dir, "train --method context --data quad.mcap --config context.toml --steps 3 --out quad-model");
-    make(dir, "collect --env unicycle --map map.png --instances 4 --steps 12 --out uni.mcap");
-    make(dir, "train --method tradyn --data uni.mcap --config context.toml --steps 3 --out tradyn-model");
+    make(dir, "train --method pets --data roll.mcap --config pets.toml --ensemble 2 --steps 5 --out pets")?;
+    make(dir, "train --method context --data ctx.mcap --config context.toml --steps 5 --out context-model")?;
+    make(dir, "train --method context --data quad.mcap --config context.toml --steps 3 --out quad-model")?;
+    make(dir, "collect --env unicycle --map map.png --instances 4 --steps 12 --out uni.mcap")?;
+    make(dir, "train --method tradyn --data uni.mcap --config context.toml --steps 3 --out tradyn-model")?;
     make(
         dir,
         "calibrate --model tradyn-model --env unicycle --map map.png --instance-seed 1 --strategy random --transitions 3 \
          --out calib-uni.mcap",
-    );
-    make(dir, "train --method dlgpd --data roll.mcap --steps 5 --batch 16 --out dlgpd");
-    make(dir, "train --method ball-ekf --data ball.mcap --launcher-prior --steps 3 --batch 8 --out ekf");
-    make(dir, "train --method seads --env tileswap:cursor --config seads.toml --env-steps 100 --out seads");
-    make(dir, "eval pendulum-swingup --model true --episodes 1 --steps 25 --candidates 16 --elites 4 --out swingup");
+    )?;
+    make(dir, "train --method dlgpd --data roll.mcap --steps 5 --batch 16 --out dlgpd")?;
+    make(dir, "train --method ball-ekf --data ball.mcap --launcher-prior --steps 3 --batch 8 --out ekf")?;
+    make(dir, "train --method seads --env tileswap:cursor --config seads.toml --env-steps 100 --out seads")?;
+    make(dir, "eval pendulum-swingup --model true --episodes 1 --steps 25 --candidates 16 --elites 4 --out swingup")?;
 
     // More MCAP writers, for the check with the official reader.
-    make(dir, "plan --env pendulum --model true --steps 3 --candidates 16 --elites 4 --out plan.mcap");
-    make(dir, "calibrate --model context-model --env toy:inner --instance-seed 1 --strategy random --out calib.mcap");
-    make(dir, "filter --model thesis --input ball.mcap --out filtered.csv --mcap filtered.mcap");
+    make(dir, "plan --env pendulum --model true --steps 3 --candidates 16 --elites 4 --out plan.mcap")?;
+    make(dir, "calibrate --model context-model --env toy:inner --instance-seed 1 --strategy random --out calib.mcap")?;
+    make(dir, "filter --model thesis --input ball.mcap --out filtered.csv --mcap filtered.mcap")?;
 
     // `train --resume` needs an unfinished run: the finished one, marked unfinished at its last step, resumes
     // without training but reads everything a resume reads.
@@ -461,6 +452,7 @@ fn generate_seeds(dir: &Path) {
         let table = without_nulls(config["config"].clone());
         fs::write(dir.join(format!("{name}-full.toml")), toml::to_string(&table).unwrap()).unwrap();
     }
+    Ok(())
 }
 
 /// TOML has no null; an absent key means the same to the config reader.
@@ -1278,27 +1270,22 @@ fn classify(status: Option<ExitStatus>, stderr: &str) -> Verdict {
 
 /// The program and arguments of a run of `target` on `input`, writing to `out`.
 fn command_line(target: &Target, input: &OsStr, out: &Path) -> (PathBuf, Vec<OsString>) {
-    match target.program {
-        Program::Mbrl => {
-            let mut args: Vec<OsString> = ["--threads", "1", "-q"].iter().map(OsString::from).collect();
-            for arg in target.args.split_whitespace() {
-                // `{in}` may sit inside an argument (`--board={in}`); the mutant's bytes go in as they are.
-                let arg = arg.replace("{out}", &out.to_string_lossy());
-                let (before, after) = arg.split_once("{in}").map_or((arg.as_str(), None), |(b, a)| (b, Some(a)));
-                let mut bytes = before.as_bytes().to_vec();
-                if let Some(after) = after {
-                    bytes.extend_from_slice(input.as_bytes());
-                    bytes.extend_from_slice(after.as_bytes());
-                }
-                args.push(OsString::from_vec(bytes));
-            }
-            (seeds().join(SNAPSHOT), args)
+    let (program, mut args): (_, Vec<OsString>) = match target.program {
+        Program::Mbrl => (seeds().join(SNAPSHOT), ["--threads", "1", "-q"].iter().map(OsString::from).collect()),
+        Program::BoardSetReader => (seeds().join(SELF_SNAPSHOT), Vec::new()),
+    };
+    for arg in target.args.split_whitespace() {
+        // `{in}` may sit inside an argument (`--board={in}`); the mutant's bytes go in as they are.
+        let arg = arg.replace("{out}", &out.to_string_lossy());
+        let (before, after) = arg.split_once("{in}").map_or((arg.as_str(), None), |(b, a)| (b, Some(a)));
+        let mut bytes = before.as_bytes().to_vec();
+        if let Some(after) = after {
+            bytes.extend_from_slice(input.as_bytes());
+            bytes.extend_from_slice(after.as_bytes());
         }
-        Program::BoardSetReader => {
-            let args = ["--exact", "board_set_reader_child", "--nocapture", "--test-threads", "1", "-q"];
-            (std::env::current_exe().unwrap(), args.iter().map(OsString::from).collect())
-        }
+        args.push(OsString::from_vec(bytes));
     }
+    (program, args)
 }
 
 struct Run {
@@ -1314,9 +1301,6 @@ fn run_bounded(target: &Target, input: &OsStr, cwd: &Path, out: &Path, stderr_pa
     let limit = format!("ulimit -v {MEMORY_LIMIT_KIB}; exec \"$0\" \"$@\"");
     let mut command = Command::new("sh");
     command.arg("-c").arg(limit).arg(&program).args(&args).current_dir(cwd).env("NO_COLOR", "1");
-    if target.program == Program::BoardSetReader {
-        command.env(BOARD_SET_CHILD_ENV, input);
-    }
     let stderr_file = fs::File::create(stderr_path).unwrap();
     let start = Instant::now();
     let mut child = command.stdin(Stdio::null()).stdout(Stdio::null()).stderr(stderr_file).spawn().unwrap();
@@ -1343,6 +1327,47 @@ fn run_bounded(target: &Target, input: &OsStr, cwd: &Path, out: &Path, stderr_pa
 // The campaign
 // ---------------------------------------------------------------------------------------------------------------
 
+/// Process-level fuzzing of every file and string reader of the `mbrl` binary (see fuzz/README.md). Each flag
+/// falls back to the environment variable named in its help, then to its default.
+#[derive(Parser)]
+#[command(name = "mbrl-fuzz", version)]
+struct Cli {
+    #[command(subcommand)]
+    child: Option<Child>,
+    /// Mutants per target [env: MBRL_FUZZ_MUTANTS] [default: 100]
+    #[arg(long, value_name = "N")]
+    mutants: Option<u64>,
+    /// Another family of mutants [env: MBRL_FUZZ_SEED] [default: 0]
+    #[arg(long, value_name = "N")]
+    seed: Option<u64>,
+    /// Comma-separated substrings of target names (see --list) [env: MBRL_FUZZ_TARGETS]
+    #[arg(long, value_name = "A,B")]
+    targets: Option<String>,
+    /// Parallel runs [env: MBRL_FUZZ_JOBS] [default: one per core]
+    #[arg(long, value_name = "N")]
+    jobs: Option<usize>,
+    /// The `mbrl` binary to fuzz [env: MBRL_FUZZ_BIN] [default: target/release/mbrl]
+    #[arg(long, value_name = "PATH")]
+    bin: Option<PathBuf>,
+    /// Where the seeds (DIR/tmp/fuzz-seeds) and the saved failures (DIR/fuzz-failures) go
+    #[arg(long, value_name = "DIR", default_value = "target")]
+    dir: PathBuf,
+    /// Print every run's outcome and first stderr line [env: MBRL_FUZZ_VERBOSE, set to anything]
+    #[arg(long)]
+    verbose: bool,
+    /// Print the target names and exit
+    #[arg(long)]
+    list: bool,
+}
+
+#[derive(Subcommand)]
+enum Child {
+    /// The child process of the `boardset-read` target: reads a board set through the library (no `mbrl`
+    /// subcommand reads board sets).
+    #[command(hide = true)]
+    ReadBoardSet { path: PathBuf },
+}
+
 struct Settings {
     mutants: u64,
     campaign: u64,
@@ -1350,24 +1375,33 @@ struct Settings {
     only: Vec<String>,
     /// Print every run's outcome and first stderr line.
     verbose: bool,
+    binary: PathBuf,
 }
 
-fn settings() -> Settings {
-    let number = |name: &str, default: u64| -> u64 {
-        std::env::var(name)
-            .ok()
-            .map_or(default, |v| v.trim().parse().unwrap_or_else(|_| panic!("{name}={v}: not a number")))
+/// The flags, else the environment, else the defaults; the message of an `Err` names the bad variable.
+fn settings(cli: &Cli) -> Result<Settings, String> {
+    let number = |flag: Option<u64>, name: &str, default: u64| -> Result<u64, String> {
+        match (flag, std::env::var(name)) {
+            (Some(n), _) => Ok(n),
+            (None, Ok(v)) => v.trim().parse().map_err(|_| format!("{name}={v}: not a number")),
+            (None, Err(_)) => Ok(default),
+        }
     };
     let cores = std::thread::available_parallelism().map_or(2, |n| n.get()) as u64;
-    Settings {
-        mutants: number("MBRL_FUZZ_MUTANTS", DEFAULT_MUTANTS),
-        campaign: number("MBRL_FUZZ_SEED", 0),
-        jobs: number("MBRL_FUZZ_JOBS", cores).max(1) as usize,
-        only: std::env::var("MBRL_FUZZ_TARGETS")
-            .map(|v| v.split(',').map(str::trim).filter(|s| !s.is_empty()).map(String::from).collect())
-            .unwrap_or_default(),
-        verbose: std::env::var_os("MBRL_FUZZ_VERBOSE").is_some(),
-    }
+    let only = cli.targets.clone().or_else(|| std::env::var("MBRL_FUZZ_TARGETS").ok()).unwrap_or_default();
+    let binary = cli
+        .bin
+        .clone()
+        .or_else(|| std::env::var_os("MBRL_FUZZ_BIN").map(PathBuf::from))
+        .unwrap_or_else(|| PathBuf::from("target/release/mbrl"));
+    Ok(Settings {
+        mutants: number(cli.mutants, "MBRL_FUZZ_MUTANTS", DEFAULT_MUTANTS)?,
+        campaign: number(cli.seed, "MBRL_FUZZ_SEED", 0)?,
+        jobs: number(cli.jobs.map(|j| j as u64), "MBRL_FUZZ_JOBS", cores)?.max(1) as usize,
+        only: only.split(',').map(str::trim).filter(|s| !s.is_empty()).map(String::from).collect(),
+        verbose: cli.verbose || std::env::var_os("MBRL_FUZZ_VERBOSE").is_some(),
+        binary,
+    })
 }
 
 /// One failing mutant, as reported and saved.
@@ -1409,7 +1443,7 @@ impl Counts {
 }
 
 fn failures_dir() -> PathBuf {
-    Path::new(env!("CARGO_TARGET_TMPDIR")).parent().unwrap().join("fuzz-failures")
+    work().join("fuzz-failures")
 }
 
 /// Shell-quotes one argument where needed (bytes kept as they are).
@@ -1458,9 +1492,9 @@ fn save_failure(target: &Target, mutant: &Mutant, index: u64, verdict: Verdict, 
         Input::Arg { .. } => (OsString::from_vec(fs::read(&mutant.path).unwrap()), ""),
         Input::File { .. } => (relative.clone().into_os_string(), ""),
     };
-    let (program, args) = command_line(target, &input, Path::new("fuzz-out"));
+    let (_, args) = command_line(target, &input, Path::new("fuzz-out"));
     let mut script = format!(
-        "#!/bin/sh\n# mbrl fuzz reproducer: target {}, mutant {index} (MBRL_FUZZ_SEED={campaign})\n# mutation: {}\n\
+        "#!/bin/sh\n# mbrl fuzz reproducer: target {}, mutant {index} (mbrl-fuzz --seed {campaign})\n# mutation: {}\n\
          # verdict: {}\n# Runs in fuzz-failures/seeds with the harness's limits and the binary that failed\n\
          # (seeds/{SNAPSHOT}); MBRL=/abs/path/to/mbrl tests another build, e.g. MBRL=$PWD/target/release/mbrl.\n\
          here=$(cd \"$(dirname \"$0\")\" && pwd)\nname={}\ncd \"$here/../seeds\" || exit 1\nrm -rf fuzz-out\n{setup}\
@@ -1472,9 +1506,7 @@ fn save_failure(target: &Target, mutant: &Mutant, index: u64, verdict: Verdict, 
     )
     .into_bytes();
     if target.program == Program::BoardSetReader {
-        script.extend_from_slice(format!("{BOARD_SET_CHILD_ENV}={} ", relative.display()).as_bytes());
-        script.extend_from_slice(b"exec ");
-        script.extend_from_slice(&quote(program.as_os_str()));
+        script.extend_from_slice(format!("exec \"$here/../seeds/{SELF_SNAPSHOT}\"").as_bytes());
     } else {
         // By default the very binary that failed (the copy next to the seeds).
         script.extend_from_slice(format!("exec \"${{MBRL:-$here/../seeds/{SNAPSHOT}}}\"").as_bytes());
@@ -1518,23 +1550,25 @@ fn remove(path: &Path) {
 
 /// Every unmutated seed must be read as intended under the same limits; otherwise the mutants test nothing
 /// (and a 4 GiB limit that breaks normal runs is itself a finding).
-fn check_seeds(targets: &[&Target], seeds: &Path) {
+fn check_seeds(targets: &[&Target], seeds: &Path) -> Result<(), String> {
     for target in targets {
         let (run, failed) = run_one(target, seeds, None, 0);
         let expected = if target.seed_is_refused { Verdict::CleanError } else { Verdict::Ok };
         if let Some(mutant) = failed {
             remove(&mutant.path);
         }
-        assert!(
-            run.verdict == expected,
-            "the unmutated seed of '{}' gave {} instead of {}: {}\n{}",
-            target.name,
-            run.verdict.describe(),
-            expected.describe(),
-            shown(target, OsStr::new("<seed>")),
-            run.stderr
-        );
+        if run.verdict != expected {
+            return Err(format!(
+                "the unmutated seed of '{}' gave {} instead of {}: {}\n{}",
+                target.name,
+                run.verdict.describe(),
+                expected.describe(),
+                shown(target, OsStr::new("<seed>")),
+                run.stderr
+            ));
+        }
     }
+    Ok(())
 }
 
 fn print_table(targets: &[&Target], counts: &[Counts]) {
@@ -1583,16 +1617,11 @@ fn print_table(targets: &[&Target], counts: &[Counts]) {
     );
 }
 
-#[test]
-fn fuzz_every_reader() {
-    let settings = settings();
+/// Runs every mutant of the chosen targets on the seeds; `Err` holds the report of the failures.
+fn fuzz_every_reader(settings: &Settings, targets: &[&Target]) -> Result<(), String> {
     let seeds = seeds();
-    let all = targets();
-    let targets: Vec<&Target> =
-        all.iter().filter(|t| settings.only.is_empty() || settings.only.iter().any(|o| t.name.contains(o))).collect();
-    assert!(!targets.is_empty(), "MBRL_FUZZ_TARGETS matches no target");
-    check_seeds(&targets, seeds);
-    for target in &targets {
+    check_seeds(targets, seeds)?;
+    for target in targets {
         remove(&failures_dir().join(target.name));
     }
 
@@ -1603,7 +1632,7 @@ fn fuzz_every_reader() {
     let failures = Mutex::new(Vec::new());
     let start = Instant::now();
     eprintln!(
-        "fuzz: {} targets × {} mutants, {} parallel runs, MBRL_FUZZ_SEED={}",
+        "fuzz: {} targets × {} mutants, {} parallel runs, --seed {}",
         targets.len(),
         settings.mutants,
         settings.jobs,
@@ -1651,15 +1680,15 @@ fn fuzz_every_reader() {
         }
     });
     let counts = counts.into_inner().unwrap();
-    print_table(&targets, &counts);
+    print_table(targets, &counts);
     eprintln!("fuzz: {} runs in {:.1} s", jobs.len(), start.elapsed().as_secs_f64());
 
     let mut failures = failures.into_inner().unwrap();
     failures.sort_by_key(|f| (f.target, f.index));
     if failures.is_empty() {
-        return;
+        return Ok(());
     }
-    // The reproducers run in a copy of the seeds, which a later test run regenerates.
+    // The reproducers run in a copy of the seeds, which a later campaign regenerates.
     let seeds_copy = failures_dir().join("seeds");
     remove(&seeds_copy);
     copy_dir(seeds, &seeds_copy);
@@ -1681,53 +1710,19 @@ fn fuzz_every_reader() {
             )
         })
         .collect();
-    panic!("{} of {} mutants failed:\n\n{}", failures.len(), jobs.len(), report.join("\n\n"));
-}
-
-/// The verdicts of the kinds of endings a run can have (wait statuses as the kernel reports them).
-#[test]
-fn classification_of_endings() {
-    let exit = |code: i32| Some(ExitStatus::from_raw(code << 8));
-    let signal = |sig: i32| Some(ExitStatus::from_raw(sig));
-    assert_eq!(classify(exit(0), ""), Verdict::Ok);
-    assert_eq!(classify(exit(1), "error: x.mcap: not a readable MCAP file\n"), Verdict::CleanError);
-    assert_eq!(classify(exit(2), "error: unexpected argument '--x' (see 'mbrl --help')\n"), Verdict::CleanError);
-    assert_eq!(classify(exit(101), ""), Verdict::Panic);
-    assert_eq!(classify(exit(1), "thread 'main' panicked at src/x.rs:1:1:\nerror: x\n"), Verdict::Panic);
-    assert_eq!(classify(signal(6), "memory allocation of 68719476736 bytes failed\n"), Verdict::Abort(6));
-    assert_eq!(classify(signal(11), ""), Verdict::Abort(11));
-    assert_eq!(classify(None, ""), Verdict::Hang);
-    assert_eq!(classify(exit(1), "progress 3/5\nerror: late\n"), Verdict::Unclean(1));
-    assert_eq!(classify(exit(3), "error: x\n"), Verdict::Unclean(3));
-}
-
-/// Not a test on its own: the child process of the `boardset-read` target, reading the board set named in
-/// its environment through the library (no subcommand reads board sets). Does nothing in a normal test run.
-#[test]
-fn board_set_reader_child() {
-    let Some(path) = std::env::var_os(BOARD_SET_CHILD_ENV) else { return };
-    match mbrl::data::boardset::read_board_set(Path::new(&path)) {
-        Ok(set) => {
-            println!("{} boards of {}", set.boards.len(), set.game);
-            std::process::exit(0)
-        }
-        Err(e) => {
-            eprintln!("error: {e}");
-            std::process::exit(1)
-        }
-    }
+    Err(format!("{} of {} mutants failed:\n\n{}", failures.len(), jobs.len(), report.join("\n\n")))
 }
 
 /// Every MCAP file the seeding wrote passes the official Python reader with CRC validation: seeking (summary,
 /// chunk CRCs) and streaming (data-section CRC), with the message counts of the summary.
-#[test]
-fn seeds_pass_the_python_mcap_reader() {
+fn seeds_pass_the_python_mcap_reader(seeds: &Path) -> Result<(), String> {
     let probe = Command::new("python3").args(["-c", "import mcap"]).output();
     if !probe.is_ok_and(|o| o.status.success()) {
-        eprintln!("note: skipped: python3 with the `mcap` package is not available (pip install mcap)");
-        return;
+        eprintln!(
+            "note: Python reader check skipped: python3 with the `mcap` package is not available (pip install mcap)"
+        );
+        return Ok(());
     }
-    let seeds = seeds();
     // The seed directory and the report directories in it (`work/` holds mutants).
     let dirs = fs::read_dir(seeds).unwrap().map(|e| e.unwrap().path()).filter(|p| p.is_dir() && !p.ends_with("work"));
     let mut files: Vec<PathBuf> = std::iter::once(seeds.to_path_buf())
@@ -1736,7 +1731,9 @@ fn seeds_pass_the_python_mcap_reader() {
         .filter(|p| p.extension().is_some_and(|e| e == "mcap"))
         .collect();
     files.sort();
-    assert!(files.len() >= 10, "expected every seed MCAP file, found {files:?}");
+    if files.len() < 10 {
+        return Err(format!("expected every seed MCAP file, found {files:?}"));
+    }
     const SCRIPT: &str = r#"
 import sys
 from mcap.reader import make_reader, NonSeekingReader
@@ -1757,7 +1754,99 @@ for path in sys.argv[1:]:
 "#;
     let out = Command::new("python3").arg("-c").arg(SCRIPT).args(&files).output().unwrap();
     let (stdout, stderr) = (String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
-    assert!(out.status.success(), "the Python mcap reader refused a seed:\n{stdout}{stderr}");
-    assert_eq!(stdout.lines().count(), files.len(), "{stdout}");
-    eprint!("{stdout}");
+    if !out.status.success() || stdout.lines().count() != files.len() {
+        return Err(format!("the Python mcap reader refused a seed:\n{stdout}{stderr}"));
+    }
+    eprintln!("fuzz: the Python mcap reader read all {} seed MCAP files with valid CRCs", files.len());
+    Ok(())
+}
+
+/// Reads a board set through the library: what the `boardset-read` target runs.
+fn read_board_set(path: &Path) -> ExitCode {
+    match mbrl::data::boardset::read_board_set(path) {
+        Ok(set) => {
+            println!("{} boards of {}", set.boards.len(), set.game);
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    if let Some(Child::ReadBoardSet { path }) = &cli.child {
+        return read_board_set(path);
+    }
+    let all = targets();
+    if cli.list {
+        for target in &all {
+            println!("{}", target.name);
+        }
+        return ExitCode::SUCCESS;
+    }
+    // 2: the campaign could not run; 1: it ran and found something.
+    let setup_error = |message: String| {
+        eprintln!("mbrl-fuzz: error: {message}");
+        ExitCode::from(2)
+    };
+    let settings = match settings(&cli) {
+        Ok(settings) => settings,
+        Err(message) => return setup_error(message),
+    };
+    if !settings.binary.is_file() {
+        let hint = if cli.bin.is_none() && std::env::var_os("MBRL_FUZZ_BIN").is_none() {
+            ": build it with `cargo build --release` in the repository root, or pass --bin PATH"
+        } else {
+            ""
+        };
+        return setup_error(format!("{} not found{hint}", settings.binary.display()));
+    }
+    let targets: Vec<&Target> =
+        all.iter().filter(|t| settings.only.is_empty() || settings.only.iter().any(|o| t.name.contains(o))).collect();
+    if targets.is_empty() {
+        return setup_error(format!("--targets {}: matches no target (see --list)", settings.only.join(",")));
+    }
+    // Absolute: the children run inside the seed directory.
+    let dir = match std::path::absolute(&cli.dir) {
+        Ok(dir) => dir,
+        Err(e) => return setup_error(format!("{}: {e}", cli.dir.display())),
+    };
+    WORK.set(dir).expect("set once");
+    eprintln!("fuzz: testing {}", settings.binary.display());
+    if let Err(message) = generate(&settings.binary) {
+        return setup_error(message);
+    }
+    let outcome = seeds_pass_the_python_mcap_reader(seeds()).and_then(|()| fuzz_every_reader(&settings, &targets));
+    match outcome {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(report) => {
+            eprintln!("mbrl-fuzz: {report}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The verdicts of the kinds of endings a run can have (wait statuses as the kernel reports them).
+    #[test]
+    fn classification_of_endings() {
+        let exit = |code: i32| Some(ExitStatus::from_raw(code << 8));
+        let signal = |sig: i32| Some(ExitStatus::from_raw(sig));
+        assert_eq!(classify(exit(0), ""), Verdict::Ok);
+        assert_eq!(classify(exit(1), "error: x.mcap: not a readable MCAP file\n"), Verdict::CleanError);
+        assert_eq!(classify(exit(2), "error: unexpected argument '--x' (see 'mbrl --help')\n"), Verdict::CleanError);
+        assert_eq!(classify(exit(101), ""), Verdict::Panic);
+        assert_eq!(classify(exit(1), "thread 'main' panicked at src/x.rs:1:1:\nerror: x\n"), Verdict::Panic);
+        assert_eq!(classify(signal(6), "memory allocation of 68719476736 bytes failed\n"), Verdict::Abort(6));
+        assert_eq!(classify(signal(11), ""), Verdict::Abort(11));
+        assert_eq!(classify(None, ""), Verdict::Hang);
+        assert_eq!(classify(exit(1), "progress 3/5\nerror: late\n"), Verdict::Unclean(1));
+        assert_eq!(classify(exit(3), "error: x\n"), Verdict::Unclean(3));
+    }
 }

@@ -1,10 +1,8 @@
 //! End to end: collect → train DLGPD → plan a swing-up on evidence, resume, and the errors a user can run into.
 
-mod common;
-
 use std::path::Path;
 
-use common::*;
+use crate::common::*;
 use mbrl::data::read_dataset;
 use mbrl::models::dlgpd::config::{DlgpdConfig, Preset};
 use mbrl::models::dlgpd::job as dlgpd;

@@ -1,11 +1,9 @@
 //! `mbrl collect` end to end: replaying action files, instance-pair datasets for context models, and the
 //! errors bad action files and start states give.
 
-mod common;
-
 use std::path::Path;
 
-use common::*;
+use crate::common::*;
 use mbrl::data::{instance_pairs, read_dataset, DatasetLayout};
 use mbrl::envs::pendulum::{Pendulum, PendulumVariant};
 use mbrl::envs::{instance_env, parse_env, Env};

@@ -1,11 +1,9 @@
 //! End to end: instance pairs → a context model → calibration → planning on the calibrated model, resume, and
 //! the errors a user can run into.
 
-mod common;
-
 use std::path::Path;
 
-use common::*;
+use crate::common::*;
 use mbrl::data::read_dataset;
 
 /// Networks small enough to train in a second; checkpoints every 10 steps.

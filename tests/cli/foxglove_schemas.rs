@@ -3,9 +3,7 @@
 //! rendered frames as `foxglove.CompressedImage` (Image panel). Read with the official Python MCAP reader and
 //! checked with the `jsonschema` package when both are installed.
 
-mod common;
-
-use common::mbrl;
+use crate::common::mbrl;
 
 const CHECK: &str = r#"
 import json, sys

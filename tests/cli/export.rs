@@ -1,12 +1,10 @@
 //! `mbrl export` end to end: every data kind to CSV and .npz, read back with a Rust npy reader (and NumPy
 //! where it is installed) and compared value for value with what mbrl's own readers see.
 
-mod common;
-
 use std::fs::File;
 use std::path::Path;
 
-use common::{assert_one_line_error, files_in, mbrl};
+use crate::common::{assert_one_line_error, files_in, mbrl};
 use ndarray::{ArrayD, Ix2};
 use ndarray_npy::NpzReader;
 

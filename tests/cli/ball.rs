@@ -1,8 +1,6 @@
 //! End to end: simulated ball shots, filtering and prediction from the command line, bad recordings.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use mbrl::data::ball_io::read_ball_dataset;
 
 #[test]

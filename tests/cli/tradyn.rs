@@ -1,11 +1,9 @@
 //! End to end for TRADYN: maps → unicycle pairs → a model with terrain lookup and its ablation → calibration →
 //! navigation on a test map; resume; and the errors a user can run into.
 
-mod common;
-
 use std::path::Path;
 
-use common::*;
+use crate::common::*;
 use mbrl::data::read_dataset;
 
 /// Networks small enough to train in seconds; checkpoints every 10 steps.

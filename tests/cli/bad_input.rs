@@ -1,8 +1,6 @@
 //! Bad input gets one clear error line, a non-zero exit, and no output file.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 
 #[test]
 fn unknown_env_names_what_is_supported() {

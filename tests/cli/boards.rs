@@ -1,8 +1,6 @@
 //! End to end: board sets, solving boards of every depth optimally, embodied play, bad boards.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use mbrl::data::boardset::read_board_set;
 use mbrl::envs::boards::{gf2, BoardGame, LightsOut, Split};
 

@@ -1,11 +1,9 @@
 //! `mbrl collect` on board games played by a manipulator (lightsout:cursor, tileswap:reacher, …): replays
 //! of given actions, random skill episodes, and the errors bad input gives.
 
-mod common;
-
 use std::path::Path;
 
-use common::*;
+use crate::common::*;
 use mbrl::data::{read_dataset, Rollout};
 
 fn write(dir: &Path, name: &str, text: &str) {

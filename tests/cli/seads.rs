@@ -2,11 +2,9 @@
 //! moves and solves test boards through its own forward model and skills; resume continues bit for bit; the
 //! errors a user can run into.
 
-mod common;
-
 use std::path::Path;
 
-use common::*;
+use crate::common::*;
 use mbrl::models::seads::{self, EmbodiedGame, Preset, SeadsConfig};
 use mbrl::run::dir::Provenance;
 

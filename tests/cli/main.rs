@@ -1,0 +1,25 @@
+//! The end-to-end tests, one module per area, in one test binary: each integration test file used to be its
+//! own binary linking the whole library, so a change to `src/` relinked twenty of them.
+//!
+//! `cargo test --release --test cli pets::` runs one module's tests.
+
+mod common;
+
+mod bad_input;
+mod ball;
+mod board_tables;
+mod boards;
+mod collect;
+mod context;
+mod dlgpd;
+mod embodied;
+mod export;
+mod foxglove_schemas;
+mod kill;
+mod pendulum_plan;
+mod pendulum_reference;
+mod pets;
+mod seads;
+mod surface;
+mod tradyn;
+mod unicycle;
