@@ -6,6 +6,7 @@ pub mod config;
 pub mod data_file;
 pub mod fit;
 pub mod job;
+pub mod run_dir;
 pub mod state;
 pub mod tensors;
 
