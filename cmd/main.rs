@@ -77,8 +77,9 @@ fn main() {
         eprintln!("error: could not install the Ctrl-C handler: {e}");
         std::process::exit(1);
     }
+    let args = train::alias::rewrite(std::env::args_os().collect(), &Cli::command());
     let cli = accept_negative_numbers(Cli::command())
-        .try_get_matches()
+        .try_get_matches_from(&args)
         .and_then(|matches| Cli::from_arg_matches(&matches))
         .unwrap_or_else(|err| exit_on_usage_error(err));
     let outcome = common::init_threads(&cli.global).and_then(|()| match cli.command {
@@ -137,13 +138,24 @@ fn exit_on_usage_error(err: clap::Error) -> ! {
         "invalid digit found in string",
         if negative { "must be a whole number ≥ 0" } else { "not a whole number" },
     );
-    let command = std::env::args().nth(1).filter(|a| Cli::command().find_subcommand(a).is_some());
-    let help = match command {
-        Some(name) => format!("mbrl {name} --help"),
-        None => "mbrl --help".to_string(),
-    };
+    let help = help_command(&train::alias::rewrite(std::env::args_os().collect(), &Cli::command()));
     eprintln!("error: {} (see '{}')", one_line(&message), one_line(&help));
     std::process::exit(2);
+}
+
+/// The help that documents the flags of the command line typed: `mbrl train dlgpd --help` for a flag that
+/// `train dlgpd` does not take, not the list of methods.
+fn help_command(args: &[std::ffi::OsString]) -> String {
+    let mut command = Cli::command();
+    let mut path = vec!["mbrl".to_string()];
+    for arg in args.iter().skip(1).take(2) {
+        let Some(sub) = arg.to_str().and_then(|a| command.find_subcommand(a)).cloned() else {
+            break;
+        };
+        path.push(sub.get_name().to_string());
+        command = sub;
+    }
+    format!("{} --help", path.join(" "))
 }
 
 /// Control characters from inputs (a file name with a newline, bytes of a corrupt header) are escaped, so

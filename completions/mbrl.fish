@@ -104,42 +104,145 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l no-tui -d 'Print plai
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -s V -l version -d 'Print version'
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l method -d 'What to train' -r -f -a "pets\t'Probabilistic ensemble of MLPs on (state, action) → state change (PETS, Chua et al. 2018), for any env that `collect` rolls out; plan with it via `mbrl plan --model DIR`'
-ball-ekf\t'Gray-box table-tennis ball EKF: learn the impact matrix, noise levels and initial values by maximizing the filter\'s marginal likelihood (thesis 6.4.4, eq. 6.24)'
-context\t'Context-conditional GRU dynamics with a context encoder (Explore the Context, thesis ch. 4), trained on instance-pair datasets (`collect --instances N`); calibrate with `mbrl calibrate`'
-tradyn\t'TRADYN (thesis ch. 5): the context model on the unicycle\'s observation with the terrain under the robot as input, read from the map at predicted positions; --no-terrain trains the ablation that predicts it. Data: `collect --env unicycle --maps DIR --split train --instances N --steps 100`'
-seads\t'SEADS (thesis ch. 7): skill policies (SAC) and a symbolic forward model learned without reward in an embodied board game (--env lightsout:cursor|tileswap:cursor|lightsout:reacher|tileswap:reacher); needs no --data, it collects its own episodes'
-dlgpd\t'DLGPD (thesis ch. 3): a VAE on pendulum frames (`collect --images`) with Gaussian-process latent dynamics and reward; plan with `mbrl plan --model DIR --evidence E.mcap`. The small preset learns from the pole angle instead of frames'"
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l data -d 'Training data (repeatable). pets: rollout datasets (.mcap) of one env; ball-ekf: a ball dataset (.mcap) or a .csv recording. SEADS collects its own episodes and takes none' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l env -d 'The env the data must come from (pets; default: the dataset\'s env)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l out -d 'Checkpoint directory (default: models/<method>-<env>, models/ball-ekf)' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l resume -d 'Continue the stopped run in this checkpoint directory' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l config -d 'Hyperparameters from a TOML file (pets, context), over the preset\'s' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l preset -d 'Network size and training length (pets: small, medium; context, seads, dlgpd: small, medium, paper)' -r -f -a "small\t'3 hidden layers × 64 SiLU units, 2000 steps (≈ 10 s on 2 cores)'
-medium\t'4 × 200 SiLU units, 5000 steps: mbrl-lib\'s PETS pendulum network'
-paper\t'The paper\'s scale (context: Table B.1; seads: 500k/10M env steps; dlgpd: batch 1024, 28 000 steps)'"
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l ensemble -d 'Ensemble members (pets; default 5)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l steps -d 'Optimizer steps (pets, context, dlgpd: the preset\'s; ball-ekf: 1000). With --resume: train a pets or dlgpd run, finished or not, on to this many steps in total' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l batch -d 'Batch size: transitions per member (pets, 256), chunks (ball-ekf, thesis 64), transitions (dlgpd: the preset\'s; the paper 1024)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l lr -d 'Adam learning rate (pets, dlgpd: 1e-3; ball-ekf: thesis 5e-3)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l reward -d 'Where the model\'s reward comes from (pets; default: known where the env has a closed form)' -r -f -a "known\t'The env\'s closed-form reward (pendulum variants without hidden actuators)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and not __fish_seen_subcommand_from pets ball-ekf context tradyn seads dlgpd help" -l resume -d 'Continue the stopped run in this checkpoint directory; the method, config and data are the checkpoint\'s' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and not __fish_seen_subcommand_from pets ball-ekf context tradyn seads dlgpd help" -l steps -d 'With --resume: train a pets or dlgpd run, finished or not, on to this many steps in total' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and not __fish_seen_subcommand_from pets ball-ekf context tradyn seads dlgpd help" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and not __fish_seen_subcommand_from pets ball-ekf context tradyn seads dlgpd help" -l threads -d 'Worker threads (0 = one per core)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and not __fish_seen_subcommand_from pets ball-ekf context tradyn seads dlgpd help" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and not __fish_seen_subcommand_from pets ball-ekf context tradyn seads dlgpd help" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and not __fish_seen_subcommand_from pets ball-ekf context tradyn seads dlgpd help" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and not __fish_seen_subcommand_from pets ball-ekf context tradyn seads dlgpd help" -s q -l quiet -d 'Print only results and errors'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and not __fish_seen_subcommand_from pets ball-ekf context tradyn seads dlgpd help" -s h -l help -d 'Print help'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and not __fish_seen_subcommand_from pets ball-ekf context tradyn seads dlgpd help" -s V -l version -d 'Print version'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and not __fish_seen_subcommand_from pets ball-ekf context tradyn seads dlgpd help" -f -a "pets" -d 'Probabilistic ensemble of MLPs on (state, action) → state change (PETS, Chua et al. 2018), for any env that `collect` rolls out; plan with it via `mbrl plan --model DIR`'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and not __fish_seen_subcommand_from pets ball-ekf context tradyn seads dlgpd help" -f -a "ball-ekf" -d 'Gray-box table-tennis ball EKF: learn the impact matrix, noise levels and initial values by maximizing the filter\'s marginal likelihood (thesis 6.4.4, eq. 6.24)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and not __fish_seen_subcommand_from pets ball-ekf context tradyn seads dlgpd help" -f -a "context" -d 'Context-conditional GRU dynamics with a context encoder (Explore the Context, thesis ch. 4), trained on instance-pair datasets (`collect --instances N`); calibrate with `mbrl calibrate`'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and not __fish_seen_subcommand_from pets ball-ekf context tradyn seads dlgpd help" -f -a "tradyn" -d 'TRADYN (thesis ch. 5): the context model on the unicycle\'s observation with the terrain under the robot as input, read from the map at predicted positions; --no-terrain trains the ablation that predicts it'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and not __fish_seen_subcommand_from pets ball-ekf context tradyn seads dlgpd help" -f -a "seads" -d 'SEADS (thesis ch. 7): skill policies (SAC) and a symbolic forward model learned without reward in an embodied board game; needs no --data, it collects its own episodes'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and not __fish_seen_subcommand_from pets ball-ekf context tradyn seads dlgpd help" -f -a "dlgpd" -d 'DLGPD (thesis ch. 3): a VAE on pendulum frames (`collect --images`) with Gaussian-process latent dynamics and reward; plan with `mbrl plan --model DIR --evidence E.mcap`'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and not __fish_seen_subcommand_from pets ball-ekf context tradyn seads dlgpd help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -l data -d 'Rollout datasets (.mcap) of one env, merged (repeatable)' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -l env -d 'The env the data must come from (default: the dataset\'s env)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -l config -d 'Hyperparameters from a TOML file (keys of config.json\'s `config` table), over the preset\'s' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -l preset -d 'Network size and training length (default: small)' -r -f -a "small\t'3 hidden layers × 64 SiLU units, 2000 steps (≈ 10 s on 2 cores)'
+medium\t'4 × 200 SiLU units, 5000 steps: mbrl-lib\'s PETS pendulum network'"
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -l ensemble -d 'Ensemble members (default 5)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -l steps -d 'Optimizer steps (default: the preset\'s)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -l batch -d 'Transitions per member in a batch (default 256)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -l lr -d 'Adam learning rate (default 1e-3)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -l reward -d 'Where the model\'s reward comes from (default: known where the env has a closed form)' -r -f -a "known\t'The env\'s closed-form reward (pendulum variants without hidden actuators)'
 learned\t'An extra output of the network, trained on the dataset\'s rewards'"
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l chunk -d 'Frames per chunk (ball-ekf; thesis: 50)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l skills -d 'Number of skills K (seads; default: the game\'s move count, 25 LightsOut, 12 TileSwap)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l env-steps -d 'Budget of environment steps (seads; default: the preset\'s, paper = 500k Cursor, 10M Reacher)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l threads -d 'Worker threads (0 = one per core)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l launcher-prior -d 'Learn the spin prior from launcher settings (ball-ekf, thesis C.1.3); recordings need side information'
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l no-relabel -d 'Ablation: no relabelling of skill labels (seads)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l no-second-best -d 'Ablation: no second-best normalization of the reward (seads)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l no-novelty -d 'Ablation: no novelty bonus in the reward (seads)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l no-terrain -d 'Ablation: no terrain lookup (tradyn "−T"): the terrain features become part of the predicted state'
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -s q -l quiet -d 'Print only results and errors'
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -s h -l help -d 'Print help (see more with \'--help\')'
-complete -c mbrl -n "__fish_mbrl_using_subcommand train" -s V -l version -d 'Print version'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -l out -d 'Checkpoint directory (default: models/pets-<env>)' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -l threads -d 'Worker threads (0 = one per core)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -l resume-if-stopped -d 'Resume the stopped run in --out when this command started it (same method, config, data and seed; a larger --steps extends a pets or dlgpd run); with no run there, or a finished one, train as without this flag. A re-run script then loses none of an interrupted run\'s training'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -s q -l quiet -d 'Print only results and errors'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -s h -l help -d 'Print help (see more with \'--help\')'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -s V -l version -d 'Print version'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from ball-ekf" -l data -d 'A ball dataset (.mcap) or a .csv recording' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from ball-ekf" -l steps -d 'Optimizer steps (default 1000)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from ball-ekf" -l batch -d 'Chunks in a batch (thesis: 64)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from ball-ekf" -l chunk -d 'Frames per chunk (thesis: 50)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from ball-ekf" -l lr -d 'Adam learning rate (thesis: 5e-3)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from ball-ekf" -l out -d 'Checkpoint directory (default: models/ball-ekf)' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from ball-ekf" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from ball-ekf" -l threads -d 'Worker threads (0 = one per core)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from ball-ekf" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from ball-ekf" -l launcher-prior -d 'Learn the spin prior from launcher settings (thesis C.1.3); recordings need side information'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from ball-ekf" -l resume-if-stopped -d 'Resume the stopped run in --out when this command started it (same method, config, data and seed; a larger --steps extends a pets or dlgpd run); with no run there, or a finished one, train as without this flag. A re-run script then loses none of an interrupted run\'s training'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from ball-ekf" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from ball-ekf" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from ball-ekf" -s q -l quiet -d 'Print only results and errors'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from ball-ekf" -s h -l help -d 'Print help'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from ball-ekf" -s V -l version -d 'Print version'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -l data -d 'An instance-pair dataset (.mcap) from `mbrl collect --instances N`' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -l env -d 'The env the data must come from (default: the dataset\'s env)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -l config -d 'Hyperparameters from a TOML file (keys of config.json\'s `config` table), over the preset\'s' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -l preset -d 'Network size and training length (default: small; paper: Table B.1)' -r -f -a "small\t'Minutes on 2 cores: what `eval quick` and the tests train'
+medium\t'The largest scale the README\'s reproductions run on 2 cores'
+paper\t'The paper\'s networks and training budgets (days on 2 cores for most methods)'"
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -l steps -d 'Optimizer steps (default: the preset\'s); the p_ctx schedule keeps its shares of the run' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -l batch -d 'Chunks of consecutive states in a batch (default: the preset\'s)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -l lr -d 'Adam learning rate (default: the preset\'s)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -l out -d 'Checkpoint directory (default: models/context-<env>)' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -l threads -d 'Worker threads (0 = one per core)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -l resume-if-stopped -d 'Resume the stopped run in --out when this command started it (same method, config, data and seed; a larger --steps extends a pets or dlgpd run); with no run there, or a finished one, train as without this flag. A re-run script then loses none of an interrupted run\'s training'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -s q -l quiet -d 'Print only results and errors'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -s h -l help -d 'Print help (see more with \'--help\')'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -s V -l version -d 'Print version'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -l data -d 'A unicycle instance-pair dataset (.mcap): `collect --env unicycle --maps DIR --split train --instances N`' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -l env -d 'The env: TRADYN models the unicycle, the only value taken' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -l config -d 'Hyperparameters from a TOML file (keys of config.json\'s `config` table), over the preset\'s' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -l preset -d 'Network size and training length (default: small; paper: Table B.1)' -r -f -a "small\t'Minutes on 2 cores: what `eval quick` and the tests train'
+medium\t'The largest scale the README\'s reproductions run on 2 cores'
+paper\t'The paper\'s networks and training budgets (days on 2 cores for most methods)'"
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -l steps -d 'Optimizer steps (default: the preset\'s); the p_ctx schedule keeps its shares of the run' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -l batch -d 'Chunks of consecutive states in a batch (default: the preset\'s)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -l lr -d 'Adam learning rate (default: the preset\'s)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -l out -d 'Checkpoint directory (default: models/tradyn-terrain, models/tradyn-no-terrain)' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -l threads -d 'Worker threads (0 = one per core)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -l no-terrain -d 'Ablation (thesis "−T"): no terrain lookup; the terrain features become part of the predicted state'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -l resume-if-stopped -d 'Resume the stopped run in --out when this command started it (same method, config, data and seed; a larger --steps extends a pets or dlgpd run); with no run there, or a finished one, train as without this flag. A re-run script then loses none of an interrupted run\'s training'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -s q -l quiet -d 'Print only results and errors'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -s h -l help -d 'Print help (see more with \'--help\')'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -s V -l version -d 'Print version'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -l env -d 'The embodied board game: lightsout:cursor, tileswap:cursor, lightsout:reacher or tileswap:reacher' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -l config -d 'Hyperparameters from a TOML file (keys of config.json\'s `config` table), over the preset\'s' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -l preset -d 'Network sizes and budget (default: small; paper: 500k env steps on the Cursor, 10M on the Reacher)' -r -f -a "small\t'Minutes on 2 cores: what `eval quick` and the tests train'
+medium\t'The largest scale the README\'s reproductions run on 2 cores'
+paper\t'The paper\'s networks and training budgets (days on 2 cores for most methods)'"
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -l skills -d 'Number of skills K (default: the game\'s move count, 25 LightsOut, 12 TileSwap)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -l env-steps -d 'Budget of environment steps (default: the preset\'s)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -l out -d 'Checkpoint directory (default: models/seads-<env>)' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -l threads -d 'Worker threads (0 = one per core)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -l no-relabel -d 'Ablation: no relabelling of skill labels'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -l no-second-best -d 'Ablation: no second-best normalization of the reward'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -l no-novelty -d 'Ablation: no novelty bonus in the reward'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -l resume-if-stopped -d 'Resume the stopped run in --out when this command started it (same method, config, data and seed; a larger --steps extends a pets or dlgpd run); with no run there, or a finished one, train as without this flag. A re-run script then loses none of an interrupted run\'s training'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -s q -l quiet -d 'Print only results and errors'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -s h -l help -d 'Print help (see more with \'--help\')'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -s V -l version -d 'Print version'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l data -d 'Pendulum rollouts (.mcap), merged (repeatable): with frames (`collect --images`) for the medium and paper presets, any for the small one' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l env -d 'The env the data must come from (default: the dataset\'s env)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l config -d 'Hyperparameters from a TOML file (keys of config.json\'s `config` table), over the preset\'s' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l preset -d 'Model and training size (default: small, which learns from the pole angle instead of frames)' -r -f -a "small\t'Minutes on 2 cores: what `eval quick` and the tests train'
+medium\t'The largest scale the README\'s reproductions run on 2 cores'
+paper\t'The paper\'s networks and training budgets (days on 2 cores for most methods)'"
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l steps -d 'Optimizer steps (default: the preset\'s)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l batch -d 'Transitions in a batch (default: the preset\'s; the paper 1024)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l lr -d 'Adam learning rate (default 1e-3)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l out -d 'Checkpoint directory (default: models/dlgpd-pendulum)' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l threads -d 'Worker threads (0 = one per core)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l resume-if-stopped -d 'Resume the stopped run in --out when this command started it (same method, config, data and seed; a larger --steps extends a pets or dlgpd run); with no run there, or a finished one, train as without this flag. A re-run script then loses none of an interrupted run\'s training'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -s q -l quiet -d 'Print only results and errors'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -s h -l help -d 'Print help (see more with \'--help\')'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -s V -l version -d 'Print version'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from help" -f -a "pets" -d 'Probabilistic ensemble of MLPs on (state, action) → state change (PETS, Chua et al. 2018), for any env that `collect` rolls out; plan with it via `mbrl plan --model DIR`'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from help" -f -a "ball-ekf" -d 'Gray-box table-tennis ball EKF: learn the impact matrix, noise levels and initial values by maximizing the filter\'s marginal likelihood (thesis 6.4.4, eq. 6.24)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from help" -f -a "context" -d 'Context-conditional GRU dynamics with a context encoder (Explore the Context, thesis ch. 4), trained on instance-pair datasets (`collect --instances N`); calibrate with `mbrl calibrate`'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from help" -f -a "tradyn" -d 'TRADYN (thesis ch. 5): the context model on the unicycle\'s observation with the terrain under the robot as input, read from the map at predicted positions; --no-terrain trains the ablation that predicts it'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from help" -f -a "seads" -d 'SEADS (thesis ch. 7): skill policies (SAC) and a symbolic forward model learned without reward in an embodied board game; needs no --data, it collects its own episodes'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from help" -f -a "dlgpd" -d 'DLGPD (thesis ch. 3): a VAE on pendulum frames (`collect --images`) with Gaussian-process latent dynamics and reward; plan with `mbrl plan --model DIR --evidence E.mcap`'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l model -d 'A context-model checkpoint (`mbrl train --method context`, or `--method tradyn` for the unicycle)' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l env -d 'Environment the model was trained on, e.g. toy:inner, pendulum:quadrant, mountaincar, unicycle' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l map -d 'For --env unicycle: the terrain map (PNG) the robot calibrates on' -r -F
@@ -452,6 +555,12 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subc
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "export" -d 'Convert a dataset, board set, ball recording or filter-estimate file to CSV or NumPy `.npz`'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "completions" -d 'Print a shell completion script'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from train" -f -a "pets" -d 'Probabilistic ensemble of MLPs on (state, action) → state change (PETS, Chua et al. 2018), for any env that `collect` rolls out; plan with it via `mbrl plan --model DIR`'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from train" -f -a "ball-ekf" -d 'Gray-box table-tennis ball EKF: learn the impact matrix, noise levels and initial values by maximizing the filter\'s marginal likelihood (thesis 6.4.4, eq. 6.24)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from train" -f -a "context" -d 'Context-conditional GRU dynamics with a context encoder (Explore the Context, thesis ch. 4), trained on instance-pair datasets (`collect --instances N`); calibrate with `mbrl calibrate`'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from train" -f -a "tradyn" -d 'TRADYN (thesis ch. 5): the context model on the unicycle\'s observation with the terrain under the robot as input, read from the map at predicted positions; --no-terrain trains the ablation that predicts it'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from train" -f -a "seads" -d 'SEADS (thesis ch. 7): skill policies (SAC) and a symbolic forward model learned without reward in an embodied board game; needs no --data, it collects its own episodes'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from train" -f -a "dlgpd" -d 'DLGPD (thesis ch. 3): a VAE on pendulum frames (`collect --images`) with Gaussian-process latent dynamics and reward; plan with `mbrl plan --model DIR --evidence E.mcap`'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from eval" -f -a "quick" -d 'Small reproduction of every implemented method (about a minute)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from eval" -f -a "dataset" -d 'Summarise a dataset: rollouts, returns, state ranges, plots'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from eval" -f -a "boards" -d 'Depth and train/test split tables of LightsOut 5x5 and TileSwap (thesis Tables 7.1, 7.2)'

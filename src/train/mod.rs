@@ -7,6 +7,7 @@ pub mod data_file;
 pub mod datasets;
 pub mod fit;
 pub mod job;
+pub mod run_dir;
 pub mod state;
 pub mod tensors;
 

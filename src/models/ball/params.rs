@@ -66,6 +66,13 @@ pub struct BallModelParams {
 }
 
 impl BallModelParams {
+    /// The drag and Magnus coefficients k_d = a_d² + ε and k_m = a_m² + ε (6.4.2) at the initial means of a_d
+    /// and a_m: the learned values in the units of the thesis' tables.
+    pub fn initial_coefficients(&self) -> (f64, f64) {
+        let eps = self.physics.coeff_offset;
+        (self.a_d0 * self.a_d0 + eps, self.a_m0 * self.a_m0 + eps)
+    }
+
     /// Starting point of training, Table C.1 (thesis lines 6680-6706) and C.1.1 (lines 6653-6662). The table gives
     /// σ as inv[·]⊕(x), i.e. the variance itself is x.
     pub fn initial() -> Self {

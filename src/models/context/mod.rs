@@ -10,6 +10,7 @@ pub mod eig;
 pub mod fast;
 pub mod grad;
 pub mod net;
+pub mod options;
 pub mod train;
 
 use std::path::{Path, PathBuf};

@@ -10,6 +10,7 @@ pub mod job;
 pub mod latent_gp;
 pub mod loss;
 pub mod model;
+pub mod options;
 pub mod prediction;
 pub mod train;
 pub mod vae;

@@ -6,6 +6,7 @@ pub mod config;
 pub mod data;
 pub mod dynamics;
 pub mod net;
+pub mod options;
 pub mod train;
 
 use std::path::{Path, PathBuf};

@@ -6,6 +6,7 @@ pub mod collect;
 pub mod config;
 pub mod forward_model;
 pub mod memory;
+pub mod options;
 pub mod planner;
 pub mod relabel;
 pub mod reward;

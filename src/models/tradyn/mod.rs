@@ -6,6 +6,7 @@
 
 pub mod dynamics;
 pub mod navigation;
+pub mod options;
 
 use std::path::Path;
 use std::sync::Arc;

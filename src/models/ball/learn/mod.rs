@@ -23,6 +23,7 @@ mod impact;
 mod init;
 pub mod job;
 mod linalg;
+pub mod options;
 mod params;
 mod positive;
 mod predict;

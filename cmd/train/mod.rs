@@ -1,0 +1,175 @@
+//! `mbrl train`: fit a model to a dataset and write a checkpoint directory. One subcommand per method, each
+//! with only the flags that method takes; `--resume DIR` reads the method from the checkpoint.
+
+pub mod alias;
+mod ball;
+mod context;
+mod dlgpd;
+mod pets;
+mod report;
+mod seads;
+mod shared;
+
+use std::path::{Path, PathBuf};
+
+use anyhow::bail;
+use clap::{Args, Subcommand, ValueEnum};
+use mbrl::models::ball::learn::job as ball_job;
+use mbrl::models::context as context_model;
+use mbrl::models::dlgpd::job as dlgpd_job;
+use mbrl::models::pets as pets_model;
+use mbrl::models::seads as seads_model;
+use mbrl::models::tradyn;
+use mbrl::train::{Extension, OpenedCheckpoint};
+
+use crate::common::{command_line, run_job, GlobalArgs};
+
+/// Train a model and write it to a checkpoint directory (config.json, weights, metrics.jsonl).
+#[derive(Args, Debug)]
+#[command(
+    args_conflicts_with_subcommands = true,
+    after_help = "\
+Examples:
+  mbrl collect --env pendulum --rollouts 200 --steps 30 --out datasets/pendulum-random.mcap
+  mbrl train pets --env pendulum --data datasets/pendulum-random.mcap --out models/pets-pendulum
+  mbrl train pets --data a.mcap --data b.mcap --preset medium --config pets.toml --out models/pets-big
+  mbrl train --resume models/pets-big
+  mbrl train --resume models/pets-big --steps 8000
+  mbrl collect --env ball --trajectories 108 --augment-rotations 19 --out datasets/ball-train.mcap
+  mbrl train ball-ekf --data datasets/ball-train.mcap --out models/ball-ekf --steps 2000
+  mbrl collect --env toy:inner --instances 1000 --steps 100 --out datasets/toy-inner.mcap
+  mbrl train context --data datasets/toy-inner.mcap --preset small --out models/context-toy-inner
+  mbrl train seads --env tileswap:cursor --preset small --out models/seads-tileswap-cursor
+  mbrl train seads --env lightsout:cursor --preset medium --no-novelty --out models/seads-lo-nonov
+  mbrl collect --env pendulum --rollouts 500 --steps 29 --out datasets/pendulum-dlgpd.mcap
+  mbrl train dlgpd --data datasets/pendulum-dlgpd.mcap --preset small --out models/dlgpd-small
+  mbrl collect --env pendulum --images --rollouts 500 --steps 29 --out datasets/pendulum-frames.mcap
+  mbrl train dlgpd --data datasets/pendulum-frames.mcap --preset medium --out models/dlgpd-medium
+  mbrl train dlgpd --help                # the flags one method takes
+
+A config file (TOML) sets any key of the method's config.json `config` table; unknown keys are errors.
+Flags given explicitly override the file. `--resume DIR` continues a stopped run from its last checkpoint
+with the config and data it was started with, and ends with the same bytes as an uninterrupted run.
+`--resume DIR --steps N` trains a pets or dlgpd run, finished or not, on to N steps in total; its weights
+end as those of a run started with N steps, when the old total was a multiple of the validation interval.
+`mbrl train METHOD … --out DIR --resume-if-stopped` resumes DIR's stopped run of the same command instead
+of refusing it, so a re-run script loses none of an interrupted run's training."
+)]
+pub struct TrainArgs {
+    #[command(subcommand)]
+    method: Option<MethodArgs>,
+    /// Continue the stopped run in this checkpoint directory; the method, config and data are the checkpoint's.
+    #[arg(long, value_name = "DIR")]
+    resume: Option<PathBuf>,
+    /// With --resume: train a pets or dlgpd run, finished or not, on to this many steps in total.
+    #[arg(long, requires = "resume")]
+    steps: Option<u64>,
+}
+
+#[derive(Subcommand, Debug)]
+enum MethodArgs {
+    /// Probabilistic ensemble of MLPs on (state, action) → state change (PETS, Chua et al. 2018), for any
+    /// env that `collect` rolls out; plan with it via `mbrl plan --model DIR`.
+    Pets(pets::PetsArgs),
+    /// Gray-box table-tennis ball EKF: learn the impact matrix, noise levels and initial values by
+    /// maximizing the filter's marginal likelihood (thesis 6.4.4, eq. 6.24).
+    BallEkf(ball::BallArgs),
+    /// Context-conditional GRU dynamics with a context encoder (Explore the Context, thesis ch. 4), trained
+    /// on instance-pair datasets (`collect --instances N`); calibrate with `mbrl calibrate`.
+    Context(context::ContextArgs),
+    /// TRADYN (thesis ch. 5): the context model on the unicycle's observation with the terrain under the robot
+    /// as input, read from the map at predicted positions; --no-terrain trains the ablation that predicts it.
+    Tradyn(context::TradynArgs),
+    /// SEADS (thesis ch. 7): skill policies (SAC) and a symbolic forward model learned without reward in an
+    /// embodied board game; needs no --data, it collects its own episodes.
+    Seads(seads::SeadsArgs),
+    /// DLGPD (thesis ch. 3): a VAE on pendulum frames (`collect --images`) with Gaussian-process latent
+    /// dynamics and reward; plan with `mbrl plan --model DIR --evidence E.mcap`.
+    Dlgpd(dlgpd::DlgpdArgs),
+}
+
+/// The presets of context, TRADYN, SEADS and DLGPD; what each sets is in the method's config.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ScalePreset {
+    /// Minutes on 2 cores: what `eval quick` and the tests train.
+    Small,
+    /// The largest scale the README's reproductions run on 2 cores.
+    Medium,
+    /// The paper's networks and training budgets (days on 2 cores for most methods).
+    Paper,
+}
+
+pub fn run(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
+    if let Some(dir) = &args.resume {
+        if args.steps == Some(0) {
+            bail!("--steps must be at least 1");
+        }
+        let extension = args.steps.map(|steps| Extension { steps, command_line: command_line() });
+        return resume(global, dir, extension.as_ref());
+    }
+    match args.method {
+        Some(MethodArgs::Pets(args)) => pets::run(global, args),
+        Some(MethodArgs::BallEkf(args)) => ball::run(global, args),
+        Some(MethodArgs::Context(args)) => context::run_context(global, args),
+        Some(MethodArgs::Tradyn(args)) => context::run_tradyn(global, args),
+        Some(MethodArgs::Seads(args)) => seads::run(global, args),
+        Some(MethodArgs::Dlgpd(args)) => dlgpd::run(global, args),
+        None => crate::exit_on_usage_error(<crate::Cli as clap::CommandFactory>::command().error(
+            clap::error::ErrorKind::MissingSubcommand,
+            "train needs a method (pets, ball-ekf, context, tradyn, seads, dlgpd) or --resume DIR",
+        )),
+    }
+}
+
+pub fn resume(global: &GlobalArgs, dir: &Path, extend_to: Option<&Extension>) -> anyhow::Result<()> {
+    let method = OpenedCheckpoint::open(dir)?.manifest.method;
+    // Training that depends on its total (context's p_ctx schedule, ball-ekf's and seads' budgets) cannot be
+    // lengthened without changing what was already trained.
+    if extend_to.is_some() && method != pets_model::METHOD && method != dlgpd_job::METHOD {
+        bail!(
+            "{}: --steps with --resume extends a run, which works for {} and {} runs; a {method} run's training \
+             depends on its total, so start a new run with the steps you want",
+            dir.display(),
+            pets_model::METHOD,
+            dlgpd_job::METHOD
+        );
+    }
+    match method.as_str() {
+        pets_model::METHOD => {
+            let report =
+                run_job(global, "train pets (resumed)", |monitor| pets_model::resume(dir, extend_to, monitor))?;
+            report::pets(&report, dir)
+        }
+        ball_job::METHOD => {
+            let report = run_job(global, "train ball-ekf (resumed)", |monitor| ball_job::resume(dir, monitor))?;
+            report::ball(&report, dir)
+        }
+        context_model::METHOD => {
+            let report = run_job(global, "train context (resumed)", |monitor| context_model::resume(dir, monitor))?;
+            report::context(&report, dir)
+        }
+        tradyn::METHOD => {
+            let report = run_job(global, "train tradyn (resumed)", |monitor| context_model::resume(dir, monitor))?;
+            report::context(&report, dir)
+        }
+        seads_model::METHOD => {
+            let report = run_job(global, "train seads (resumed)", |monitor| seads_model::resume(dir, monitor))?;
+            report::seads(&report, dir)
+        }
+        dlgpd_job::METHOD => {
+            let report =
+                run_job(global, "train dlgpd (resumed)", |monitor| dlgpd_job::resume(dir, extend_to, monitor))?;
+            report::dlgpd(&report, dir)
+        }
+        other => bail!(
+            "{}: '{other}' runs cannot be resumed; resumable methods: {}, {}, {}, {}, {}, {}",
+            dir.display(),
+            pets_model::METHOD,
+            ball_job::METHOD,
+            context_model::METHOD,
+            tradyn::METHOD,
+            seads_model::METHOD,
+            dlgpd_job::METHOD
+        ),
+    }
+}

@@ -1,0 +1,42 @@
+//! What `mbrl train dlgpd` may ask for: the preset, a TOML file over it, then each setting given.
+
+use std::path::PathBuf;
+
+use super::config::{DlgpdConfig, Preset};
+use crate::error::Result;
+use crate::train::config::apply_toml_file;
+use crate::train::run_dir::default_out;
+
+#[derive(Clone, Debug, Default)]
+pub struct DlgpdOptions {
+    pub preset: Option<Preset>,
+    pub config_file: Option<PathBuf>,
+    pub steps: Option<u64>,
+    pub batch_size: Option<usize>,
+    pub learning_rate: Option<f64>,
+}
+
+impl DlgpdOptions {
+    pub fn config(&self) -> Result<DlgpdConfig> {
+        let mut config = DlgpdConfig::preset(self.preset.unwrap_or(Preset::Small));
+        if let Some(path) = &self.config_file {
+            config = apply_toml_file(&config, path)?;
+        }
+        if let Some(n) = self.steps {
+            config.steps = n;
+        }
+        if let Some(n) = self.batch_size {
+            config.batch_size = n;
+        }
+        if let Some(lr) = self.learning_rate {
+            config.learning_rate = lr;
+        }
+        config.validate()?;
+        Ok(config)
+    }
+}
+
+/// The pendulum is DLGPD's only env, so one default directory serves.
+pub fn default_out_dir() -> PathBuf {
+    default_out("dlgpd-pendulum")
+}
