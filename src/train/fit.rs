@@ -96,15 +96,92 @@ struct Best {
     weights: Vec<StoredTensor>,
 }
 
-/// Runs `method` to `settings.total_steps` in `dir`, whose `config.json` (already written) is vouched for by
-/// `config_entry`. Every scalar goes to `monitor` (live view) and `metrics` (the run's file).
+/// A checkpoint as the loop hands it over: the model's weights to keep (the best-validation snapshot, or the
+/// live weights of a method that has not validated yet) and everything a resumed run needs.
+pub struct Snapshot<'a> {
+    pub method: &'a dyn TrainingMethod,
+    pub settings: &'a FitSettings,
+    pub step: u64,
+    pub complete: bool,
+    pub best_step: Option<u64>,
+    pub best_valid_loss: Option<f64>,
+    pub weights: &'a [StoredTensor],
+}
+
+/// Where the loop's checkpoints go: a run directory (`mbrl train`), or memory (`eval quick`, benchmarks and
+/// tests, which train, use the model and throw it away). One loop serves both.
+pub trait Checkpointer {
+    fn save(&mut self, snapshot: Snapshot) -> Result<()>;
+    /// Whether a saved checkpoint outlives the process, so a failed run can say what is left to resume.
+    fn persists(&self) -> bool;
+}
+
+/// Checkpoints into a run directory whose `config.json` (already written) is vouched for by `config_entry`;
+/// the manifest records how far `metrics` had been written, so `--resume` cuts the log back to it.
+pub struct DirCheckpointer<'a> {
+    pub dir: &'a CheckpointDir,
+    pub config_entry: &'a FileEntry,
+    pub metrics: &'a JsonlMonitor,
+}
+
+impl Checkpointer for DirCheckpointer<'_> {
+    fn save(&mut self, snapshot: Snapshot) -> Result<()> {
+        let dir = self.dir;
+        let mut files = BTreeMap::new();
+        files.insert(CONFIG_FILE.to_string(), self.config_entry.clone());
+        files.insert(MODEL_FILE.to_string(), dir.write_file(MODEL_FILE, &to_bytes(snapshot.weights)?)?);
+        files.insert(STATE_FILE.to_string(), dir.write_file(STATE_FILE, &to_bytes(&snapshot.method.state())?)?);
+        for (name, bytes) in snapshot.method.artifacts()? {
+            let entry = dir.write_file(&name, &bytes)?;
+            files.insert(name, entry);
+        }
+        let metrics_bytes = self.metrics.flush_position().map_err(|e| Error::io(&dir.file("metrics.jsonl"), e))?;
+        dir.commit(&Manifest {
+            format_version: CHECKPOINT_FORMAT,
+            method: snapshot.settings.method.clone(),
+            env: snapshot.settings.env.clone(),
+            step: snapshot.step,
+            total_steps: snapshot.settings.total_steps,
+            complete: snapshot.complete,
+            best_step: snapshot.best_step,
+            best_valid_loss: snapshot.best_valid_loss,
+            metrics_bytes,
+            files,
+        })
+    }
+
+    fn persists(&self) -> bool {
+        true
+    }
+}
+
+/// Keeps the last checkpoint's weights and step in memory.
+#[derive(Default)]
+pub struct MemoryCheckpointer {
+    pub step: u64,
+    pub complete: bool,
+    pub weights: Vec<StoredTensor>,
+}
+
+impl Checkpointer for MemoryCheckpointer {
+    fn save(&mut self, snapshot: Snapshot) -> Result<()> {
+        (self.step, self.complete) = (snapshot.step, snapshot.complete);
+        self.weights = snapshot.weights.to_vec();
+        Ok(())
+    }
+
+    fn persists(&self) -> bool {
+        false
+    }
+}
+
+/// Runs `method` to `settings.total_steps`, checkpointing through `checkpoints`; a resumed run picks up at
+/// `resume`. Every scalar goes to `monitor`.
 pub fn fit(
     method: &mut dyn TrainingMethod,
     settings: &FitSettings,
-    dir: &CheckpointDir,
-    config_entry: &FileEntry,
+    checkpoints: &mut dyn Checkpointer,
     resume: Option<ResumePoint>,
-    metrics: &JsonlMonitor,
     monitor: &dyn Monitor,
 ) -> Result<FitOutcome> {
     if settings.total_steps == 0 {
@@ -124,7 +201,7 @@ pub fn fit(
         }
         let loss = method.step(step)?;
         if !loss.is_finite() {
-            return Err(diverged(settings, step, "training", loss, last_checkpoint));
+            return Err(diverged(settings, step, "training", loss, last_checkpoint, checkpoints.persists()));
         }
         last_loss = Some(loss);
         monitor.scalar("train/loss", step, loss);
@@ -139,7 +216,7 @@ pub fn fit(
         if step % every(settings.validate_every) == 0 || last {
             if let Some(valid) = method.validate()? {
                 if !valid.is_finite() {
-                    return Err(diverged(settings, step, "validation", valid, last_checkpoint));
+                    return Err(diverged(settings, step, "validation", valid, last_checkpoint, checkpoints.persists()));
                 }
                 monitor.scalar("valid/loss", step, valid);
                 for (name, value) in method.validation_scalars()? {
@@ -157,7 +234,23 @@ pub fn fit(
             None => monitor.progress("train", step, settings.total_steps),
         }
         if step % every(settings.checkpoint_every) == 0 || last {
-            save(method, settings, dir, config_entry, &best, step, last, metrics)?;
+            // A method that has not validated yet (or never does) keeps its live weights.
+            let live;
+            let weights = if best.step.is_some() {
+                &best.weights
+            } else {
+                live = method.weights();
+                &live
+            };
+            checkpoints.save(Snapshot {
+                method: &*method,
+                settings,
+                step,
+                complete: last,
+                best_step: best.step,
+                best_valid_loss: best.loss,
+                weights,
+            })?;
             last_checkpoint = step;
         }
         if last {
@@ -168,52 +261,15 @@ pub fn fit(
     Ok(FitOutcome { steps: steps_done, best_step: best.step, best_valid_loss: best.loss, last_train_loss: last_loss })
 }
 
-fn diverged(settings: &FitSettings, step: u64, what: &str, value: f64, checkpoint: u64) -> Error {
-    let saved = if checkpoint > 0 {
-        format!("the checkpoint of step {checkpoint} is intact and can be resumed")
-    } else {
-        "no checkpoint was written".to_string()
+fn diverged(settings: &FitSettings, step: u64, what: &str, value: f64, checkpoint: u64, persists: bool) -> Error {
+    let saved = match (checkpoint, persists) {
+        (0, _) | (_, false) => "no checkpoint was written".to_string(),
+        _ => format!("the checkpoint of step {checkpoint} is intact and can be resumed"),
     };
     Error::Diverged(format!(
         "{} diverged: {what} loss {value} at step {step}; {saved}. Lower the learning rate or check the data for outliers",
         settings.method
     ))
-}
-
-#[allow(clippy::too_many_arguments)] // the checkpoint's parts, each owned by a different piece of the loop
-fn save(
-    method: &dyn TrainingMethod,
-    settings: &FitSettings,
-    dir: &CheckpointDir,
-    config_entry: &FileEntry,
-    best: &Best,
-    step: u64,
-    complete: bool,
-    metrics: &JsonlMonitor,
-) -> Result<()> {
-    let mut files = BTreeMap::new();
-    files.insert(CONFIG_FILE.to_string(), config_entry.clone());
-    // A method that has not validated yet (or never does) saves its live weights.
-    let weights = if best.step.is_some() { to_bytes(&best.weights)? } else { to_bytes(&method.weights())? };
-    files.insert(MODEL_FILE.to_string(), dir.write_file(MODEL_FILE, &weights)?);
-    files.insert(STATE_FILE.to_string(), dir.write_file(STATE_FILE, &to_bytes(&method.state())?)?);
-    for (name, bytes) in method.artifacts()? {
-        let entry = dir.write_file(&name, &bytes)?;
-        files.insert(name, entry);
-    }
-    let metrics_bytes = metrics.flush_position().map_err(|e| Error::io(&dir.file("metrics.jsonl"), e))?;
-    dir.commit(&Manifest {
-        format_version: CHECKPOINT_FORMAT,
-        method: settings.method.clone(),
-        env: settings.env.clone(),
-        step,
-        total_steps: settings.total_steps,
-        complete,
-        best_step: best.step,
-        best_valid_loss: best.loss,
-        metrics_bytes,
-        files,
-    })
 }
 
 #[cfg(test)]
@@ -279,7 +335,8 @@ mod tests {
         let ckpt = CheckpointDir::start(dir)?;
         let entry = ckpt.write_file(CONFIG_FILE, b"{}")?;
         let metrics = JsonlMonitor::create(&dir.join("metrics.jsonl")).unwrap();
-        fit(counter, &settings, &ckpt, &entry, None, &metrics, monitor)
+        let mut checkpoints = DirCheckpointer { dir: &ckpt, config_entry: &entry, metrics: &metrics };
+        fit(counter, &settings, &mut checkpoints, None, monitor)
     }
 
     fn run(nan_at: u64, dir: &std::path::Path) -> Result<FitOutcome> {

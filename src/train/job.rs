@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use super::checkpoint::{CheckpointDir, FileEntry};
-use super::fit::{fit, FitOutcome, FitSettings, TrainingMethod, CONFIG_FILE, STATE_FILE};
+use super::fit::{fit, DirCheckpointer, FitOutcome, FitSettings, TrainingMethod, CONFIG_FILE, STATE_FILE};
 use super::OpenedCheckpoint;
 use crate::error::{Error, Result};
 use crate::run::dir::{Provenance, METRICS_FILE};
@@ -138,7 +138,8 @@ pub fn run_training(
             .map_err(|e| Error::io(&metrics_path, e))?;
         monitor.message(&format!("resuming at step {} of {}", point.step, settings.total_steps));
         let tee = Tee { first: monitor, second: &metrics };
-        let outcome = fit(method, settings, &opened.dir, &entry, Some(point), &metrics, &tee)?;
+        let mut checkpoints = DirCheckpointer { dir: &opened.dir, config_entry: &entry, metrics: &metrics };
+        let outcome = fit(method, settings, &mut checkpoints, Some(point), &tee)?;
         metrics.emit(&Event::Finished { ok: true });
         return Ok(outcome);
     }
@@ -150,7 +151,8 @@ pub fn run_training(
         metrics.emit(event);
     }
     let tee = Tee { first: monitor, second: &metrics };
-    let outcome = fit(method, settings, &ckpt, &entry, None, &metrics, &tee)?;
+    let mut checkpoints = DirCheckpointer { dir: &ckpt, config_entry: &entry, metrics: &metrics };
+    let outcome = fit(method, settings, &mut checkpoints, None, &tee)?;
     metrics.emit(&Event::Finished { ok: true });
     Ok(outcome)
 }

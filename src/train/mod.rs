@@ -13,7 +13,10 @@ pub mod tensors;
 
 pub use checkpoint::{CheckpointDir, Manifest};
 pub use data_file::{loss_history, DataFile};
-pub use fit::{fit, Budget, FitOutcome, FitSettings, ResumePoint, TrainingMethod, CONFIG_FILE, MODEL_FILE, STATE_FILE};
+pub use fit::{
+    fit, Budget, Checkpointer, DirCheckpointer, FitOutcome, FitSettings, MemoryCheckpointer, ResumePoint, Snapshot,
+    TrainingMethod, CONFIG_FILE, MODEL_FILE, STATE_FILE,
+};
 pub use job::{
     continuation, loss_panel, run_training, training_view, validation_panel, Continuation, Extension, Start,
 };

@@ -1,5 +1,7 @@
 //! Fitting Ψ by maximizing log p(m_3:N | m_1, m_2) over chunks (eq. 6.24) with Adam.
 
+use std::sync::Mutex;
+
 use serde::{Deserialize, Serialize};
 
 use super::spin_net::SpinNetWeights;
@@ -8,8 +10,8 @@ use crate::data::ball_io::Recording;
 use crate::error::{Error, Result};
 use crate::models::ball::BallModelParams;
 use crate::nn::AdamConfig;
-use crate::run::Monitor;
-use crate::train::TrainingMethod;
+use crate::run::{Event, Monitor};
+use crate::train::{fit, FitSettings, MemoryCheckpointer};
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -84,27 +86,52 @@ pub struct TrainOutcome {
     pub chunks: usize,
 }
 
-/// Trains in memory (no checkpoint directory): for `eval quick` and tests. `mbrl train` runs the same trainer
-/// through the shared loop with checkpoints and `--resume` ([`super::job`]).
+/// Passes everything on and keeps the training loss of every step.
+struct LossLog<'a> {
+    inner: &'a dyn Monitor,
+    losses: Mutex<Vec<f64>>,
+}
+
+impl Monitor for LossLog<'_> {
+    fn emit(&self, event: &Event) {
+        self.inner.emit(event);
+    }
+
+    fn scalar(&self, name: &str, step: u64, value: f64) {
+        if name == "train/loss" {
+            self.losses.lock().unwrap_or_else(|e| e.into_inner()).push(value);
+        }
+        self.inner.scalar(name, step, value);
+    }
+
+    fn progress(&self, phase: &str, done: u64, total: u64) {
+        self.inner.progress(phase, done, total);
+    }
+
+    fn message(&self, text: &str) {
+        self.inner.message(text);
+    }
+
+    fn is_cancelled(&self) -> bool {
+        self.inner.is_cancelled()
+    }
+}
+
+/// Trains in memory (checkpoints kept in memory, none written): for `eval quick` and tests. `mbrl train` runs
+/// the same trainer through the same loop with a checkpoint directory and `--resume` ([`super::job`]).
 pub fn train(recordings: &[Recording], settings: &TrainSettings, monitor: &dyn Monitor) -> Result<TrainOutcome> {
     let mut trainer = BallEkfTrainer::new(recordings, settings)?;
-    let mut losses = Vec::with_capacity(settings.steps as usize);
-    for step in 1..=settings.steps {
-        if monitor.is_cancelled() {
-            return Err(Error::Cancelled);
-        }
-        let value = trainer.step(step)?;
-        if !value.is_finite() {
-            return Err(Error::Diverged(format!(
-                "ball EKF training diverged: loss {value} at step {step}; the filter's covariances broke down. \
-                 Lower the learning rate or check the recordings for outliers"
-            )));
-        }
-        losses.push(value);
-        monitor.scalar("train/loss", step, value);
-        monitor.progress("train", step, settings.steps);
-    }
+    let fit_settings = FitSettings {
+        method: super::job::METHOD.into(),
+        env: None,
+        total_steps: settings.steps,
+        validate_every: settings.steps,
+        checkpoint_every: settings.steps,
+    };
+    let log = LossLog { inner: monitor, losses: Mutex::new(Vec::with_capacity(settings.steps as usize)) };
+    fit(&mut trainer, &fit_settings, &mut MemoryCheckpointer::default(), None, &log)?;
     let (params, spin_net) = trainer.current();
     params.validate().map_err(|e| Error::Diverged(format!("ball EKF training ended with unusable parameters: {e}")))?;
+    let losses = log.losses.into_inner().unwrap_or_else(|e| e.into_inner());
     Ok(TrainOutcome { params, spin_net, losses, chunks: trainer.chunk_count() })
 }
