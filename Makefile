@@ -21,15 +21,10 @@ $(MBRL): build
 # rebuild of mbrl does not re-collect them). Each seeded dataset has its seed in its path; `collect` writes
 # through a temporary file, so a file that exists is whole.
 
-# `$(call train_or_resume,DIR,TRAIN FLAGS,RESUME FLAGS)`: a new run in DIR, or, where an interrupted make left a
-# stopped run there, that run resumed (a fresh `train` refuses to replace it), so re-running a long target
-# loses none of its training.
-train_or_resume = if cat $(1)/checkpoint.json $(1)/.mbrl-next/checkpoint.json 2>/dev/null | grep -q '"complete": false'; then \
-		echo "resuming the stopped run in $(1)"; \
-		$(MBRL) train --resume $(1) $(3) --no-tui -q; \
-	else \
-		$(MBRL) train $(2) --no-tui -q --out $(1); \
-	fi
+# `$(call train_or_resume,DIR,METHOD AND FLAGS)`: a new run in DIR, or the stopped run an interrupted make left
+# there resumed (`--resume-if-stopped` refuses one started with other flags), so re-running a long target loses
+# none of its training.
+train_or_resume = $(MBRL) train $(2) --no-tui -q --out $(1) --resume-if-stopped
 
 # The README's main job: a small reproduction of every implemented method (reports/quick/).
 repro-quick: build
@@ -56,7 +51,7 @@ datasets/pets/random-%.mcap: | $(MBRL)
 	$(MBRL) collect --env pendulum --rollouts 200 --steps 30 --seed $* --no-tui -q --out $@
 repro-pets: build $(PETS_SEEDS:%=datasets/pets/random-%.mcap)
 	for s in $(PETS_SEEDS); do \
-		$(MBRL) train --method pets --env pendulum --data datasets/pets/random-$$s.mcap --seed $$s --no-tui -q --out models/pets/seed-$$s || exit 1; \
+		$(MBRL) train pets --env pendulum --data datasets/pets/random-$$s.mcap --seed $$s --no-tui -q --out models/pets/seed-$$s || exit 1; \
 		$(MBRL) eval pendulum-swingup --model models/pets/seed-$$s --episodes 1 --seed $$s --no-tui -q --out reports/pets/seed-$$s || exit 1; \
 		$(MBRL) eval pendulum-swingup --model true --episodes 1 --seed $$s --no-tui -q --out reports/pets/truth-$$s || exit 1; \
 	done
@@ -73,7 +68,7 @@ repro-pets-loop: build
 	$(MBRL) collect --env pendulum --rollouts 10 --steps 30 --seed $(SEED) --no-tui -q --out datasets/pets-loop/iter-0.mcap
 	for i in $$(seq 1 $(LOOP_ITERATIONS)); do \
 		data=$$(ls datasets/pets-loop/iter-*.mcap | sed 's/^/--data /' | tr '\n' ' '); \
-		$(MBRL) train --method pets --env pendulum $$data --steps 1000 --seed $(SEED) --no-tui -q --out models/pets-loop || exit 1; \
+		$(MBRL) train pets --env pendulum $$data --steps 1000 --seed $(SEED) --no-tui -q --out models/pets-loop || exit 1; \
 		$(MBRL) plan --env pendulum --model models/pets-loop --steps 150 --seed $$i --no-tui --out datasets/pets-loop/iter-$$i.mcap || exit 1; \
 	done
 
@@ -98,16 +93,16 @@ $(CONTEXT_DATA)/mountaincar-10k.mcap: | $(MBRL)
 repro-context: build $(CONTEXT_DATA)/toy-inner.mcap $(CONTEXT_DATA)/toy-outer.mcap \
 		$(CONTEXT_DATA)/pendulum-quadrant.mcap $(CONTEXT_DATA)/mountaincar.mcap
 	for sq in inner outer; do \
-		$(MBRL) train --method context --data $(CONTEXT_DATA)/toy-$$sq.mcap --preset $(CONTEXT_PRESET) --seed $(SEED) --no-tui -q --out models/context/toy-$$sq || exit 1; \
+		$(MBRL) train context --data $(CONTEXT_DATA)/toy-$$sq.mcap --preset $(CONTEXT_PRESET) --seed $(SEED) --no-tui -q --out models/context/toy-$$sq || exit 1; \
 		for n in 1 2 3; do \
 			$(MBRL) eval context --model models/context/toy-$$sq --env toy:$$sq --transitions $$n --contexts $(CONTEXT_CONTEXTS) \
 				$(CONTEXT_CEM) --seed $(SEED) --no-tui -q --out reports/context/toy-$$sq-n$$n || exit 1; \
 		done; \
 	done
-	$(call train_or_resume,models/context/pendulum-quadrant,--method context --data $(CONTEXT_DATA)/pendulum-quadrant.mcap --preset $(CONTEXT_PRESET) --seed $(SEED))
+	$(call train_or_resume,models/context/pendulum-quadrant,context --data $(CONTEXT_DATA)/pendulum-quadrant.mcap --preset $(CONTEXT_PRESET) --seed $(SEED))
 	$(MBRL) eval context --model models/context/pendulum-quadrant --env pendulum:quadrant --transitions 30 --horizon 20 \
 		--contexts $(CONTEXT_CONTEXTS) $(CONTEXT_CEM) $(CONTEXT_SWINGUP) --seed $(SEED) --no-tui -q --out reports/context/pendulum-quadrant
-	$(call train_or_resume,models/context/mountaincar,--method context --data $(CONTEXT_DATA)/mountaincar.mcap --preset $(CONTEXT_PRESET) --seed $(SEED))
+	$(call train_or_resume,models/context/mountaincar,context --data $(CONTEXT_DATA)/mountaincar.mcap --preset $(CONTEXT_PRESET) --seed $(SEED))
 	$(MBRL) eval context --model models/context/mountaincar --env mountaincar --transitions 50 --horizon 30 \
 		--contexts $(CONTEXT_CONTEXTS) $(CONTEXT_CEM) --seed $(SEED) --no-tui -q --out reports/context/mountaincar
 
@@ -116,7 +111,7 @@ repro-context: build $(CONTEXT_DATA)/toy-inner.mcap $(CONTEXT_DATA)/toy-outer.mc
 # transitions with EIG CEM 300 × 30 elites × 4 iterations and 10 β samples on one thread (≈ 25 min; the
 # figures in the README are this run's, seed 0).
 repro-context-mountaincar: build $(CONTEXT_DATA)/mountaincar-10k.mcap
-	$(call train_or_resume,models/context/mountaincar-small,--method context --data $(CONTEXT_DATA)/mountaincar-10k.mcap --preset small --steps 30000 --seed $(SEED))
+	$(call train_or_resume,models/context/mountaincar-small,context --data $(CONTEXT_DATA)/mountaincar-10k.mcap --preset small --steps 30000 --seed $(SEED))
 	$(MBRL) eval context --model models/context/mountaincar-small --env mountaincar --transitions 50 --horizon 30 --contexts 50 \
 		--candidates 300 --elites 30 --iters 4 --beta-samples 10 --threads 1 --seed $(SEED) --no-tui -q --out reports/context/mountaincar-small
 
@@ -137,9 +132,9 @@ $(TRADYN_DATA)/train.mcap: $(TRADYN_DATA)/maps/terrain.json | $(MBRL)
 		--seed $(SEED) --no-tui -q --out $@
 # The two trainings run side by side; a bare `wait` would return 0 when one of them failed.
 repro-tradyn: build $(TRADYN_DATA)/train.mcap
-	$(MBRL) train --method tradyn --data $(TRADYN_DATA)/train.mcap --preset small --steps $(TRADYN_STEPS) \
+	$(MBRL) train tradyn --data $(TRADYN_DATA)/train.mcap --preset small --steps $(TRADYN_STEPS) \
 		--seed $(SEED) --no-tui -q --out models/tradyn/terrain & terrain=$$!; \
-	$(MBRL) train --method tradyn --no-terrain --data $(TRADYN_DATA)/train.mcap --preset small --steps $(TRADYN_STEPS) \
+	$(MBRL) train tradyn --no-terrain --data $(TRADYN_DATA)/train.mcap --preset small --steps $(TRADYN_STEPS) \
 		--seed $(SEED) --no-tui -q --out models/tradyn/no-terrain & no_terrain=$$!; \
 	status=0; wait $$terrain || status=1; wait $$no_terrain || status=1; exit $$status
 	$(MBRL) eval tradyn --model-terrain models/tradyn/terrain --model-no-terrain models/tradyn/no-terrain \
@@ -150,7 +145,7 @@ repro-tradyn: build $(TRADYN_DATA)/train.mcap
 SEADS_PRESET ?= paper
 repro-seads: build
 	for game in lightsout tileswap; do \
-		$(MBRL) train --method seads --env $$game:cursor --preset $(SEADS_PRESET) --seed $(SEED) --no-tui -q \
+		$(MBRL) train seads --env $$game:cursor --preset $(SEADS_PRESET) --seed $(SEED) --no-tui -q \
 			--out models/seads-$$game-cursor || exit 1; \
 		$(MBRL) eval seads --model models/seads-$$game-cursor --boards 20 --seed $(SEED) --no-tui -q \
 			--out reports/seads-$$game-cursor || exit 1; \
@@ -172,9 +167,8 @@ DLGPD_DATA = datasets/dlgpd/seed-$(SEED)
 $(DLGPD_DATA)/pendulum-frames.mcap: | $(MBRL)
 	$(MBRL) collect --env pendulum --images --rollouts 500 --steps 29 --seed $(SEED) --no-tui -q --out $@
 repro-dlgpd: build $(DLGPD_DATA)/pendulum-frames.mcap
-	$(call train_or_resume,models/dlgpd-$(DLGPD_PRESET),--method dlgpd --data $(DLGPD_DATA)/pendulum-frames.mcap \
-		--preset $(DLGPD_PRESET) $(if $(DLGPD_STEPS),--steps $(DLGPD_STEPS)) --threads $(DLGPD_THREADS) --seed $(SEED),\
-		--threads $(DLGPD_THREADS))
+	$(call train_or_resume,models/dlgpd-$(DLGPD_PRESET),dlgpd --data $(DLGPD_DATA)/pendulum-frames.mcap \
+		--preset $(DLGPD_PRESET) $(if $(DLGPD_STEPS),--steps $(DLGPD_STEPS)) --threads $(DLGPD_THREADS) --seed $(SEED))
 	$(MBRL) eval dlgpd --model models/dlgpd-$(DLGPD_PRESET) $(DLGPD_EVAL) --threads $(DLGPD_THREADS) --seed $(SEED) \
 		--no-tui -q --out reports/dlgpd
 
@@ -197,10 +191,10 @@ $(BALL_DATA)/train.mcap: | $(MBRL)
 $(BALL_DATA)/train-noaug.mcap: | $(MBRL)
 	$(MBRL) collect --env ball --trajectories 108 --seed $(SEED) --no-tui --out $@
 repro-ball: build $(BALL_DATA)/train.mcap $(BALL_DATA)/train-noaug.mcap
-	$(MBRL) train --method ball-ekf --data $(BALL_DATA)/train.mcap --steps 2000 --seed $(SEED) --no-tui --out models/ball-ekf
-	$(MBRL) train --method ball-ekf --data $(BALL_DATA)/train.mcap --steps 2000 --launcher-prior --seed $(SEED) --no-tui \
+	$(MBRL) train ball-ekf --data $(BALL_DATA)/train.mcap --steps 2000 --seed $(SEED) --no-tui --out models/ball-ekf
+	$(MBRL) train ball-ekf --data $(BALL_DATA)/train.mcap --steps 2000 --launcher-prior --seed $(SEED) --no-tui \
 		--out models/ball-ekf-launch
-	$(MBRL) train --method ball-ekf --data $(BALL_DATA)/train-noaug.mcap --steps 2000 --seed $(SEED) --no-tui \
+	$(MBRL) train ball-ekf --data $(BALL_DATA)/train-noaug.mcap --steps 2000 --seed $(SEED) --no-tui \
 		--out models/ball-ekf-noaug
 	$(MBRL) eval ball --model models/ball-ekf-launch --model models/ball-ekf --model models/ball-ekf-noaug --model thesis \
 		--seed $(SEED) --no-tui --out reports/ball

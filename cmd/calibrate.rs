@@ -45,7 +45,7 @@ MountainCar N = 50, H_max = 30. The command prints the entropy of q(β | transit
 A TRADYN model calibrates with random colored actions (as its data were collected), 10 transitions by
 default, on the --map the robot drives on; the instance is the robot (mass, throttle and steering gains).")]
 pub struct CalibrateArgs {
-    /// A context-model checkpoint (`mbrl train --method context`, or `--method tradyn` for the unicycle).
+    /// A context-model checkpoint (`mbrl train context`, or `mbrl train tradyn` for the unicycle).
     #[arg(long)]
     model: PathBuf,
     /// Environment the model was trained on, e.g. toy:inner, pendulum:quadrant, mountaincar, unicycle.
@@ -182,7 +182,7 @@ fn load_model(dir: &std::path::Path, env: &EnvName, accept: Accept) -> anyhow::R
     let unicycle = matches!(env, EnvName::Unicycle(_));
     if unicycle && method != tradyn::METHOD {
         bail!(
-            "{}: is a '{method}' checkpoint; the unicycle calibrates a TRADYN model (`mbrl train --method tradyn`)",
+            "{}: is a '{method}' checkpoint; the unicycle calibrates a TRADYN model (`mbrl train tradyn`)",
             dir.display()
         );
     }

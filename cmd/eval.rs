@@ -130,7 +130,7 @@ struct EmbodiedArgs {
 
 #[derive(Args, Debug)]
 struct SeadsArgs {
-    /// A SEADS checkpoint directory (`mbrl train --method seads`); repeat it to compare runs (seeds of the full
+    /// A SEADS checkpoint directory (`mbrl train seads`); repeat it to compare runs (seeds of the full
     /// method and of ablations: one-sided Mann-Whitney U tests of each ablation against `full`).
     #[arg(long, required = true)]
     model: Vec<PathBuf>,
@@ -336,7 +336,7 @@ pub fn run(global: &GlobalArgs, args: EvalArgs) -> anyhow::Result<()> {
 
 #[derive(Args, Debug)]
 struct TradynArgs {
-    /// The TRADYN model with terrain lookup (`mbrl train --method tradyn`): the +T variants.
+    /// The TRADYN model with terrain lookup (`mbrl train tradyn`): the +T variants.
     #[arg(long)]
     model_terrain: PathBuf,
     /// The ablation trained with `--no-terrain`: the −T variants.
@@ -453,7 +453,7 @@ fn eval_tradyn(global: &GlobalArgs, provenance: &Provenance, a: TradynArgs) -> a
 
 #[derive(Args, Debug)]
 struct ContextArgs {
-    /// A context-model checkpoint (`mbrl train --method context`).
+    /// A context-model checkpoint (`mbrl train context`).
     #[arg(long)]
     model: PathBuf,
     /// The env the model was trained on.
@@ -676,7 +676,7 @@ fn eval_seads(global: &GlobalArgs, provenance: &Provenance, a: SeadsArgs) -> any
 
 #[derive(Args, Debug)]
 struct DlgpdArgs {
-    /// A DLGPD checkpoint (`mbrl train --method dlgpd`).
+    /// A DLGPD checkpoint (`mbrl train dlgpd`).
     #[arg(long)]
     model: PathBuf,
     /// Settings to swing up (repeatable; default: the thesis' pendulum, pendulum:inverted, pendulum:light,

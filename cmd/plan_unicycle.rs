@@ -61,7 +61,7 @@ fn load_dynamics(
     let method = OpenedCheckpoint::open(dir)?.manifest.method;
     if method != tradyn::METHOD {
         bail!(
-            "{}: is a '{method}' checkpoint; unicycle navigation plans with a TRADYN model (`mbrl train --method tradyn`) or --model true",
+            "{}: is a '{method}' checkpoint; unicycle navigation plans with a TRADYN model (`mbrl train tradyn`) or --model true",
             dir.display()
         );
     }

@@ -243,7 +243,7 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcomm
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from help" -f -a "seads" -d 'SEADS (thesis ch. 7): skill policies (SAC) and a symbolic forward model learned without reward in an embodied board game; needs no --data, it collects its own episodes'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from help" -f -a "dlgpd" -d 'DLGPD (thesis ch. 3): a VAE on pendulum frames (`collect --images`) with Gaussian-process latent dynamics and reward; plan with `mbrl plan --model DIR --evidence E.mcap`'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l model -d 'A context-model checkpoint (`mbrl train --method context`, or `--method tradyn` for the unicycle)' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l model -d 'A context-model checkpoint (`mbrl train context`, or `mbrl train tradyn` for the unicycle)' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l env -d 'Environment the model was trained on, e.g. toy:inner, pendulum:quadrant, mountaincar, unicycle' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l map -d 'For --env unicycle: the terrain map (PNG) the robot calibrates on' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l instance-seed -d 'Which instance (hidden parameters) to calibrate in' -r
@@ -393,7 +393,7 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -s V -l version -d 'Print version'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l model -d 'A context-model checkpoint (`mbrl train --method context`)' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l model -d 'A context-model checkpoint (`mbrl train context`)' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l env -d 'The env the model was trained on' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l contexts -d 'Unseen contexts (instances) to calibrate in (thesis: 50)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l validation-rollouts -d 'Random validation rollouts per context (thesis: 20)' -r
@@ -420,7 +420,7 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -s V -l version -d 'Print version'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -l model-terrain -d 'The TRADYN model with terrain lookup (`mbrl train --method tradyn`): the +T variants' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -l model-terrain -d 'The TRADYN model with terrain lookup (`mbrl train tradyn`): the +T variants' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -l model-no-terrain -d 'The ablation trained with `--no-terrain`: the −T variants' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -l maps -d 'The map set (`mbrl collect --env terrain`); tasks are drawn on its test maps' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -l tasks -d 'Navigation tasks (thesis: 150 per model seed)' -r
@@ -441,7 +441,7 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -s V -l version -d 'Print version'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l model -d 'A SEADS checkpoint directory (`mbrl train --method seads`); repeat it to compare runs (seeds of the full method and of ablations: one-sided Mann-Whitney U tests of each ablation against `full`)' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l model -d 'A SEADS checkpoint directory (`mbrl train seads`); repeat it to compare runs (seeds of the full method and of ablations: one-sided Mann-Whitney U tests of each ablation against `full`)' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l max-depth -d 'Boards of depth 1..=max-depth are solved' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l boards -d 'Boards per depth (thesis: 20)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l coverage-boards -d 'Boards every skill is executed from for the coverage table' -r
@@ -459,7 +459,7 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -s V -l version -d 'Print version'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l model -d 'A DLGPD checkpoint (`mbrl train --method dlgpd`)' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l model -d 'A DLGPD checkpoint (`mbrl train dlgpd`)' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l env -d 'Settings to swing up (repeatable; default: the thesis\' pendulum, pendulum:inverted, pendulum:light, pendulum:heavy)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l evidence-rollouts -d 'Evidence sizes in rollouts of 30 frames (thesis: 10, 20, 30, 50, 70, 100, 200)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l runs -d 'Runs per point, each with its own evidence pool and start state (thesis: 27)' -r

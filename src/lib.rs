@@ -21,5 +21,11 @@ pub use error::{Error, Result};
 #[cfg(test)]
 mod layering;
 
+// The unit tests train and plan in-process: they run on the allocator the binary ships with (see util::alloc),
+// so their memory behaviour is the binary's. Programs linking the library still choose their own.
+#[cfg(test)]
+#[global_allocator]
+static TEST_ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 /// The version written into datasets and run directories.
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");

@@ -12,5 +12,5 @@ pub mod quick;
 pub mod seads;
 pub mod stats;
 pub mod swingup;
-pub mod training;
 pub mod tradyn;
+pub mod training;

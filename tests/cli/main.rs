@@ -22,4 +22,5 @@ mod pets;
 mod seads;
 mod surface;
 mod tradyn;
+mod train_methods;
 mod unicycle;

@@ -269,7 +269,7 @@ fn wrong_inputs_are_one_line_errors() {
             "--strategy",
             "random",
         ],
-        "--method tradyn",
+        "mbrl train tradyn",
     );
     fails_with(
         d,
@@ -277,6 +277,6 @@ fn wrong_inputs_are_one_line_errors() {
         "unicycle",
     );
     fails_with(d, &["train", "--method", "tradyn", "--data", "toy.mcap", "--steps", "5"], "unicycle");
-    fails_with(d, &["train", "--method", "context", "--data", "uni.mcap", "--steps", "5"], "--method tradyn");
+    fails_with(d, &["train", "--method", "context", "--data", "uni.mcap", "--steps", "5"], "mbrl train tradyn");
     assert!(!d.join("datasets/plan-unicycle.mcap").exists(), "no output from a failed run");
 }

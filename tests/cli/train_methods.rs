@@ -1,11 +1,9 @@
 //! `mbrl train <method>`: each method's own flags, the `--method` spelling scripts use, and
 //! `--resume-if-stopped` on a directory that holds nothing, a finished run or a stopped one.
 
-mod common;
-
 use std::path::Path;
 
-use common::*;
+use crate::common::*;
 use mbrl::models::pets;
 use mbrl::models::pets::options::PetsOptions;
 use mbrl::run::dir::Provenance;

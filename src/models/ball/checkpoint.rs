@@ -35,7 +35,7 @@ impl LoadedBallModel {
     }
 }
 
-/// Parses `--model`: a built-in name or a directory written by `mbrl train --method ball-ekf`.
+/// Parses `--model`: a built-in name or a directory written by `mbrl train ball-ekf`.
 /// How reports name a model given as `spec`: the built-in `thesis` parameters (Table C.1) are the very
 /// constants the simulator generates its shots with, so on simulated shots that model is an oracle, not a
 /// competitor, and is named so.
@@ -67,7 +67,7 @@ pub fn load_ball_model(spec: &str) -> Result<LoadedBallModel> {
 
 const MAX_JSON_BYTES: u64 = 16 << 20;
 
-/// A directory written by `mbrl train --method ball-ekf`: every file checked against the manifest.
+/// A directory written by `mbrl train ball-ekf`: every file checked against the manifest.
 fn load_checkpoint(dir: &Path) -> Result<(BallModelParams, Option<SpinNetWeights>)> {
     let opened = OpenedCheckpoint::open(dir)?;
     opened.expect_finished(METHOD)?;

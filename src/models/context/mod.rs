@@ -388,7 +388,7 @@ pub fn load_method_accepting(dir: &Path, env: &EnvName, method: &str, accept: Ac
         return Err(Error::bad_file(
             dir,
             format!(
-                "is a '{}' checkpoint; this needs a {method} model (`mbrl train --method {method}`)",
+                "is a '{}' checkpoint; this needs a {method} model (`mbrl train {method}`)",
                 opened.manifest.method
             ),
         ));

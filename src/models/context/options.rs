@@ -66,7 +66,7 @@ impl ContextOptions {
         if matches!(env, EnvName::Unicycle(_)) {
             return Err(Error::bad_file(
                 data,
-                "unicycle data trains TRADYN, which reads the terrain: `mbrl train --method tradyn`",
+                "unicycle data trains TRADYN, which reads the terrain: `mbrl train tradyn`",
             ));
         }
         let config = self.config(&env)?;

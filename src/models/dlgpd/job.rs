@@ -1,4 +1,4 @@
-//! `train --method dlgpd` as a job: datasets in, a checkpoint directory out (config.json, the VAE's weights
+//! `mbrl train dlgpd` as a job: datasets in, a checkpoint directory out (config.json, the VAE's weights
 //! with the GPs' hyperparameters and the frozen latent standardization in model.safetensors, the optimizers'
 //! state), resumable; and loading a finished checkpoint for planning.
 

@@ -1,4 +1,4 @@
-//! `mbrl train --method ball-ekf` on the shared training loop: a checkpoint directory with `params.json`
+//! `mbrl train ball-ekf` on the shared training loop: a checkpoint directory with `params.json`
 //! (and `spin_net.json`) vouched for by the manifest, periodic checkpoints and `--resume`.
 
 use std::path::{Path, PathBuf};
