@@ -236,7 +236,7 @@ pub fn load_dynamics(
     let weights: Vec<_> = stored.iter().filter(|t| !t.name.starts_with("input_normalizer.")).cloned().collect();
     let weights = to_params(&model_path, &weights, &layout)?;
     let reward = match run.config.reward {
-        RewardSource::Known => Some(crate::control::known_reward(&env).ok_or_else(|| {
+        RewardSource::Known => Some(crate::control::known_reward(env).ok_or_else(|| {
             Error::config(format!("env '{}' has no closed-form reward for this model", env.canonical()))
         })?),
         RewardSource::Learned => None,
