@@ -16,13 +16,15 @@ use mbrl::models::context::eig::EigObjective;
 use mbrl::models::context::fast::{FastContextModel, RolloutScratch};
 use mbrl::models::context::net::{param_name, ContextNet};
 use mbrl::models::context::ContextTrainer;
-use mbrl::models::context::{load, train, TrainRequest};
+use mbrl::models::context::{load, Context};
 use mbrl::nn::tensor::inference_device;
 use mbrl::nn::ParamSet;
 use mbrl::planning::{Cem, CemConfig};
 use mbrl::run::dir::Provenance;
 use mbrl::run::NullMonitor;
+use mbrl::train::job::start;
 use mbrl::train::TrainingMethod;
+use mbrl::train::{Accept, Request};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -112,18 +114,10 @@ fn mpc_step(c: &mut Criterion) {
     let mut config = paper_config(64);
     config.steps = 1;
     let provenance = Provenance::new(String::new(), 0, 1);
-    let request = TrainRequest {
-        method: mbrl::models::context::METHOD.into(),
-        space: mbrl::models::context::StateSpace::EnvState,
-        out: dir.path().join("model"),
-        data,
-        env: None,
-        config,
-        seed: 0,
-        provenance,
-    };
-    train(&request, false, &NullMonitor).unwrap();
-    let model = load(&request.out, &env).unwrap();
+    let request = Request::<Context> { env: None, data: vec![data], seed: 0, config, variant: (), provenance };
+    let out = dir.path().join("model");
+    start(&out, &request, &NullMonitor).unwrap();
+    let model = load(&out, &env, Accept::Finished).unwrap();
     let context: Vec<f32> = (0..10 * model.fast.transition_dim()).map(|i| ((i % 7) as f32 - 3.0) * 0.3).collect();
     let dynamics = ContextDynamics::new(model, &context, &env).unwrap();
     let init = [std::f64::consts::PI, 0.0];

@@ -11,12 +11,14 @@ use mbrl::data::write_dataset;
 use mbrl::envs::terrain::generate_map;
 use mbrl::envs::unicycle::UnicycleTerrain;
 use mbrl::envs::EnvName;
-use mbrl::models::context::{train, ContextConfig, EnvFamily, Preset, TrainRequest};
+use mbrl::models::context::{ContextConfig, EnvFamily, Preset};
 use mbrl::models::tradyn::navigation::{NavigationObjective, NavigationSettings};
 use mbrl::models::tradyn::{self, TradynDynamics, TradynModel};
 use mbrl::planning::{Cem, CemConfig};
 use mbrl::run::dir::Provenance;
 use mbrl::run::NullMonitor;
+use mbrl::train::job::start;
+use mbrl::train::{Accept, Request};
 
 // The binary runs on mimalloc (cmd/main.rs) and these figures are meant to be its: the library no longer
 // chooses the process allocator, so each benchmark declares the same one.
@@ -33,18 +35,16 @@ fn model(dir: &std::path::Path, width: usize) -> TradynModel {
     let mut config = ContextConfig::preset(Preset::Paper, EnvFamily::Control);
     (config.embedding, config.hidden_units, config.steps, config.batch_size) = (width, width, 1, 8);
     let out = dir.join(format!("model-{width}"));
-    let request = TrainRequest {
-        method: tradyn::METHOD.into(),
-        space: tradyn::state_space(true),
-        out: out.clone(),
-        data,
+    let request = Request::<tradyn::Tradyn> {
         env: None,
-        config,
+        data: vec![data],
         seed: 0,
+        config,
+        variant: true,
         provenance: Provenance::new(String::new(), 0, 1),
     };
-    train(&request, false, &NullMonitor).unwrap();
-    TradynModel::load(&out).unwrap()
+    start(&out, &request, &NullMonitor).unwrap();
+    TradynModel::load(&out, Accept::Finished).unwrap()
 }
 
 fn planning_step(c: &mut Criterion) {

@@ -189,9 +189,5 @@ fn load_model(dir: &std::path::Path, env: &EnvName, accept: Accept) -> anyhow::R
     if method == tradyn::METHOD && !unicycle {
         bail!("{}: is a TRADYN model of the unicycle; calibrate it with --env unicycle --map PNG", dir.display());
     }
-    Ok(if unicycle {
-        TradynModel::load_accepting(dir, accept)?.loaded
-    } else {
-        context::load_accepting(dir, env, accept)?
-    })
+    Ok(if unicycle { TradynModel::load(dir, accept)?.loaded } else { context::load(dir, env, accept)? })
 }

@@ -395,11 +395,8 @@ fn eval_tradyn(global: &GlobalArgs, provenance: &Provenance, a: TradynArgs) -> a
         }
     }
     let models = TradynEvalModels {
-        terrain: mbrl::models::tradyn::TradynModel::load_accepting(&a.model_terrain, accepting(a.allow_incomplete))?,
-        no_terrain: mbrl::models::tradyn::TradynModel::load_accepting(
-            &a.model_no_terrain,
-            accepting(a.allow_incomplete),
-        )?,
+        terrain: mbrl::models::tradyn::TradynModel::load(&a.model_terrain, accepting(a.allow_incomplete))?,
+        no_terrain: mbrl::models::tradyn::TradynModel::load(&a.model_no_terrain, accepting(a.allow_incomplete))?,
     };
     for model in [&models.terrain, &models.no_terrain] {
         report_unfinished(&model.loaded.dir, &model.loaded.progress);
@@ -551,7 +548,7 @@ fn eval_context(global: &GlobalArgs, provenance: &Provenance, a: ContextArgs) ->
     {
         bail!("--contexts must be 2..=100000, --validation-rollouts and --validation-steps 1..=10000");
     }
-    let model = mbrl::models::context::load_accepting(&a.model, &env, accepting(a.allow_incomplete))?;
+    let model = mbrl::models::context::load(&a.model, &env, accepting(a.allow_incomplete))?;
     report_unfinished(&a.model, &model.progress);
     let summary = run_job(global, "eval context", |monitor| {
         mbrl::eval::context::evaluate(&model, &env, &settings, provenance, &a.out, monitor)
@@ -611,7 +608,7 @@ fn eval_seads(global: &GlobalArgs, provenance: &Provenance, a: SeadsArgs) -> any
     let loaded: Vec<_> = a
         .model
         .iter()
-        .map(|m| mbrl::models::seads::planner::load_accepting(m, accepting(a.allow_incomplete)))
+        .map(|m| mbrl::models::seads::planner::load(m, accepting(a.allow_incomplete)))
         .collect::<Result<_, _>>()?;
     for model in &loaded {
         report_unfinished(&model.dir, &model.progress);
@@ -736,7 +733,7 @@ fn eval_dlgpd(global: &GlobalArgs, provenance: &Provenance, a: DlgpdArgs) -> any
         cem,
         swing_ups: !a.prediction_only,
     };
-    let trained = mbrl::models::dlgpd::job::load_accepting(&a.model, accepting(a.allow_incomplete))?;
+    let trained = mbrl::models::dlgpd::job::load(&a.model, accepting(a.allow_incomplete))?;
     report_unfinished(&a.model, &trained.progress);
     let summary = run_job(global, "eval dlgpd", |monitor| evaluate(&trained, &settings, provenance, &a.out, monitor))?;
     if !summary.points.is_empty() {

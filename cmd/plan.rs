@@ -165,7 +165,7 @@ fn plan_dlgpd(
         bail!("--instance-seed and --context are for context models; a DLGPD model adapts through --evidence");
     }
     let model_dir = std::path::Path::new(&args.model.model);
-    let trained = dlgpd::job::load_accepting(model_dir, args.model.accept())?;
+    let trained = dlgpd::job::load(model_dir, args.model.accept())?;
     report_unfinished(model_dir, &trained.progress);
     let evidence = mbrl::data::read_dataset(evidence_path)?;
     let seed = global.seed;

@@ -65,7 +65,7 @@ fn load_dynamics(
             dir.display()
         );
     }
-    let trained = TradynModel::load_accepting(dir, model.accept())?;
+    let trained = TradynModel::load(dir, model.accept())?;
     report_unfinished(dir, &trained.loaded.progress);
     let rows = match &model.context {
         Some(path) => read_context(&trained.loaded, path)?,

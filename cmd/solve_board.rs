@@ -12,7 +12,7 @@ use mbrl::planning::board_view::layout;
 use mbrl::planning::solve_board::{execute_plan, plan_board, SearchKind};
 use mbrl::util::seeding::rng_for;
 
-use mbrl::models::seads::planner::{load_accepting as load_seads, solve_with_skills, LoadedSeads};
+use mbrl::models::seads::planner::{load as load_seads, solve_with_skills, LoadedSeads};
 
 use crate::common::{run_job, GlobalArgs};
 use crate::model_args::{accepting, report_unfinished};

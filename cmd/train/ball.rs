@@ -3,13 +3,12 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use mbrl::models::ball::learn::job::{self as ball_job, BallTrainRequest};
+use mbrl::models::ball::learn::job::BallEkf;
 use mbrl::models::ball::learn::options::{default_out_dir, BallOptions};
-use mbrl::run::dir::Provenance;
-use mbrl::train::run_dir::{decide, Decision, RunRequest};
+use mbrl::train::Request;
 
-use super::shared::{check_steps, RunArgs};
-use crate::common::{command_line, run_job, GlobalArgs};
+use super::shared::{check_steps, provenance, train, RunArgs};
+use crate::common::GlobalArgs;
 
 #[derive(Args, Debug)]
 #[command(
@@ -53,25 +52,14 @@ pub fn run(global: &GlobalArgs, args: BallArgs) -> anyhow::Result<()> {
         learning_rate: args.lr,
         launcher_prior: args.launcher_prior,
     };
-    let request = BallTrainRequest {
-        out: args.run.out.clone().unwrap_or_else(default_out_dir),
-        data: args.data.clone(),
-        settings: options.settings(global.seed),
-        provenance: Provenance::new(command_line(), global.seed, global.thread_count()),
+    let request = Request::<BallEkf> {
+        env: None,
+        data: vec![args.data.clone()],
+        seed: global.seed,
+        config: options.settings(global.seed),
+        variant: (),
+        provenance: provenance(global),
     };
-    let asked = RunRequest {
-        method: ball_job::METHOD.into(),
-        config_key: "settings",
-        config: serde_json::to_value(&request.settings)?,
-        seed: None,
-        data: vec![request.data.clone()],
-        fields: Vec::new(),
-        extendable: false,
-        command_line: request.provenance.command_line.clone(),
-    };
-    if let Decision::Resume(extension) = decide(&request.out, &asked, args.run.resume_if_stopped)? {
-        return super::resume(global, &request.out, extension.as_ref());
-    }
-    let report = run_job(global, "train ball-ekf", |monitor| ball_job::train_checkpointed(&request, false, monitor))?;
-    super::report::ball(&report, &request.out)
+    let out = args.run.out.clone().unwrap_or_else(default_out_dir);
+    train(global, &out, &request, args.run.resume_if_stopped)
 }

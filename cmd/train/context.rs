@@ -3,15 +3,14 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use mbrl::models::context;
 use mbrl::models::context::options::ContextOptions;
-use mbrl::models::tradyn;
-use mbrl::run::dir::Provenance;
-use mbrl::train::run_dir::{decide, Decision, Field, RunRequest};
+use mbrl::models::context::{self, Context};
+use mbrl::models::tradyn::{self, Tradyn};
+use mbrl::train::Request;
 
-use super::shared::{check_steps, RunArgs};
+use super::shared::{check_steps, provenance, train, RunArgs};
 use super::ScalePreset;
-use crate::common::{command_line, run_job, GlobalArgs};
+use crate::common::GlobalArgs;
 
 /// The flags context and TRADYN share: the model and its training are the same.
 #[derive(Args, Debug)]
@@ -108,17 +107,15 @@ pub fn run_context(global: &GlobalArgs, args: ContextArgs) -> anyhow::Result<()>
         || Ok(mbrl::data::read_dataset(data)?.meta.env),
         args.run.out.clone(),
     )?;
-    let request = context::TrainRequest {
-        method: context::METHOD.into(),
-        space: context::StateSpace::EnvState,
-        out: planned.out,
-        data: data.clone(),
+    let request = Request::<Context> {
         env: args.env.clone(),
-        config: planned.config,
+        data: vec![data.clone()],
         seed: global.seed,
-        provenance: Provenance::new(command_line(), global.seed, global.thread_count()),
+        config: planned.config,
+        variant: (),
+        provenance: provenance(global),
     };
-    train(global, &request, Vec::new(), args.run.resume_if_stopped)
+    train(global, &planned.out, &request, args.run.resume_if_stopped)
 }
 
 pub fn run_tradyn(global: &GlobalArgs, args: TradynArgs) -> anyhow::Result<()> {
@@ -134,48 +131,13 @@ pub fn run_tradyn(global: &GlobalArgs, args: TradynArgs) -> anyhow::Result<()> {
         terrain,
         args.run.out.clone(),
     )?;
-    let request = context::TrainRequest {
-        method: tradyn::METHOD.into(),
-        space: tradyn::state_space(terrain),
-        out: planned.out,
-        data: data.clone(),
+    let request = Request::<Tradyn> {
         env: None,
-        config: planned.config,
+        data: vec![data.clone()],
         seed: global.seed,
-        provenance: Provenance::new(command_line(), global.seed, global.thread_count()),
+        config: planned.config,
+        variant: terrain,
+        provenance: provenance(global),
     };
-    // The lookup is no config field: the model records it as the size of the terrain features it reads.
-    let lookup = match &request.space {
-        context::StateSpace::Observation { local_dim, .. } if *local_dim > 0 => serde_json::Value::from(*local_dim),
-        _ => serde_json::Value::Null,
-    };
-    let field = Field {
-        show: |v| if v.is_null() { "off (--no-terrain)".into() } else { "on".into() },
-        ..Field::new("the terrain lookup", "/model/local_dim", lookup)
-    };
-    train(global, &request, vec![field], args.run.resume_if_stopped)
-}
-
-fn train(
-    global: &GlobalArgs,
-    request: &context::TrainRequest,
-    fields: Vec<Field>,
-    resume_if_stopped: bool,
-) -> anyhow::Result<()> {
-    let asked = RunRequest {
-        method: request.method.clone(),
-        config_key: "config",
-        config: serde_json::to_value(&request.config)?,
-        seed: Some(request.seed),
-        data: vec![request.data.clone()],
-        fields,
-        extendable: false,
-        command_line: request.provenance.command_line.clone(),
-    };
-    if let Decision::Resume(extension) = decide(&request.out, &asked, resume_if_stopped)? {
-        return super::resume(global, &request.out, extension.as_ref());
-    }
-    let title = format!("train {}", request.method);
-    let report = run_job(global, &title, |monitor| context::train(request, false, monitor))?;
-    super::report::context(&report, &request.out)
+    train(global, &planned.out, &request, args.run.resume_if_stopped)
 }

@@ -4,15 +4,13 @@ use std::path::PathBuf;
 
 use clap::Args;
 use mbrl::models::dlgpd::config::Preset as DlgpdPreset;
-use mbrl::models::dlgpd::job as dlgpd;
+use mbrl::models::dlgpd::job::Dlgpd;
 use mbrl::models::dlgpd::options::{default_out_dir, DlgpdOptions};
-use mbrl::run::dir::Provenance;
-use mbrl::train::run_dir::{decide, Decision, RunRequest};
-use mbrl::train::Start;
+use mbrl::train::Request;
 
-use super::shared::{check_steps, RunArgs};
+use super::shared::{check_steps, provenance, train, RunArgs};
 use super::ScalePreset;
-use crate::common::{command_line, run_job, GlobalArgs};
+use crate::common::GlobalArgs;
 
 #[derive(Args, Debug)]
 #[command(
@@ -66,27 +64,14 @@ pub fn run(global: &GlobalArgs, args: DlgpdArgs) -> anyhow::Result<()> {
         batch_size: args.batch,
         learning_rate: args.lr,
     };
-    let request = dlgpd::TrainRequest {
-        config: options.config()?,
-        out: args.run.out.clone().unwrap_or_else(default_out_dir),
-        data: args.data.clone(),
+    let request = Request::<Dlgpd> {
         env: args.env.clone(),
+        data: args.data.clone(),
         seed: global.seed,
-        provenance: Provenance::new(command_line(), global.seed, global.thread_count()),
+        config: options.config()?,
+        variant: (),
+        provenance: provenance(global),
     };
-    let asked = RunRequest {
-        method: dlgpd::METHOD.into(),
-        config_key: "config",
-        config: serde_json::to_value(&request.config)?,
-        seed: Some(request.seed),
-        data: request.data.clone(),
-        fields: Vec::new(),
-        extendable: true,
-        command_line: request.provenance.command_line.clone(),
-    };
-    if let Decision::Resume(extension) = decide(&request.out, &asked, args.run.resume_if_stopped)? {
-        return super::resume(global, &request.out, extension.as_ref());
-    }
-    let report = run_job(global, "train dlgpd", |monitor| dlgpd::train(&request, Start::Fresh, monitor))?;
-    super::report::dlgpd(&report, &request.out)
+    let out = args.run.out.clone().unwrap_or_else(default_out_dir);
+    train(global, &out, &request, args.run.resume_if_stopped)
 }

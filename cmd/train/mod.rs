@@ -6,7 +6,6 @@ mod ball;
 mod context;
 mod dlgpd;
 mod pets;
-mod report;
 mod seads;
 mod shared;
 
@@ -14,12 +13,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::bail;
 use clap::{Args, Subcommand, ValueEnum};
-use mbrl::models::ball::learn::job as ball_job;
-use mbrl::models::context as context_model;
-use mbrl::models::dlgpd::job as dlgpd_job;
-use mbrl::models::pets as pets_model;
-use mbrl::models::seads as seads_model;
-use mbrl::models::tradyn;
+use mbrl::eval::training::write_loss_report;
+use mbrl::models::registry;
 use mbrl::train::{Extension, OpenedCheckpoint};
 
 use crate::common::{command_line, run_job, GlobalArgs};
@@ -122,54 +117,11 @@ pub fn run(global: &GlobalArgs, args: TrainArgs) -> anyhow::Result<()> {
 }
 
 pub fn resume(global: &GlobalArgs, dir: &Path, extend_to: Option<&Extension>) -> anyhow::Result<()> {
-    let method = OpenedCheckpoint::open(dir)?.manifest.method;
-    // Training that depends on its total (context's p_ctx schedule, ball-ekf's and seads' budgets) cannot be
-    // lengthened without changing what was already trained.
-    if extend_to.is_some() && method != pets_model::METHOD && method != dlgpd_job::METHOD {
-        bail!(
-            "{}: --steps with --resume extends a run, which works for {} and {} runs; a {method} run's training \
-             depends on its total, so start a new run with the steps you want",
-            dir.display(),
-            pets_model::METHOD,
-            dlgpd_job::METHOD
-        );
-    }
-    match method.as_str() {
-        pets_model::METHOD => {
-            let report =
-                run_job(global, "train pets (resumed)", |monitor| pets_model::resume(dir, extend_to, monitor))?;
-            report::pets(&report, dir)
-        }
-        ball_job::METHOD => {
-            let report = run_job(global, "train ball-ekf (resumed)", |monitor| ball_job::resume(dir, monitor))?;
-            report::ball(&report, dir)
-        }
-        context_model::METHOD => {
-            let report = run_job(global, "train context (resumed)", |monitor| context_model::resume(dir, monitor))?;
-            report::context(&report, dir)
-        }
-        tradyn::METHOD => {
-            let report = run_job(global, "train tradyn (resumed)", |monitor| context_model::resume(dir, monitor))?;
-            report::context(&report, dir)
-        }
-        seads_model::METHOD => {
-            let report = run_job(global, "train seads (resumed)", |monitor| seads_model::resume(dir, monitor))?;
-            report::seads(&report, dir)
-        }
-        dlgpd_job::METHOD => {
-            let report =
-                run_job(global, "train dlgpd (resumed)", |monitor| dlgpd_job::resume(dir, extend_to, monitor))?;
-            report::dlgpd(&report, dir)
-        }
-        other => bail!(
-            "{}: '{other}' runs cannot be resumed; resumable methods: {}, {}, {}, {}, {}, {}",
-            dir.display(),
-            pets_model::METHOD,
-            ball_job::METHOD,
-            context_model::METHOD,
-            tradyn::METHOD,
-            seads_model::METHOD,
-            dlgpd_job::METHOD
-        ),
-    }
+    let method = registry::method(&OpenedCheckpoint::open(dir)?.manifest.method, dir)?;
+    let title = format!("train {} (resumed)", method.name());
+    let summary = run_job(global, &title, |monitor| method.resume(dir, extend_to, monitor))?;
+    let (plot_title, y_label) = method.loss_plot();
+    write_loss_report(dir, plot_title, y_label)?;
+    say!("{summary}");
+    Ok(())
 }

@@ -4,13 +4,11 @@ use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
 use mbrl::models::pets::options::PetsOptions;
-use mbrl::models::pets::{self, Preset, RewardSource};
-use mbrl::run::dir::Provenance;
-use mbrl::train::run_dir::{decide, Decision, RunRequest};
-use mbrl::train::Start;
+use mbrl::models::pets::{Pets, Preset, RewardSource};
+use mbrl::train::Request;
 
-use super::shared::{check_steps, RunArgs};
-use crate::common::{command_line, run_job, GlobalArgs};
+use super::shared::{check_steps, provenance, train, RunArgs};
+use crate::common::GlobalArgs;
 
 #[derive(Args, Debug)]
 #[command(
@@ -99,27 +97,13 @@ pub fn run(global: &GlobalArgs, args: PetsArgs) -> anyhow::Result<()> {
         || Ok(mbrl::data::read_dataset(first)?.meta.env),
         args.run.out.clone(),
     )?;
-    let request = pets::TrainRequest {
-        out: planned.out,
-        data: args.data.clone(),
+    let request = Request::<Pets> {
         env: args.env.clone(),
-        config: planned.config,
+        data: args.data.clone(),
         seed: global.seed,
-        provenance: Provenance::new(command_line(), global.seed, global.thread_count()),
+        config: planned.config,
+        variant: (),
+        provenance: provenance(global),
     };
-    let asked = RunRequest {
-        method: pets::METHOD.into(),
-        config_key: "config",
-        config: serde_json::to_value(&request.config)?,
-        seed: Some(request.seed),
-        data: request.data.clone(),
-        fields: Vec::new(),
-        extendable: true,
-        command_line: request.provenance.command_line.clone(),
-    };
-    if let Decision::Resume(extension) = decide(&request.out, &asked, args.run.resume_if_stopped)? {
-        return super::resume(global, &request.out, extension.as_ref());
-    }
-    let report = run_job(global, "train pets", |monitor| pets::train(&request, Start::Fresh, monitor))?;
-    super::report::pets(&report, &request.out)
+    train(global, &planned.out, &request, args.run.resume_if_stopped)
 }

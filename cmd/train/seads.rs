@@ -5,13 +5,12 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::Args;
 use mbrl::models::seads::options::{default_out_for, SeadsOptions};
-use mbrl::models::seads::{self, EmbodiedGame};
-use mbrl::run::dir::Provenance;
-use mbrl::train::run_dir::{decide, Decision, Field, RunRequest};
+use mbrl::models::seads::{self, EmbodiedGame, Seads};
+use mbrl::train::Request;
 
-use super::shared::RunArgs;
+use super::shared::{provenance, train, RunArgs};
 use super::ScalePreset;
-use crate::common::{command_line, run_job, GlobalArgs};
+use crate::common::GlobalArgs;
 
 #[derive(Args, Debug)]
 #[command(
@@ -71,26 +70,14 @@ pub fn run(global: &GlobalArgs, args: SeadsArgs) -> anyhow::Result<()> {
         no_novelty: args.no_novelty,
     };
     let config = options.config(&env)?;
-    let request = seads::TrainRequest {
-        out: args.run.out.clone().unwrap_or_else(|| default_out_for(&env)),
-        env,
-        config,
-        seed: global.seed,
-        provenance: Provenance::new(command_line(), global.seed, global.thread_count()),
-    };
-    let asked = RunRequest {
-        method: seads::METHOD.into(),
-        config_key: "config",
-        config: serde_json::to_value(&request.config)?,
-        seed: Some(request.seed),
+    let request = Request::<Seads> {
+        env: Some(env.name()),
         data: Vec::new(),
-        fields: vec![Field::new("--env", "/env", serde_json::Value::from(request.env.name()))],
-        extendable: false,
-        command_line: request.provenance.command_line.clone(),
+        seed: global.seed,
+        config,
+        variant: (),
+        provenance: provenance(global),
     };
-    if let Decision::Resume(extension) = decide(&request.out, &asked, args.run.resume_if_stopped)? {
-        return super::resume(global, &request.out, extension.as_ref());
-    }
-    let report = run_job(global, "train seads", |monitor| seads::train(&request, false, monitor))?;
-    super::report::seads(&report, &request.out)
+    let out = args.run.out.clone().unwrap_or_else(|| default_out_for(&env));
+    train(global, &out, &request, args.run.resume_if_stopped)
 }

@@ -158,7 +158,7 @@ pub fn entropy_after_one_action(model: &LoadedModel, actions: &[f64], samples: u
                 .collect::<Vec<_>>()
         })
         .collect();
-    let init = model.features(&vec![0.0; model.run.model.angular.len()]);
+    let init = model.features(&vec![0.0; model.run.details.model.angular.len()]);
     actions
         .iter()
         .map(|&a| {
@@ -572,7 +572,7 @@ fn write_report(
         c.iterations,
         c.beta_samples,
         c.horizon_max,
-        if model.run.model.angular.iter().any(|a| *a) { " (angles as cos, sin)" } else { "" }
+        if model.run.details.model.angular.iter().any(|a| *a) { " (angles as cos, sin)" } else { "" }
     );
     let has_quadrants = outcomes[0][0].quadrants.is_some();
     let _ = writeln!(
@@ -702,18 +702,17 @@ mod tests {
         let mut config = ContextConfig::preset(Preset::Small, EnvFamily::Toy);
         config.steps = 1000;
         let provenance = Provenance::new(String::new(), 3, 1);
-        let request = context::TrainRequest {
-            method: context::METHOD.into(),
-            space: context::StateSpace::EnvState,
-            out: dir.path().join("model"),
-            data,
+        let request = crate::train::Request::<context::Context> {
             env: None,
-            config,
+            data: vec![data],
             seed: 3,
+            config,
+            variant: (),
             provenance: provenance.clone(),
         };
-        context::train(&request, false, &NullMonitor).unwrap();
-        let model = context::load(&request.out, &env).unwrap();
+        let out = dir.path().join("model");
+        crate::train::job::start(&out, &request, &NullMonitor).unwrap();
+        let model = context::load(&out, &env, crate::train::Accept::Finished).unwrap();
         let settings = ContextEvalSettings {
             contexts: 20,
             validation_rollouts: 10,

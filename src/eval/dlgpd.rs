@@ -202,7 +202,7 @@ pub fn evaluate(
     let metrics = run_dir.metrics()?;
     let monitor = Tee { first: monitor, second: &metrics };
     monitor.emit(&crate::eval::swingup::layout("eval dlgpd: swing-ups on swapped evidence", false));
-    let images = matches!(trained.run.observation, ObservationKind::Images { .. });
+    let images = matches!(trained.run.details.observation, ObservationKind::Images { .. });
     let seed = provenance.seed;
     let largest = settings.evidence_rollouts.iter().copied().max().unwrap_or(0);
     let mut plan: Vec<(PendulumVariant, &'static str, PendulumVariant)> = Vec::new();
@@ -372,7 +372,7 @@ fn write_report(
 ) -> Result<()> {
     let mut md = String::new();
     md.push_str("# DLGPD: swing-up on swapped evidence (thesis 3.5.3, Figs. 3.4/3.5)\n\n");
-    let observed = match trained.run.observation {
+    let observed = match trained.run.details.observation {
         ObservationKind::Images { side } => format!("{side}×{side} rendered frames (the paper's conv VAE)"),
         ObservationKind::Angles => {
             "pole angles (cos θ, sin θ) with an MLP VAE: the small preset, not the paper's images".to_string()
@@ -382,8 +382,8 @@ fn write_report(
         "One model trained on {} transitions of `{}` from {observed}, {} at batch {}. No retraining: for \
          each setting the GPs are conditioned on encoded evidence rollouts (random actions, {} frames each) of \
          the system at hand (**matching**) or of the standard pendulum (**mismatching**).\n\n",
-        trained.run.transitions.train,
-        trained.run.env,
+        trained.run.details.transitions.train,
+        trained.run.env(),
         trained.progress.describe(),
         trained.run.config.batch_size,
         EVIDENCE_STEPS + 1,
@@ -398,7 +398,7 @@ fn write_report(
     }
     write_prediction_section(run_dir, findings.predictions, &mut md)?;
     files.extend(["prediction.csv", "prediction.png", "action_response.csv"].map(|f| format!("`{f}`")));
-    if matches!(trained.run.observation, ObservationKind::Images { .. }) {
+    if matches!(trained.run.details.observation, ObservationKind::Images { .. }) {
         files.push("`reconstructions.png` (top: observed newer frames; bottom: decoded from the encoder mean)".into());
     }
     md.push_str(&format!("\nFiles: {}.\n", files.join(", ")));
@@ -663,13 +663,13 @@ fn write_prediction_section(run_dir: &RunDir, predictions: &[PredictionCheck], m
 
 /// Observed frames above the model's reconstructions of them (newer frame of each pair, from the encoder mean).
 fn write_reconstructions(trained: &TrainedDlgpd, pool: &Dataset, path: &Path) -> Result<()> {
-    let ObservationKind::Images { side } = trained.run.observation else {
+    let ObservationKind::Images { side } = trained.run.details.observation else {
         return Ok(());
     };
-    let windows = Windows::from_dataset(pool, trained.run.observation, 0)?;
+    let windows = Windows::from_dataset(pool, trained.run.details.observation, 0)?;
     let rows: Vec<usize> = (0..windows.len()).step_by(3).take(8).collect();
     let (obs, _) = windows.observations(&rows);
-    let width = trained.run.observation.input_len();
+    let width = trained.run.details.observation.input_len();
     let device = inference_device();
     let (mean, _) = encode_rows(&trained.vae, &obs, width, &device);
     let latent = trained.run.config.latent_dim;

@@ -106,10 +106,10 @@ fn branch_latents(
         seed,
         command_line: "mbrl eval dlgpd (action response)".into(),
     })?;
-    if matches!(trained.run.observation, ObservationKind::Images { .. }) {
+    if matches!(trained.run.details.observation, ObservationKind::Images { .. }) {
         add_pendulum_frames(&mut branch, &NullMonitor)?;
     }
-    let windows = Windows::from_dataset(&branch, trained.run.observation, seed)?;
+    let windows = Windows::from_dataset(&branch, trained.run.details.observation, seed)?;
     let rows: Vec<usize> = (0..windows.len()).collect();
     encoded_means(&trained.vae, &windows, &rows)
 }

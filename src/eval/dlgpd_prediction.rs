@@ -39,7 +39,7 @@ pub fn reward_prediction(
     variant: &PendulumVariant,
     seed: u64,
 ) -> Result<RewardPrediction> {
-    let windows = Windows::from_dataset(held_out, trained.run.observation, seed)?;
+    let windows = Windows::from_dataset(held_out, trained.run.details.observation, seed)?;
     let rows: Vec<usize> = (0..windows.len()).collect();
     let latents = encoded_means(&trained.vae, &windows, &rows)?;
     let dims = dynamics.latent_dim();

@@ -28,7 +28,8 @@ use crate::models::pets::{self, PetsConfig, Preset, Propagation};
 use crate::models::seads;
 use crate::run::dir::Provenance;
 use crate::run::Monitor;
-use crate::train::Start;
+use crate::train::job::start;
+use crate::train::{Accept, Request};
 use crate::util::atomic::write_text;
 use crate::util::seeding::derive_seed;
 
@@ -142,17 +143,18 @@ fn pets_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) ->
     write_dataset(&data_path, &collect_random(&collect, monitor)?)?;
     let mut config = PetsConfig::preset(Preset::Small);
     config.steps = QUICK_PETS_TRAIN_STEPS;
-    let request = pets::TrainRequest {
-        out: dir.join("model"),
-        data: vec![data_path],
+    let out = dir.join("model");
+    let request = Request::<pets::Pets> {
         env: None,
-        config,
+        data: vec![data_path],
         seed: provenance.seed,
+        config,
+        variant: (),
         provenance: provenance.clone(),
     };
-    let trained = pets::train(&request, Start::Fresh, monitor)?;
+    let trained = start(&out, &request, monitor)?;
     let model = pets::load_dynamics(
-        &request.out,
+        &out,
         &collect.env,
         Propagation::TsInf,
         QUICK_PETS_PARTICLES,
@@ -169,7 +171,7 @@ fn pets_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) ->
         "PETS: ensemble of 5 trained {} steps on {} random transitions (validation MSE {}); swing-up planned on the \
          learned model (CEM {}×{}×{}, {} TS-∞ particles): {}/{} episodes succeeded, mean return {mean_return:.1}; see pets/swingup/report.md",
         QUICK_PETS_TRAIN_STEPS,
-        trained.run.transitions.train,
+        trained.record.details.transitions.train,
         trained.outcome.best_valid_loss.map(|v| format!("{v:.2e}")).unwrap_or_else(|| "–".into()),
         settings.cem.candidates,
         settings.cem.horizon,
@@ -248,18 +250,17 @@ fn context_slice(squash: Squash, provenance: &Provenance, out_dir: &Path, monito
     write_dataset(&data_path, &collect_instance_pairs(&collect, monitor)?)?;
     let config = ContextConfig::preset(ContextPreset::Small, EnvFamily::Toy);
     let steps = config.steps;
-    let request = context::TrainRequest {
-        method: context::METHOD.into(),
-        space: context::StateSpace::EnvState,
-        out: dir.join("model"),
-        data: data_path,
+    let out = dir.join("model");
+    let request = Request::<context::Context> {
         env: None,
-        config,
+        data: vec![data_path],
         seed: provenance.seed,
+        config,
+        variant: (),
         provenance: provenance.clone(),
     };
-    context::train(&request, false, monitor)?;
-    let model = context::load(&request.out, &env)?;
+    start(&out, &request, monitor)?;
+    let model = context::load(&out, &env, Accept::Finished)?;
     let settings = ContextEvalSettings {
         contexts: QUICK_CONTEXT_CONTEXTS,
         validation_rollouts: 20,
@@ -301,15 +302,17 @@ fn context_slice(squash: Squash, provenance: &Provenance, out_dir: &Path, monito
 fn seads_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) -> Result<String> {
     let env = seads::EmbodiedGame::parse("tileswap:cursor")?;
     let dir = out_dir.join("seads-tileswap-cursor");
-    let request = seads::TrainRequest {
-        out: dir.join("model"),
-        env,
-        config: seads::SeadsConfig::preset(seads::Preset::Small, env.moves(), true),
+    let out = dir.join("model");
+    let request = Request::<seads::Seads> {
+        env: Some(env.name()),
+        data: Vec::new(),
         seed: provenance.seed,
+        config: seads::SeadsConfig::preset(seads::Preset::Small, env.moves(), true),
+        variant: (),
         provenance: provenance.clone(),
     };
-    let report = seads::train(&request, false, monitor)?;
-    let loaded = seads::planner::load(&request.out)?;
+    let trained = start(&out, &request, monitor)?;
+    let loaded = seads::planner::load(&out, Accept::Finished)?;
     let settings = SeadsEvalSettings {
         max_depth: QUICK_SEADS_DEPTH,
         boards_per_depth: QUICK_SEADS_BOARDS,
@@ -323,7 +326,7 @@ fn seads_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) -
     Ok(format!(
         "SEADS, tileswap:cursor (small preset, {} env steps, no game reward): the skills cover {}/{} moves; {solved}/{boards} \
          test boards of depth 1-{} solved by planning over the learned forward model; see seads-tileswap-cursor/eval/report.md",
-        report.env_steps, summary.distinct_moves, summary.moves, QUICK_SEADS_DEPTH
+        trained.trainer.env_steps(), summary.distinct_moves, summary.moves, QUICK_SEADS_DEPTH
     ))
 }
 
@@ -342,16 +345,17 @@ fn dlgpd_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) -
         command_line: provenance.command_line.clone(),
     };
     write_dataset(&data_path, &collect_random(&collect, monitor)?)?;
-    let request = dlgpd::TrainRequest {
-        out: dir.join("model"),
-        data: vec![data_path],
+    let out = dir.join("model");
+    let request = Request::<dlgpd::Dlgpd> {
         env: None,
-        config: DlgpdConfig { steps: QUICK_DLGPD_TRAIN_STEPS, ..DlgpdConfig::preset(DlgpdPreset::Small) },
+        data: vec![data_path],
         seed: provenance.seed,
+        config: DlgpdConfig { steps: QUICK_DLGPD_TRAIN_STEPS, ..DlgpdConfig::preset(DlgpdPreset::Small) },
+        variant: (),
         provenance: provenance.clone(),
     };
-    dlgpd::train(&request, Start::Fresh, monitor)?;
-    let trained = dlgpd::load(&request.out)?;
+    start(&out, &request, monitor)?;
+    let trained = dlgpd::load(&out, Accept::Finished)?;
     let mut cem = ControlSettings::authors(PendulumVariant::Inverted).cem;
     cem.candidates = QUICK_DLGPD_CANDIDATES;
     cem.elites = QUICK_DLGPD_CANDIDATES / 10;
@@ -377,7 +381,7 @@ fn dlgpd_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) -
         "DLGPD (small preset: MLP VAE on pole angles instead of images, {QUICK_DLGPD_TRAIN_STEPS} steps on {} random \
          transitions of the standard pendulum), inverted-action pendulum, no retraining, {} steps: with {} matching \
          evidence rollouts {}; with the standard pendulum's evidence {}; see dlgpd/eval/report.md",
-        trained.run.transitions.train,
+        trained.run.details.transitions.train,
         QUICK_DLGPD_SWINGUP_STEPS,
         QUICK_DLGPD_EVIDENCE_ROLLOUTS,
         describe("matching"),
@@ -419,18 +423,16 @@ fn tradyn_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) 
     let mut models = Vec::new();
     for terrain in [true, false] {
         let out = dir.join(if terrain { "model-terrain" } else { "model-no-terrain" });
-        let request = context::TrainRequest {
-            method: tradyn::METHOD.into(),
-            space: tradyn::state_space(terrain),
-            out: out.clone(),
-            data: data_path.clone(),
+        let request = Request::<tradyn::Tradyn> {
             env: None,
-            config: config.clone(),
+            data: vec![data_path.clone()],
             seed: provenance.seed,
+            config: config.clone(),
+            variant: terrain,
             provenance: provenance.clone(),
         };
-        context::train(&request, false, monitor)?;
-        models.push(TradynModel::load(&out)?);
+        start(&out, &request, monitor)?;
+        models.push(TradynModel::load(&out, Accept::Finished)?);
     }
     let no_terrain = models.pop().expect("two models trained");
     let terrain = models.pop().expect("two models trained");

@@ -51,6 +51,41 @@ pub trait TrainingMethod {
     }
 }
 
+/// A boxed trainer trains as the trainer it holds, so a method whose trainer type depends on its data (the
+/// SEADS game) can name one type.
+impl<T: TrainingMethod + ?Sized> TrainingMethod for Box<T> {
+    fn step(&mut self, step: u64) -> Result<f64> {
+        (**self).step(step)
+    }
+    fn validate(&mut self) -> Result<Option<f64>> {
+        (**self).validate()
+    }
+    fn weights(&self) -> Vec<StoredTensor> {
+        (**self).weights()
+    }
+    fn state(&self) -> Vec<StoredTensor> {
+        (**self).state()
+    }
+    fn restore(&mut self, state: &[StoredTensor]) -> Result<()> {
+        (**self).restore(state)
+    }
+    fn artifacts(&self) -> Result<Vec<(String, Vec<u8>)>> {
+        (**self).artifacts()
+    }
+    fn budget(&self) -> Option<Budget> {
+        (**self).budget()
+    }
+    fn validation_scalars(&mut self) -> Result<Vec<(&'static str, f64)>> {
+        (**self).validation_scalars()
+    }
+    fn step_scalars(&self) -> Vec<(&'static str, f64)> {
+        (**self).step_scalars()
+    }
+    fn step_texts(&self) -> Vec<(&'static str, String)> {
+        (**self).step_texts()
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Budget {
     pub unit: &'static str,

@@ -3,8 +3,12 @@
 
 use std::path::Path;
 
+use serde_json::Value;
+
 use super::checkpoint::{CheckpointDir, FileEntry};
-use super::fit::{fit, DirCheckpointer, FitOutcome, FitSettings, TrainingMethod, CONFIG_FILE, STATE_FILE};
+use super::fit::{fit, DirCheckpointer, FitSettings, TrainingMethod, CONFIG_FILE, STATE_FILE};
+use super::method::{Method, Prepared, Request, RunRecord, Trained};
+use super::run_dir::Decision;
 use super::OpenedCheckpoint;
 use crate::error::{Error, Result};
 use crate::run::dir::{Provenance, METRICS_FILE};
@@ -24,16 +28,6 @@ pub enum Start {
     /// that total only (the caller builds it from the checkpoint's), and only for methods whose training does
     /// not depend on the total, so the run ends as one started with the larger total would have.
     Extend,
-}
-
-impl Start {
-    pub fn resuming(resume: bool) -> Start {
-        if resume {
-            Start::Resume
-        } else {
-            Start::Fresh
-        }
-    }
 }
 
 /// `train --resume DIR --steps N`: the total asked for, and the command, which the run's provenance keeps.
@@ -85,80 +79,147 @@ pub fn continuation(
     Ok(Continuation { start: Start::Extend, steps: total, provenance })
 }
 
-/// Runs `method` to the end in `dir`. A fresh run writes `config` (the full description a resumed run is rebuilt
-/// from) and starts the metrics log with `view`. To resume, `dir` must hold an unfinished checkpoint of the same
-/// config, and the run continues from it so that it ends with the bytes an uninterrupted run would. To extend,
-/// the new config is staged with the next checkpoint, so until that checkpoint the directory still holds the
-/// run as it was.
-pub fn run_training(
-    dir: &Path,
-    config: &serde_json::Value,
-    settings: &FitSettings,
-    method: &mut dyn TrainingMethod,
-    start: Start,
-    view: &[Event],
-    monitor: &dyn Monitor,
-) -> Result<FitOutcome> {
-    if settings.total_steps > MAX_TRAIN_STEPS {
+/// Starts a new run of `request` in `out`, replacing whatever is there (callers first [`super::run_dir::decide`]
+/// whether a stopped run must be kept).
+pub fn start<M: Method>(out: &Path, request: &Request<M>, monitor: &dyn Monitor) -> Result<Trained<M>> {
+    run(out, request, Start::Fresh, monitor)
+}
+
+/// Continues the run in `dir` from its last checkpoint with the config, data and seed it was started with;
+/// with `extension`, on to a larger total (only for [`Method::EXTENDABLE`] methods).
+pub fn resume<M: Method>(dir: &Path, extension: Option<&Extension>, monitor: &dyn Monitor) -> Result<Trained<M>> {
+    let opened = OpenedCheckpoint::open(dir)?;
+    opened.expect_method(M::NAME)?;
+    let record = RunRecord::<M>::read(&opened)?;
+    let steps = M::total_steps(&record.config);
+    opened.expect_total_steps(steps)?;
+    if extension.is_some_and(|e| e.steps != steps) && !M::EXTENDABLE {
         return Err(Error::config(format!(
-            "{} training steps; at most {MAX_TRAIN_STEPS} (months on any machine mbrl runs on)",
-            settings.total_steps
+            "{}: --steps with --resume extends a run, which works for pets and dlgpd runs; a {} run's training \
+             depends on its total, so start a new run with the steps you want",
+            dir.display(),
+            M::NAME
         )));
     }
-    let config_bytes = config_bytes(config)?;
-    for event in view {
+    let next = continuation(&opened, steps, &record.provenance, extension)?;
+    for file in &record.data {
+        file.verify_unchanged()?;
+    }
+    let request = Request::<M> {
+        env: record.env.clone(),
+        data: record.data_paths(),
+        seed: record.seed,
+        config: if next.steps == steps {
+            record.config.clone()
+        } else {
+            M::with_total_steps(&record.config, next.steps)
+        },
+        variant: M::variant_of(&record)?,
+        provenance: next.provenance,
+    };
+    drop(opened);
+    run(dir, &request, next.start, monitor)
+}
+
+/// Starts or continues a run as [`super::run_dir::decide`] decided.
+pub fn carry_out<M: Method>(
+    out: &Path,
+    request: &Request<M>,
+    decision: &Decision,
+    monitor: &dyn Monitor,
+) -> Result<Trained<M>> {
+    match decision {
+        Decision::Fresh => start(out, request, monitor),
+        Decision::Resume(extension) => resume(out, extension.as_ref(), monitor),
+    }
+}
+
+/// Runs `request` to the end in `dir`. A fresh run writes its record (the full description a resumed run is
+/// rebuilt from) and starts the metrics log with the live view. To resume, `dir` must hold an unfinished
+/// checkpoint of the same record, and the run continues from it so that it ends with the bytes an
+/// uninterrupted run would. To extend, the new record is staged with the next checkpoint, so until that
+/// checkpoint the directory still holds the run as it was.
+fn run<M: Method>(dir: &Path, request: &Request<M>, start: Start, monitor: &dyn Monitor) -> Result<Trained<M>> {
+    M::validate(&request.config)?;
+    let total_steps = M::total_steps(&request.config);
+    if total_steps > MAX_TRAIN_STEPS {
+        return Err(Error::config(format!(
+            "{total_steps} training steps; at most {MAX_TRAIN_STEPS} (months on any machine mbrl runs on)"
+        )));
+    }
+    let Prepared { env, data, details, mut trainer, view } = M::prepare(request)?;
+    let record = RunRecord::<M> {
+        method: M::NAME.to_string(),
+        env,
+        data,
+        seed: request.seed,
+        config: request.config.clone(),
+        details,
+        provenance: request.provenance.clone(),
+    };
+    let (validate_every, checkpoint_every) = M::schedule(&request.config);
+    let settings = FitSettings {
+        method: M::NAME.to_string(),
+        env: record.env.clone(),
+        total_steps,
+        validate_every,
+        checkpoint_every,
+    };
+    let config = record.to_value()?;
+    let config_bytes = config_bytes(&config)?;
+    for event in &view {
         monitor.emit(event);
     }
-    if start != Start::Fresh {
-        let opened = OpenedCheckpoint::open(dir)?;
-        // The config entry the run keeps: the checkpoint's own when resuming; when extending, none yet (the new
-        // config is staged once everything has been read from the checkpoint).
-        let kept_entry = if start == Start::Resume {
-            Some(check_resumable(&opened, settings, &config_bytes)?)
-        } else if settings.total_steps <= opened.manifest.total_steps {
-            return Err(Error::config(format!(
-                "extending {} to {} steps: the run already has {}",
-                dir.display(),
-                settings.total_steps,
-                opened.manifest.total_steps
-            )));
-        } else {
-            None
-        };
-        // A checkpoint killed halfway into place is finished first, so this run stages its own cleanly.
-        opened.dir.settle()?;
-        method.restore(&opened.tensors(STATE_FILE)?)?;
-        let point = opened.resume_point()?;
-        let entry = match kept_entry {
-            Some(entry) => entry,
-            None => opened.dir.write_file(CONFIG_FILE, &config_bytes)?,
-        };
-        let metrics_path = opened.dir.file(METRICS_FILE);
-        let metrics = JsonlMonitor::resume(&metrics_path, opened.manifest.metrics_bytes)
-            .map_err(|e| Error::io(&metrics_path, e))?;
-        monitor.message(&format!("resuming at step {} of {}", point.step, settings.total_steps));
+    if start == Start::Fresh {
+        let ckpt = CheckpointDir::start(dir)?;
+        let entry = ckpt.write_file(CONFIG_FILE, &config_bytes)?;
+        let metrics_path = ckpt.file(METRICS_FILE);
+        let metrics = JsonlMonitor::create(&metrics_path).map_err(|e| Error::io(&metrics_path, e))?;
+        for event in &view {
+            metrics.emit(event);
+        }
         let tee = Tee { first: monitor, second: &metrics };
-        let mut checkpoints = DirCheckpointer { dir: &opened.dir, config_entry: &entry, metrics: &metrics };
-        let outcome = fit(method, settings, &mut checkpoints, Some(point), &tee)?;
+        let mut checkpoints = DirCheckpointer { dir: &ckpt, config_entry: &entry, metrics: &metrics };
+        let outcome = fit(&mut trainer, &settings, &mut checkpoints, None, &tee)?;
         metrics.emit(&Event::Finished { ok: true });
-        return Ok(outcome);
+        return Ok(Trained { record, outcome, trainer });
     }
-    let ckpt = CheckpointDir::start(dir)?;
-    let entry = ckpt.write_file(CONFIG_FILE, &config_bytes)?;
-    let metrics_path = ckpt.file(METRICS_FILE);
-    let metrics = JsonlMonitor::create(&metrics_path).map_err(|e| Error::io(&metrics_path, e))?;
-    for event in view {
-        metrics.emit(event);
-    }
+    let opened = OpenedCheckpoint::open(dir)?;
+    // The config entry the run keeps: the checkpoint's own when resuming; when extending, none yet (the new
+    // record is staged once everything has been read from the checkpoint).
+    let kept_entry = if start == Start::Resume {
+        Some(check_resumable::<M>(&opened, &settings, &config)?)
+    } else if settings.total_steps <= opened.manifest.total_steps {
+        return Err(Error::config(format!(
+            "extending {} to {} steps: the run already has {}",
+            dir.display(),
+            settings.total_steps,
+            opened.manifest.total_steps
+        )));
+    } else {
+        None
+    };
+    // A checkpoint killed halfway into place is finished first, so this run stages its own cleanly.
+    opened.dir.settle()?;
+    trainer.restore(&opened.tensors(STATE_FILE)?)?;
+    let point = opened.resume_point()?;
+    let entry = match kept_entry {
+        Some(entry) => entry,
+        None => opened.dir.write_file(CONFIG_FILE, &config_bytes)?,
+    };
+    let metrics_path = opened.dir.file(METRICS_FILE);
+    let metrics =
+        JsonlMonitor::resume(&metrics_path, opened.manifest.metrics_bytes).map_err(|e| Error::io(&metrics_path, e))?;
+    monitor.message(&format!("resuming at step {} of {}", point.step, settings.total_steps));
     let tee = Tee { first: monitor, second: &metrics };
-    let mut checkpoints = DirCheckpointer { dir: &ckpt, config_entry: &entry, metrics: &metrics };
-    let outcome = fit(method, settings, &mut checkpoints, None, &tee)?;
+    let mut checkpoints = DirCheckpointer { dir: &opened.dir, config_entry: &entry, metrics: &metrics };
+    let outcome = fit(&mut trainer, &settings, &mut checkpoints, Some(point), &tee)?;
     metrics.emit(&Event::Finished { ok: true });
-    Ok(outcome)
+    Ok(Trained { record, outcome, trainer })
 }
 
 /// A plain resume needs an unfinished checkpoint of exactly this config; returns the config's manifest entry.
-fn check_resumable(opened: &OpenedCheckpoint, settings: &FitSettings, config_bytes: &[u8]) -> Result<FileEntry> {
+fn check_resumable<M: Method>(opened: &OpenedCheckpoint, settings: &FitSettings, config: &Value) -> Result<FileEntry> {
     if opened.manifest.total_steps != settings.total_steps {
         return Err(Error::bad_file(
             &opened.dir.file(CONFIG_FILE),
@@ -178,7 +239,11 @@ fn check_resumable(opened: &OpenedCheckpoint, settings: &FitSettings, config_byt
         ));
     }
     let entry = opened.manifest.files.get(CONFIG_FILE).cloned().expect("checked by OpenedCheckpoint::open");
-    if opened.dir.read_verified(CONFIG_FILE, &entry)? != config_bytes {
+    // Compared as the record it reads as today, so a run stopped under an older layout still resumes.
+    let mut stored: Value = serde_json::from_slice(&opened.dir.read_verified(CONFIG_FILE, &entry)?)
+        .map_err(|e| Error::bad_file(&opened.dir.file(CONFIG_FILE), format!("not valid JSON: {e}")))?;
+    M::upgrade(&mut stored);
+    if stored != *config {
         return Err(Error::bad_file(&opened.dir.file(CONFIG_FILE), "differs from the run being resumed"));
     }
     Ok(entry)

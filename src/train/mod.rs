@@ -7,6 +7,7 @@ pub mod data_file;
 pub mod datasets;
 pub mod fit;
 pub mod job;
+pub mod method;
 pub mod run_dir;
 pub mod state;
 pub mod tensors;
@@ -17,9 +18,8 @@ pub use fit::{
     fit, Budget, Checkpointer, DirCheckpointer, FitOutcome, FitSettings, MemoryCheckpointer, ResumePoint, Snapshot,
     TrainingMethod, CONFIG_FILE, MODEL_FILE, STATE_FILE,
 };
-pub use job::{
-    continuation, loss_panel, run_training, training_view, validation_panel, Continuation, Extension, Start,
-};
+pub use job::{continuation, loss_panel, training_view, validation_panel, Continuation, Extension, Start};
+pub use method::{Method, Prepared, Request, RunRecord, Trained};
 pub use tensors::StoredTensor;
 
 use std::path::Path;
@@ -108,15 +108,24 @@ impl OpenedCheckpoint {
         self.expect(method, Accept::Finished)
     }
 
+    /// Refuses checkpoints of another method.
+    pub fn expect_method(&self, method: &str) -> Result<()> {
+        if self.manifest.method != method {
+            return Err(Error::bad_file(
+                self.dir.path(),
+                format!(
+                    "is a '{}' checkpoint; this needs a {method} run (`mbrl train {method}`)",
+                    self.manifest.method
+                ),
+            ));
+        }
+        Ok(())
+    }
+
     /// Refuses checkpoints of another method, and, unless `accept` takes them, models still in training.
     pub fn expect(&self, method: &str, accept: Accept) -> Result<()> {
         let path = self.dir.path();
-        if self.manifest.method != method {
-            return Err(Error::bad_file(
-                path,
-                format!("is a '{}' checkpoint; expected '{method}'", self.manifest.method),
-            ));
-        }
+        self.expect_method(method)?;
         if !self.manifest.complete && accept == Accept::Finished {
             return Err(Error::bad_file(
                 path,
@@ -167,4 +176,13 @@ impl OpenedCheckpoint {
             best_weights: self.tensors(MODEL_FILE)?,
         })
     }
+}
+
+/// Opens a checkpoint of method `M` and reads its record, refusing another method's checkpoint and, unless
+/// `accept` takes it, a run still in training: what every loader starts with.
+pub fn open_run<M: Method>(dir: &Path, accept: Accept) -> Result<(OpenedCheckpoint, RunRecord<M>)> {
+    let opened = OpenedCheckpoint::open(dir)?;
+    opened.expect(M::NAME, accept)?;
+    let record = RunRecord::<M>::read(&opened)?;
+    Ok((opened, record))
 }

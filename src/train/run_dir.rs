@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use serde_json::Value;
 
 use super::job::MAX_TRAIN_STEPS;
+use super::method::{Method, Request};
 use super::{Extension, OpenedCheckpoint, CONFIG_FILE};
 use crate::error::{Error, Result};
 
@@ -16,22 +17,6 @@ pub enum Decision {
     Fresh,
     /// The stopped run there goes on, to its own total or, extended, to the total asked for.
     Resume(Option<Extension>),
-}
-
-/// A new run, described in the terms of the config.json it would write, to be compared with a stopped run's.
-pub struct RunRequest {
-    pub method: String,
-    /// The key of the method's settings in config.json (the ball EKF calls them `settings`).
-    pub config_key: &'static str,
-    pub config: Value,
-    /// The run's seed where config.json keeps it beside the settings (`None` where they hold it).
-    pub seed: Option<u64>,
-    pub data: Vec<PathBuf>,
-    /// Further fields of config.json that the command decides.
-    pub fields: Vec<Field>,
-    /// Whether the method trains to a larger total exactly as a run started with it (`--resume DIR --steps N`).
-    pub extendable: bool,
-    pub command_line: String,
 }
 
 /// A field of config.json, by JSON pointer, that a flag decides: what a message calls it, the value the
@@ -53,7 +38,7 @@ impl Field {
 /// new run starts by clearing the directory, so it would throw away every hour that run trained); with it, the
 /// stopped run goes on when `request` is what started it, and only then. A directory whose checkpoint cannot be
 /// read holds no run and is replaced, as a finished one is.
-pub fn decide(out: &Path, request: &RunRequest, resume_if_stopped: bool) -> Result<Decision> {
+pub fn decide<M: Method>(out: &Path, request: &Request<M>, resume_if_stopped: bool) -> Result<Decision> {
     let Ok(opened) = OpenedCheckpoint::open(out) else {
         return Ok(Decision::Fresh);
     };
@@ -73,12 +58,12 @@ pub fn decide(out: &Path, request: &RunRequest, resume_if_stopped: bool) -> Resu
             ),
         ));
     }
-    if manifest.method != request.method {
+    if manifest.method != M::NAME {
         return Err(Error::bad_file(
             out,
             format!(
                 "{stopped}, not a {} run; continue it with `mbrl train --resume {}`, or give another --out",
-                request.method,
+                M::NAME,
                 out.display()
             ),
         ));
@@ -96,31 +81,32 @@ pub fn decide(out: &Path, request: &RunRequest, resume_if_stopped: bool) -> Resu
             ),
         )
     };
-    let stored = &opened.config;
-    if let Some(seed) = request.seed {
-        let asked = Value::from(seed);
-        if stored.get("seed") != Some(&asked) {
-            return Err(differs("--seed", brief(stored.get("seed").unwrap_or(&Value::Null)), brief(&asked)));
-        }
+    let mut stored = opened.config.clone();
+    M::upgrade(&mut stored);
+    let stored = &stored;
+    let asked_seed = Value::from(request.seed);
+    if stored.get("seed") != Some(&asked_seed) {
+        return Err(differs("--seed", brief(stored.get("seed").unwrap_or(&Value::Null)), brief(&asked_seed)));
     }
     let stored_data = data_paths(stored);
     let asked_data: Vec<Value> = request.data.iter().map(|p| Value::from(p.display().to_string())).collect();
     if stored_data != asked_data {
         return Err(differs("--data", brief(&Value::Array(stored_data)), brief(&Value::Array(asked_data))));
     }
-    for field in &request.fields {
+    for field in &M::fixed_fields(request) {
         let found = stored.pointer(field.pointer).unwrap_or(&Value::Null);
         if *found != field.asked {
             return Err(differs(field.what, (field.show)(found), (field.show)(&field.asked)));
         }
     }
-    let stored_config = stored.get(request.config_key).unwrap_or(&Value::Null);
-    let asked_steps = request.config.get("steps").and_then(Value::as_u64);
+    let stored_config = stored.get("config").unwrap_or(&Value::Null);
     let mut extension = None;
-    match asked_steps {
+    let mut asked_config =
+        serde_json::to_value(&request.config).map_err(|e| Error::config(format!("{CONFIG_FILE}: {e}")))?;
+    match asked_config.get("steps").and_then(Value::as_u64) {
         Some(steps) if steps != manifest.total_steps => {
-            if !request.extendable || steps < manifest.total_steps || steps > MAX_TRAIN_STEPS {
-                let why = if request.extendable { "shorten" } else { "lengthen" };
+            if !M::EXTENDABLE || steps < manifest.total_steps || steps > MAX_TRAIN_STEPS {
+                let why = if M::EXTENDABLE { "shorten" } else { "lengthen" };
                 return Err(Error::bad_file(
                     out,
                     format!(
@@ -130,17 +116,16 @@ pub fn decide(out: &Path, request: &RunRequest, resume_if_stopped: bool) -> Resu
                     ),
                 ));
             }
-            extension = Some(Extension { steps, command_line: request.command_line.clone() });
+            extension = Some(Extension { steps, command_line: request.provenance.command_line.clone() });
         }
         _ => {}
     }
     // The total is the one field an extension may change; everything else must be what started the run.
-    let mut asked_config = request.config.clone();
     if let (Some(asked), Some(stored_steps)) = (asked_config.get_mut("steps"), stored_config.get("steps")) {
         *asked = stored_steps.clone();
     }
     if let Some((field, stored_value, asked_value)) = first_difference(stored_config, &asked_config, String::new()) {
-        return Err(differs(&format!("{}.{field}", request.config_key), brief(&stored_value), brief(&asked_value)));
+        return Err(differs(&format!("config.{field}"), brief(&stored_value), brief(&asked_value)));
     }
     Ok(Decision::Resume(extension))
 }

@@ -167,22 +167,25 @@ fn hdf5_input_without_the_feature_says_how_to_get_it() {
 
 #[test]
 fn ball_training_resumes_to_the_same_bytes_and_stopped_runs_are_not_models() {
-    use mbrl::models::ball::learn::job::{train_checkpointed, BallTrainRequest, CHECKPOINT_EVERY};
+    use mbrl::models::ball::learn::job::{BallEkf, CHECKPOINT_EVERY};
     use mbrl::models::ball::learn::TrainSettings;
+    use mbrl::train::job::start;
     let dir = tempfile::tempdir().unwrap();
     mbrl(dir.path())
         .args(["collect", "--env", "ball", "--trajectories", "6", "--out", "t.mcap", "-q"])
         .assert()
         .success();
-    let request = |out: &str| BallTrainRequest {
-        out: dir.path().join(out),
-        data: dir.path().join("t.mcap"),
-        settings: TrainSettings { steps: CHECKPOINT_EVERY + 20, batch_size: 8, seed: 3, ..TrainSettings::default() },
+    let request = mbrl::train::Request::<BallEkf> {
+        env: None,
+        data: vec![dir.path().join("t.mcap")],
+        seed: 3,
+        config: TrainSettings { steps: CHECKPOINT_EVERY + 20, batch_size: 8, seed: 3, ..TrainSettings::default() },
+        variant: (),
         provenance: mbrl::run::dir::Provenance::new("mbrl train …".into(), 3, 1),
     };
-    train_checkpointed(&request("whole"), false, &mbrl::run::NullMonitor).unwrap();
+    start(&dir.path().join("whole"), &request, &mbrl::run::NullMonitor).unwrap();
     let stop = StopAfter::new(CHECKPOINT_EVERY + 10);
-    assert!(matches!(train_checkpointed(&request("stopped"), false, &stop), Err(mbrl::Error::Cancelled)));
+    assert!(matches!(start(&dir.path().join("stopped"), &request, &stop), Err(mbrl::Error::Cancelled)));
     let out = mbrl(dir.path()).args(["predict", "--model", "stopped", "--input", "t.mcap", "-q"]).output().unwrap();
     assert!(!out.status.success() && stderr_of(&out).contains("--resume"), "{}", stderr_of(&out));
     // The filter's validation schedule hangs on the total, so a run cannot be lengthened.

@@ -7,7 +7,8 @@ use mbrl::data::read_dataset;
 use mbrl::models::dlgpd::config::{DlgpdConfig, Preset};
 use mbrl::models::dlgpd::job as dlgpd;
 use mbrl::run::dir::Provenance;
-use mbrl::train::Start;
+use mbrl::train::job::start;
+use mbrl::train::Request;
 
 fn collect(dir: &Path, name: &str, env: &str, rollouts: &str, images: bool) {
     let mut cmd = mbrl(dir);
@@ -121,17 +122,18 @@ fn resume_ends_with_the_bytes_of_an_uninterrupted_run() {
         checkpoint_every: 10,
         ..DlgpdConfig::preset(Preset::Small)
     };
-    let request = |out: &str| dlgpd::TrainRequest {
-        out: dir.path().join(out),
-        data: vec![dir.path().join("train.mcap")],
+    let request = Request::<dlgpd::Dlgpd> {
         env: None,
-        config: config.clone(),
+        data: vec![dir.path().join("train.mcap")],
         seed: 4,
+        config: config.clone(),
+        variant: (),
         provenance: Provenance::new("mbrl train …".into(), 4, 1),
     };
-    dlgpd::train(&request("whole"), Start::Fresh, &mbrl::run::NullMonitor).unwrap();
+    let run_dir = |name: &str| dir.path().join(name);
+    start(&run_dir("whole"), &request, &mbrl::run::NullMonitor).unwrap();
     let stop = StopAfter::new(25);
-    let err = dlgpd::train(&request("stopped"), Start::Fresh, &stop).err().unwrap();
+    let err = start(&run_dir("stopped"), &request, &stop).err().unwrap();
     assert!(matches!(err, mbrl::Error::Cancelled), "{err}");
 
     // A run still in training is refused, unless asked for; its report then says how far it got.
@@ -176,8 +178,8 @@ fn resume_ends_with_the_bytes_of_an_uninterrupted_run() {
     same_as_whole("stopped");
 
     // A finished run of 20 steps, trained on to 30, is the run that was started with 30.
-    let short = dlgpd::TrainRequest { config: DlgpdConfig { steps: 20, ..config.clone() }, ..request("short") };
-    dlgpd::train(&short, Start::Fresh, &mbrl::run::NullMonitor).unwrap();
+    let short = Request { config: DlgpdConfig { steps: 20, ..config.clone() }, ..request };
+    start(&run_dir("short"), &short, &mbrl::run::NullMonitor).unwrap();
     let extend = |steps: &str| {
         mbrl(dir.path()).args(["train", "--resume", "short", "--steps", steps, "--no-tui"]).output().unwrap()
     };
@@ -216,6 +218,6 @@ fn an_image_model_trains_a_few_steps_on_rendered_frames() {
         .unwrap();
     assert!(out.status.success(), "{}", stderr_of(&out));
     assert!(stdout_of(&out).contains("64×64 frames"), "{}", stdout_of(&out));
-    let trained = dlgpd::load(&dir.path().join("m")).unwrap();
+    let trained = dlgpd::load(&dir.path().join("m"), mbrl::train::Accept::Finished).unwrap();
     assert_eq!(trained.scale.mean.len(), 3);
 }

@@ -4,9 +4,10 @@ use std::path::Path;
 
 use crate::common::*;
 use mbrl::data::{read_dataset, write_dataset};
-use mbrl::models::pets::{self, PetsConfig, Preset};
+use mbrl::models::pets::{Pets, PetsConfig, Preset};
 use mbrl::run::dir::Provenance;
-use mbrl::train::Start;
+use mbrl::train::job::start;
+use mbrl::train::Request;
 
 /// A network small enough to train in a second; checkpoints every 20 steps.
 const TINY: &str = "hidden_layers = 2\nhidden_units = 16\nvalidate_every = 10\ncheckpoint_every = 20\n";
@@ -65,18 +66,19 @@ fn resume_ends_with_the_bytes_of_an_uninterrupted_run() {
     config = mbrl::train::config::apply_toml(&config, TINY).unwrap();
     config.ensemble = 2;
     config.steps = 70;
-    let request = |out: &str| pets::TrainRequest {
-        out: dir.path().join(out),
-        data: vec![dir.path().join("random.mcap")],
+    let request = Request::<Pets> {
         env: None,
-        config: config.clone(),
+        data: vec![dir.path().join("random.mcap")],
         seed: 5,
+        config: config.clone(),
+        variant: (),
         provenance: Provenance::new("mbrl train …".into(), 5, 1),
     };
-    pets::train(&request("whole"), Start::Fresh, &mbrl::run::NullMonitor).unwrap();
+    let run_dir = |name: &str| dir.path().join(name);
+    start(&run_dir("whole"), &request, &mbrl::run::NullMonitor).unwrap();
     // Stopped after step 50: the last checkpoint is step 40, so steps 41–50 are redone after resuming.
     let stop = StopAfter::new(50);
-    let err = pets::train(&request("stopped"), Start::Fresh, &stop).err().unwrap();
+    let err = start(&run_dir("stopped"), &request, &stop).err().unwrap();
     assert!(matches!(err, mbrl::Error::Cancelled), "{err}");
     let manifest: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dir.path().join("stopped/checkpoint.json")).unwrap()).unwrap();
@@ -103,8 +105,8 @@ fn resume_ends_with_the_bytes_of_an_uninterrupted_run() {
     same_as_whole(&dir_bytes(&dir.path().join("stopped")));
 
     // A finished run of 40 steps, trained on to 70, is the run that was started with 70.
-    let short = pets::TrainRequest { config: PetsConfig { steps: 40, ..config.clone() }, ..request("short") };
-    pets::train(&short, Start::Fresh, &mbrl::run::NullMonitor).unwrap();
+    let short = Request { config: PetsConfig { steps: 40, ..config.clone() }, ..request };
+    start(&run_dir("short"), &short, &mbrl::run::NullMonitor).unwrap();
     let out = mbrl(dir.path()).args(["train", "--resume", "short", "--steps", "70", "--no-tui"]).output().unwrap();
     assert!(out.status.success(), "{}", stderr_of(&out));
     assert_extended_like(&dir.path().join("whole"), &dir.path().join("short"));

@@ -7,6 +7,8 @@ use std::path::Path;
 use crate::common::*;
 use mbrl::models::seads::{self, EmbodiedGame, Preset, SeadsConfig};
 use mbrl::run::dir::Provenance;
+use mbrl::train::job::start;
+use mbrl::train::Request;
 
 fn run_ok(dir: &Path, args: &[&str]) -> String {
     let out = mbrl(dir).args(args).arg("--no-tui").output().unwrap();
@@ -71,18 +73,20 @@ fn resume_ends_with_the_bytes_of_an_uninterrupted_run() {
          env_steps = 400\n",
     )
     .unwrap();
-    let request = |out: &str| seads::TrainRequest {
-        out: dir.path().join(out),
-        env,
-        config: config.clone(),
+    let request = Request::<seads::Seads> {
+        env: Some(env.name()),
+        data: Vec::new(),
         seed: 3,
+        config: config.clone(),
+        variant: (),
         provenance: Provenance::new("mbrl train …".into(), 3, 1),
     };
-    let whole = seads::train(&request("whole"), false, &mbrl::run::NullMonitor).unwrap();
+    let run_dir = |name: &str| dir.path().join(name);
+    let whole = start(&run_dir("whole"), &request, &mbrl::run::NullMonitor).unwrap();
     assert!(whole.outcome.steps > 7, "too few epochs to test resuming: {}", whole.outcome.steps);
     // Stopped after epoch 6: the last checkpoint is epoch 4, so epochs 5 and 6 are redone after resuming.
     let stop = StopAfter::new(6);
-    let err = seads::train(&request("stopped"), false, &stop).err().unwrap();
+    let err = start(&run_dir("stopped"), &request, &stop).err().unwrap();
     assert!(matches!(err, mbrl::Error::Cancelled), "{err}");
     let out = mbrl(dir.path()).args(["train", "--resume", "stopped", "--no-tui"]).output().unwrap();
     assert!(out.status.success(), "{}", stderr_of(&out));

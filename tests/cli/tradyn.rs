@@ -155,7 +155,7 @@ fn train_calibrate_and_navigate_with_and_without_terrain_lookup() {
 
 #[test]
 fn resume_ends_with_the_bytes_of_an_uninterrupted_run() {
-    use mbrl::models::context::{self, ContextConfig, EnvFamily, Preset};
+    use mbrl::models::context::{ContextConfig, EnvFamily, Preset};
     use mbrl::models::tradyn;
     use mbrl::run::dir::Provenance;
     let dir = tempfile::tempdir().unwrap();
@@ -165,18 +165,17 @@ fn resume_ends_with_the_bytes_of_an_uninterrupted_run() {
     (config.embedding, config.hidden_units, config.transition_features, config.latent_dim) = (16, 16, 8, 4);
     (config.chunk_states, config.context_max, config.batch_size, config.steps) = (10, 4, 8, 30);
     (config.validate_every, config.checkpoint_every) = (10, 10);
-    let request = |out: &str| context::TrainRequest {
-        method: tradyn::METHOD.into(),
-        space: tradyn::state_space(true),
-        out: d.join(out),
-        data: d.join("uni.mcap"),
+    let request = mbrl::train::Request::<tradyn::Tradyn> {
         env: None,
-        config: config.clone(),
+        data: vec![d.join("uni.mcap")],
         seed: 3,
+        config: config.clone(),
+        variant: true,
         provenance: Provenance::new("mbrl train …".into(), 3, 1),
     };
-    context::train(&request("whole"), false, &mbrl::run::NullMonitor).unwrap();
-    let err = context::train(&request("stopped"), false, &StopAfter::new(25)).err().unwrap();
+    let start = mbrl::train::job::start::<tradyn::Tradyn>;
+    start(&d.join("whole"), &request, &mbrl::run::NullMonitor).unwrap();
+    let err = start(&d.join("stopped"), &request, &StopAfter::new(25)).err().unwrap();
     assert!(matches!(err, mbrl::Error::Cancelled), "{err}");
     run_ok(d, &["train", "--resume", "stopped", "-q"]);
     // The CLI adds its loss report after training; the library run writes none.

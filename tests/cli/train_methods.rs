@@ -7,7 +7,8 @@ use crate::common::*;
 use mbrl::models::pets;
 use mbrl::models::pets::options::PetsOptions;
 use mbrl::run::dir::Provenance;
-use mbrl::train::Start;
+use mbrl::train::job::start;
+use mbrl::train::Request;
 
 const TINY_PETS: &str = "hidden_layers = 2\nhidden_units = 16\nvalidate_every = 10\ncheckpoint_every = 20\n";
 
@@ -142,15 +143,15 @@ fn resume_if_stopped_goes_on_with_the_stopped_run_of_the_same_command() {
         ..PetsOptions::default()
     };
     let planned = options.plan(None, || Ok("pendulum".into()), Some(d.join("stopped"))).unwrap();
-    let request = pets::TrainRequest {
-        out: planned.out,
-        data: vec![d.join("roll.mcap")],
+    let request = Request::<pets::Pets> {
         env: None,
-        config: planned.config,
+        data: vec![d.join("roll.mcap")],
         seed: 4,
+        config: planned.config,
+        variant: (),
         provenance: Provenance::new("mbrl train …".into(), 4, 1),
     };
-    let err = pets::train(&request, Start::Fresh, &StopAfter::new(30)).err().unwrap();
+    let err = start(&planned.out, &request, &StopAfter::new(30)).err().unwrap();
     assert!(matches!(err, mbrl::Error::Cancelled), "{err}");
     assert_eq!(manifest(&d.join("stopped"))["complete"], false);
     let with_seed = |seed: &str, out: &str, extra: &[&str]| -> Vec<String> {
@@ -195,15 +196,15 @@ fn resume_if_stopped_extends_a_stopped_pets_run_asked_for_more_steps() {
     collect_rollouts(d);
     let options = PetsOptions { config_file: Some(d.join("tiny.toml")), steps: Some(40), ..PetsOptions::default() };
     let planned = options.plan(None, || Ok("pendulum".into()), Some(d.join("m"))).unwrap();
-    let request = pets::TrainRequest {
-        out: planned.out,
-        data: vec![d.join("roll.mcap")],
+    let request = Request::<pets::Pets> {
         env: None,
-        config: planned.config,
+        data: vec![d.join("roll.mcap")],
         seed: 0,
+        config: planned.config,
+        variant: (),
         provenance: Provenance::new("mbrl train …".into(), 0, 1),
     };
-    pets::train(&request, Start::Fresh, &StopAfter::new(25)).err().unwrap();
+    start(&planned.out, &request, &StopAfter::new(25)).err().unwrap();
     let data = d.join("roll.mcap").display().to_string();
     let tiny = d.join("tiny.toml").display().to_string();
     // The Makefile's spelling.

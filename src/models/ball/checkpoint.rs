@@ -3,13 +3,13 @@
 
 use std::path::Path;
 
-use super::learn::job::METHOD;
+use super::learn::job::BallEkf;
 use super::learn::SpinNetWeights;
 use super::{BallModel, BallModelParams, SpinPrior};
 use crate::data::ball_io::Recording;
 use crate::error::{Error, Result};
 use crate::train::checkpoint::read_bounded;
-use crate::train::OpenedCheckpoint;
+use crate::train::{open_run, Accept};
 
 pub const PARAMS_FILE: &str = "params.json";
 pub const SPIN_NET_FILE: &str = "spin_net.json";
@@ -69,8 +69,7 @@ const MAX_JSON_BYTES: u64 = 16 << 20;
 
 /// A directory written by `mbrl train ball-ekf`: every file checked against the manifest.
 fn load_checkpoint(dir: &Path) -> Result<(BallModelParams, Option<SpinNetWeights>)> {
-    let opened = OpenedCheckpoint::open(dir)?;
-    opened.expect_finished(METHOD)?;
+    let (opened, _record) = open_run::<BallEkf>(dir, Accept::Finished)?;
     let params_bytes = opened
         .file_bytes(PARAMS_FILE)?
         .ok_or_else(|| Error::bad_file(dir, format!("the checkpoint lists no {PARAMS_FILE}")))?;

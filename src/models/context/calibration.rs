@@ -231,7 +231,7 @@ pub fn calibrate(
     mut on_step: impl FnMut(&CalibrationStep),
 ) -> Result<Calibration> {
     settings.validate()?;
-    if model.run.model.observations && settings.strategy != Strategy::Random {
+    if model.run.details.model.observations && settings.strategy != Strategy::Random {
         return Err(Error::config(format!(
             "a {} model calibrates with random actions (thesis 5.4.2); supported: --strategy random",
             model.run.method
@@ -367,22 +367,23 @@ pub fn calibration_dataset(
 /// Model-space context rows from a context file (any rollout dataset of the model's env).
 pub fn read_context(model: &LoadedModel, path: &std::path::Path) -> Result<Vec<f32>> {
     let dataset = crate::data::read_dataset(path)?;
-    if dataset.meta.env != model.run.env {
+    if dataset.meta.env != model.run.env() {
         return Err(Error::bad_file(
             path,
-            format!("holds transitions of '{}'; the model is of '{}'", dataset.meta.env, model.run.env),
+            format!("holds transitions of '{}'; the model is of '{}'", dataset.meta.env, model.run.env()),
         ));
     }
-    let names_match = model.run.model.observations || dataset.meta.state_names == model.run.model.state_names;
-    if !names_match || dataset.meta.action_dim != model.run.model.action_dim {
+    let names_match =
+        model.run.details.model.observations || dataset.meta.state_names == model.run.details.model.state_names;
+    if !names_match || dataset.meta.action_dim != model.run.details.model.action_dim {
         return Err(Error::bad_file(
             path,
             format!(
                 "has states ({}) and {} action dimensions; the model expects ({}) and {}",
                 dataset.meta.state_names.join(", "),
                 dataset.meta.action_dim,
-                model.run.model.state_names.join(", "),
-                model.run.model.action_dim
+                model.run.details.model.state_names.join(", "),
+                model.run.details.model.action_dim
             ),
         ));
     }

@@ -53,7 +53,7 @@ impl ContextDynamics {
 
     fn to_state(&self, features: &[f32], out: &mut [f64]) {
         let mut k = 0;
-        for (slot, angular) in out.iter_mut().zip(&self.model.run.model.angular) {
+        for (slot, angular) in out.iter_mut().zip(&self.model.run.details.model.angular) {
             if *angular {
                 *slot = (features[k + 1] as f64).atan2(features[k] as f64);
                 k += 2;
@@ -67,11 +67,11 @@ impl ContextDynamics {
 
 impl BatchDynamics for ContextDynamics {
     fn state_dim(&self) -> usize {
-        self.model.run.model.angular.len()
+        self.model.run.details.model.angular.len()
     }
 
     fn action_dim(&self) -> usize {
-        self.model.run.model.action_dim
+        self.model.run.details.model.action_dim
     }
 
     fn rollout(

@@ -24,12 +24,10 @@ pub use train::ContextTrainer;
 use crate::data::{read_dataset, Dataset};
 use crate::envs::EnvName;
 use crate::error::{Error, Result};
-use crate::run::dir::Provenance;
-use crate::run::Monitor;
 use crate::train::tensors::to_params;
 use crate::train::{
-    loss_panel, run_training, training_view, Accept, DataFile, FitOutcome, FitSettings, OpenedCheckpoint, Start,
-    TrainingProgress, MODEL_FILE,
+    loss_panel, open_run, training_view, Accept, DataFile, FitOutcome, Method, OpenedCheckpoint, Prepared, Request,
+    RunRecord, Trained, TrainingProgress, MODEL_FILE,
 };
 use data::{ContextData, Episode, InstancePair};
 
@@ -67,20 +65,62 @@ pub enum StateSpace {
     Observation { names: Vec<String>, local_dim: usize },
 }
 
-/// config.json of a context-model checkpoint.
+/// What a context-model run records beyond the shared fields.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct ContextRun {
-    pub method: String,
-    pub env: String,
-    pub data: Vec<DataFile>,
-    pub seed: u64,
+pub struct ContextDetails {
     pub model: ModelSpec,
-    pub config: ContextConfig,
     pub instances: InstanceCounts,
     /// States per training chunk actually used (the config's, or fewer for short rollouts).
     pub chunk_states: usize,
-    pub provenance: Provenance,
+}
+
+/// config.json of a context-model checkpoint (TRADYN's too, read as one).
+pub type ContextRun = RunRecord<Context>;
+
+/// Explore the Context's model as the training job drives it.
+pub struct Context;
+
+impl Method for Context {
+    const NAME: &'static str = METHOD;
+    const TITLE: &'static str = "context-model";
+    type Config = ContextConfig;
+    type Variant = ();
+    type Details = ContextDetails;
+    type Trainer = ContextTrainer;
+
+    fn total_steps(config: &ContextConfig) -> u64 {
+        config.steps
+    }
+
+    fn schedule(config: &ContextConfig) -> (u64, u64) {
+        (config.validate_every, config.checkpoint_every)
+    }
+
+    fn validate(config: &ContextConfig) -> Result<()> {
+        config.validate()
+    }
+
+    fn prepare(request: &Request<Self>) -> Result<Prepared<Self>> {
+        prepare_model(request, &StateSpace::EnvState)
+    }
+
+    fn variant_of(_record: &ContextRun) -> Result<()> {
+        Ok(())
+    }
+
+    fn check_record(record: &ContextRun) -> Result<()> {
+        check_details(&record.details, &record.data)
+    }
+}
+
+/// The checks every record of this network passes: sizes that agree, and a dataset to resume from.
+pub fn check_details(details: &ContextDetails, data: &[DataFile]) -> Result<()> {
+    details.model.validate().map_err(|e| Error::config(format!("model: {e}")))?;
+    if data.len() != 1 {
+        return Err(Error::config(format!("lists {} training data files; a context model trains on one", data.len())));
+    }
+    Ok(())
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -88,24 +128,6 @@ pub struct ContextRun {
 pub struct InstanceCounts {
     pub train: usize,
     pub valid: usize,
-}
-
-pub struct TrainRequest {
-    /// The checkpoint's method name (`context`, or `tradyn` for the terrain-aware variant).
-    pub method: String,
-    pub space: StateSpace,
-    pub out: PathBuf,
-    pub data: PathBuf,
-    pub env: Option<String>,
-    pub config: ContextConfig,
-    pub seed: u64,
-    pub provenance: Provenance,
-}
-
-pub struct TrainReport {
-    pub run: ContextRun,
-    pub outcome: FitOutcome,
-    pub parameters: usize,
 }
 
 /// The Table B.1 column an env belongs to.
@@ -165,45 +187,30 @@ pub fn instance_pairs(dataset: &Dataset, path: &Path, spec: &ModelSpec) -> Resul
     })
 }
 
-/// Trains (or, with `resume`, continues) a context model into `request.out`.
-pub fn train(request: &TrainRequest, resume: bool, monitor: &dyn Monitor) -> Result<TrainReport> {
-    request.config.validate()?;
-    let file = DataFile::fingerprint(&request.data)?;
-    let dataset = read_dataset(&request.data)?;
-    let env = crate::train::datasets::env_of(&dataset, request.env.as_deref(), &request.data)?;
-    let model = model_spec(&request.space, &env, &dataset, &request.data)?;
-    let all = instance_pairs(&dataset, &request.data, &model)?;
-    let (train_data, valid_data) = all.split(request.config.validation_fraction, request.seed);
-    let chunk_states = train_data.chunk_states(request.config.chunk_states)?;
-    let run = ContextRun {
-        method: request.method.clone(),
-        env: env.canonical(),
-        data: vec![file],
-        seed: request.seed,
-        model,
-        config: request.config.clone(),
-        instances: InstanceCounts { train: train_data.len(), valid: valid_data.len() },
-        chunk_states,
-        provenance: request.provenance.clone(),
+/// Builds the trainer of a context model (Explore the Context's, or TRADYN's on `space`) from a request.
+pub fn prepare_model<M>(request: &Request<M>, space: &StateSpace) -> Result<Prepared<M>>
+where
+    M: Method<Config = ContextConfig, Details = ContextDetails, Trainer = ContextTrainer>,
+{
+    let [path] = request.data.as_slice() else {
+        return Err(Error::config(format!("a context model trains on one dataset, got {}", request.data.len())));
     };
-    let mut trainer = ContextTrainer::new(request.config.clone(), request.seed, train_data, valid_data)?;
-    let parameters = trainer.parameter_count();
-    let settings = FitSettings {
-        method: request.method.clone(),
-        env: Some(run.env.clone()),
-        total_steps: request.config.steps,
-        validate_every: request.config.validate_every,
-        checkpoint_every: request.config.checkpoint_every,
-    };
-    let config = serde_json::to_value(&run).map_err(|e| Error::config(e.to_string()))?;
-    let title = format!("train {} model on {}", run.method, run.env);
+    let file = DataFile::fingerprint(path)?;
+    let dataset = read_dataset(path)?;
+    let env = crate::train::datasets::env_of(&dataset, request.env.as_deref(), path)?;
+    let model = model_spec(space, &env, &dataset, path)?;
+    let all = instance_pairs(&dataset, path, &model)?;
     let c = &request.config;
+    let (train_data, valid_data) = all.split(c.validation_fraction, request.seed);
+    let chunk_states = train_data.chunk_states(c.chunk_states)?;
+    let instances = InstanceCounts { train: train_data.len(), valid: valid_data.len() };
+    let trainer = ContextTrainer::new(c.clone(), request.seed, train_data, valid_data)?;
     let schedule = c.context_from_target;
     let view = training_view(
-        &title,
+        &format!("train {} model on {}", M::NAME, env.canonical()),
         vec![loss_panel("loss, eq. 4.32 (train, held-out)", true)],
         &[
-            ("instances", format!("{} train / {} valid", run.instances.train, run.instances.valid)),
+            ("instances", format!("{} train / {} valid", instances.train, instances.valid)),
             ("batch", format!("{} × {chunk_states} states", c.batch_size)),
             ("learning rate", format!("{}", c.optimizer.learning_rate)),
             ("KL", format!("weight {}, floor {}", c.kl_weight, c.kl_floor)),
@@ -215,12 +222,69 @@ pub fn train(request: &TrainRequest, resume: bool, monitor: &dyn Monitor) -> Res
                     "0".to_string()
                 },
             ),
-            ("parameters", parameters.to_string()),
+            ("parameters", trainer.parameter_count().to_string()),
         ],
     );
-    let outcome =
-        run_training(&request.out, &config, &settings, &mut trainer, Start::resuming(resume), &view, monitor)?;
-    Ok(TrainReport { run, outcome, parameters })
+    Ok(Prepared {
+        env: Some(env.canonical()),
+        data: vec![file],
+        details: ContextDetails { model, instances, chunk_states },
+        trainer,
+        view,
+    })
+}
+
+/// What `mbrl train context` and `mbrl train tradyn` report of a finished run.
+pub struct ContextSummary {
+    /// "a context model", "a TRADYN model with terrain lookup".
+    pub what: String,
+    pub record: ContextRun,
+    pub outcome: FitOutcome,
+    pub parameters: usize,
+    pub dir: PathBuf,
+}
+
+impl ContextSummary {
+    pub fn of<M>(what: String, trained: &Trained<M>, dir: &Path) -> Self
+    where
+        M: Method<Config = ContextConfig, Details = ContextDetails, Trainer = ContextTrainer>,
+    {
+        ContextSummary {
+            what,
+            record: trained.record.clone().retag(),
+            outcome: trained.outcome.clone(),
+            parameters: trained.trainer.parameter_count(),
+            dir: dir.to_path_buf(),
+        }
+    }
+}
+
+impl std::fmt::Display for ContextSummary {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let (run, c) = (&self.record, &self.record.config);
+        writeln!(
+            f,
+            "trained {} (embedding {}, D_F {}, D_β {}, {} parameters) on {} instances of {} ({} held out), batch {} × {} states",
+            self.what,
+            c.embedding,
+            c.transition_features,
+            c.latent_dim,
+            self.parameters,
+            run.details.instances.train,
+            run.env(),
+            run.details.instances.valid,
+            c.batch_size,
+            run.details.chunk_states
+        )?;
+        let o = &self.outcome;
+        if let Some(loss) = o.last_train_loss {
+            writeln!(f, "final training loss {loss:.4} after {} steps", o.steps)?;
+        }
+        if let (Some(step), Some(v)) = (o.best_step, o.best_valid_loss) {
+            writeln!(f, "best validation loss {v:.4} at step {step} (saved as model.safetensors)")?;
+        }
+        write!(f, "checkpoint: {}", self.dir.display())
+    }
 }
 
 /// The model's state space for `env`'s data, checked against the dataset's sizes.
@@ -254,17 +318,6 @@ fn model_spec(space: &StateSpace, env: &EnvName, dataset: &Dataset, path: &Path)
             local_dim: *local_dim,
         }),
     }
-}
-
-pub fn read_run(opened: &OpenedCheckpoint) -> Result<ContextRun> {
-    let path = opened.dir.file("config.json");
-    let run: ContextRun = serde_json::from_value(opened.config.clone())
-        .map_err(|e| Error::bad_file(&path, format!("not a context-model run config: {e}")))?;
-    run.model.validate().map_err(|e| Error::bad_file(&path, format!("model: {e}")))?;
-    if run.data.is_empty() {
-        return Err(Error::bad_file(&path, "lists no training data file"));
-    }
-    Ok(run)
 }
 
 /// Far above any env mbrl simulates; beyond it a size in config.json is corrupt.
@@ -302,32 +355,6 @@ impl ModelSpec {
     }
 }
 
-/// Continues the run in `dir` from its last checkpoint, with the config and data it was started with.
-pub fn resume(dir: &Path, monitor: &dyn Monitor) -> Result<TrainReport> {
-    let opened = OpenedCheckpoint::open(dir)?;
-    let run = read_run(&opened)?;
-    opened.expect_total_steps(run.config.steps as u64)?;
-    for file in &run.data {
-        file.verify_unchanged()?;
-    }
-    let space = if run.model.observations {
-        StateSpace::Observation { names: run.model.state_names.clone(), local_dim: run.model.local_dim }
-    } else {
-        StateSpace::EnvState
-    };
-    let request = TrainRequest {
-        method: run.method.clone(),
-        space,
-        out: dir.to_path_buf(),
-        data: run.data[0].path.clone(),
-        env: Some(run.env.clone()),
-        config: run.config.clone(),
-        seed: run.seed,
-        provenance: run.provenance.clone(),
-    };
-    train(&request, true, monitor)
-}
-
 /// A finished context model, ready to calibrate and plan in `env`.
 #[derive(Clone)]
 pub struct LoadedModel {
@@ -341,7 +368,7 @@ impl LoadedModel {
     /// The model's state for an env state and its observation: the observation itself for a model of
     /// observations (which must then be given, with the model's width), else the state's features.
     pub fn model_state(&self, state: &[f64], observation: Option<&Vec<f64>>) -> Result<Vec<f32>> {
-        let spec = &self.run.model;
+        let spec = &self.run.details.model;
         if !spec.observations {
             return Ok(self.features(state));
         }
@@ -359,50 +386,29 @@ impl LoadedModel {
 
     /// Model-space features of an env state (a model of the env's state; TRADYN models observations).
     pub fn features(&self, state: &[f64]) -> Vec<f32> {
-        let mut out = Vec::with_capacity(self.run.model.feature_dim);
-        crate::nn::features::features(state, &[], &self.run.model.angular, &mut out);
+        let spec = &self.run.details.model;
+        let mut out = Vec::with_capacity(spec.feature_dim);
+        crate::nn::features::features(state, &[], &spec.angular, &mut out);
         out
     }
 }
 
-/// Loads a finished context-model checkpoint for `env` (which must be the env it was trained on).
-pub fn load(dir: &Path, env: &EnvName) -> Result<LoadedModel> {
-    load_method(dir, env, METHOD)
-}
-
-/// Loads a finished checkpoint of this module's network made by `method` (`context` or `tradyn`).
-pub fn load_method(dir: &Path, env: &EnvName, method: &str) -> Result<LoadedModel> {
-    load_method_accepting(dir, env, method, Accept::Finished)
-}
-
 /// A context model of `env`, finished or (with [`Accept::InProgress`]) still training: then its
 /// best-validation weights so far.
-pub fn load_accepting(dir: &Path, env: &EnvName, accept: Accept) -> Result<LoadedModel> {
-    load_method_accepting(dir, env, METHOD, accept)
+pub fn load(dir: &Path, env: &EnvName, accept: Accept) -> Result<LoadedModel> {
+    let (opened, run) = open_run::<Context>(dir, accept)?;
+    model_from(&opened, run, env)
 }
 
-/// As [`load_method`], also taking a run still in training when `accept` does.
-pub fn load_method_accepting(dir: &Path, env: &EnvName, method: &str, accept: Accept) -> Result<LoadedModel> {
-    let opened = OpenedCheckpoint::open(dir)?;
-    if opened.manifest.method != method {
-        return Err(Error::bad_file(
-            dir,
-            format!(
-                "is a '{}' checkpoint; this needs a {method} model (`mbrl train {method}`)",
-                opened.manifest.method
-            ),
-        ));
+/// The model of an opened checkpoint of this network (made by `context` or `tradyn`) whose record is `run`.
+pub fn model_from(opened: &OpenedCheckpoint, run: ContextRun, env: &EnvName) -> Result<LoadedModel> {
+    let dir = opened.dir.path();
+    if run.env() != env.canonical() {
+        return Err(Error::bad_file(dir, format!("is a model of '{}', not of '{}'", run.env(), env.canonical())));
     }
-    opened.expect(method, accept)?;
-    let run = read_run(&opened)?;
-    if run.env != env.canonical() {
-        return Err(Error::bad_file(dir, format!("is a model of '{}', not of '{}'", run.env, env.canonical())));
-    }
-    let config_path = opened.dir.file("config.json");
-    run.config.validate().map_err(|e| Error::bad_file(&config_path, e.to_string()))?;
     let model_path = opened.dir.file(MODEL_FILE);
     let device = crate::nn::tensor::inference_device();
-    let m = &run.model;
+    let m = &run.details.model;
     let layout_net = train::init_net(&run.config, m.feature_dim, m.action_dim, m.local_dim, 0, &device);
     let layout = crate::nn::ParamSet::<f32>::from_module(&layout_net, net::param_name);
     let params = to_params(&model_path, &opened.tensors(MODEL_FILE)?, &layout)?;

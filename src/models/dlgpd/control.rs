@@ -43,11 +43,11 @@ const OBJECTIVE_STREAM: u64 = 4;
 /// The trained model's GPs conditioned on the evidence in `data` (encoder means of every transition's two
 /// observations; the observation noise is drawn from `seed` as at training).
 pub fn condition_on(trained: &TrainedDlgpd, data: &Dataset, seed: u64) -> Result<LatentDynamics> {
-    let windows = Windows::from_dataset(data, trained.run.observation, seed)?;
-    if windows.action_dim != trained.run.action_dim {
+    let windows = Windows::from_dataset(data, trained.run.details.observation, seed)?;
+    if windows.action_dim != trained.run.details.action_dim {
         return Err(Error::data(format!(
             "evidence actions have {} dimensions; the model was trained with {}",
-            windows.action_dim, trained.run.action_dim
+            windows.action_dim, trained.run.details.action_dim
         )));
     }
     let rows: Vec<usize> = (0..windows.len()).collect();
@@ -206,7 +206,7 @@ impl Agent for ImageAgent<'_> {
     fn act(&mut self, t: usize, _state: &[f64], _observation: &[f64]) -> Result<Vec<f64>> {
         let monitor = self.monitor;
         let input: Vec<f32> = self.previous.iter().chain(&self.current).copied().collect();
-        let width = self.trained.run.observation.input_len();
+        let width = self.trained.run.details.observation.input_len();
         let (mean, std) = encode_rows(&self.trained.vae, &input, width, &inference_device());
         let mean: Vec<f64> = mean.into_iter().map(f64::from).collect();
         let variance: Vec<f64> = std.into_iter().map(|s| f64::from(s) * f64::from(s)).collect();
@@ -242,7 +242,7 @@ pub fn swing_up(
     let mut env = Pendulum::new(settings.variant.clone()).with_start(StartDistribution::Hanging);
     let mut rng = rng_for(seed, &[EPISODE_STREAM]);
     env.reset(&mut rng);
-    let mut observer = Observer::new(trained.run.observation, seed);
+    let mut observer = Observer::new(trained.run.details.observation, seed);
     let previous = observer.observe(env.state()[0]);
     let warm_up = 0.1 * rng.random_range(-2.0..2.0);
     env.step(&[warm_up]);

@@ -16,48 +16,31 @@ use super::vae::VaeNet;
 use crate::error::{Error, Result};
 use crate::models::gp::GpHypers;
 use crate::nn::tensor::inference_device;
-use crate::run::dir::Provenance;
-use crate::run::Monitor;
 use crate::train::datasets::{env_of, load_datasets, TransitionCounts};
 use crate::train::tensors::TensorData;
 use crate::train::{
-    continuation, loss_panel, run_training, training_view, Accept, DataFile, Extension, FitOutcome, FitSettings,
-    OpenedCheckpoint, Start, TrainingProgress, MODEL_FILE,
+    loss_panel, open_run, training_view, Accept, FitOutcome, Method, Prepared, Request, RunRecord, Trained,
+    TrainingProgress, MODEL_FILE,
 };
 use crate::util::seeding::rng_for;
 
 pub const METHOD: &str = "dlgpd";
 const SPLIT_STREAM: u64 = u64::from_be_bytes(*b"dlgpdval");
 
-/// config.json of a DLGPD checkpoint.
+/// What a DLGPD run records beyond the shared fields.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct DlgpdRun {
-    pub method: String,
-    pub env: String,
-    pub data: Vec<DataFile>,
-    pub seed: u64,
+pub struct DlgpdDetails {
     pub observation: ObservationKind,
     pub action_dim: usize,
-    pub config: DlgpdConfig,
     pub transitions: TransitionCounts,
-    pub provenance: Provenance,
 }
 
-pub struct TrainRequest {
-    pub out: PathBuf,
-    pub data: Vec<PathBuf>,
-    pub env: Option<String>,
-    pub config: DlgpdConfig,
-    pub seed: u64,
-    pub provenance: Provenance,
-}
+/// config.json of a DLGPD checkpoint.
+pub type DlgpdRun = RunRecord<Dlgpd>;
 
-pub struct TrainReport {
-    pub run: DlgpdRun,
-    pub outcome: FitOutcome,
-    pub parameters: usize,
-}
+/// DLGPD as the training job drives it.
+pub struct Dlgpd;
 
 /// Rows of held-out and training transitions: whole rollouts, a seeded share held out.
 fn split_rows(windows: &Windows, fraction: f64, seed: u64) -> (Vec<usize>, Vec<usize>, TransitionCounts) {
@@ -81,112 +64,142 @@ fn split_rows(windows: &Windows, fraction: f64, seed: u64) -> (Vec<usize>, Vec<u
     (train, valid, counts)
 }
 
-/// Trains DLGPD into `request.out`, fresh or continuing the run there (see [`Start`]).
-pub fn train(request: &TrainRequest, start: Start, monitor: &dyn Monitor) -> Result<TrainReport> {
-    request.config.validate()?;
-    let (dataset, files) = load_datasets(&request.data)?;
-    let env = env_of(&dataset, request.env.as_deref(), &request.data[0])?;
-    if !env.canonical().starts_with("pendulum") {
-        return Err(Error::bad_file(
-            &request.data[0],
-            format!("holds '{}' rollouts; DLGPD learns the pendulum (pendulum[:variant] datasets)", env.canonical()),
-        ));
+impl Method for Dlgpd {
+    const NAME: &'static str = METHOD;
+    const TITLE: &'static str = "DLGPD";
+    const EXTENDABLE: bool = true;
+    type Config = DlgpdConfig;
+    type Variant = ();
+    type Details = DlgpdDetails;
+    type Trainer = DlgpdTrainer;
+
+    fn total_steps(config: &DlgpdConfig) -> u64 {
+        config.steps
     }
-    let kind = ObservationKind::of(&dataset, request.config.images)
-        .map_err(|e| Error::bad_file(&request.data[0], e.to_string()))?;
-    let windows = Windows::from_dataset(&dataset, kind, request.seed)
-        .map_err(|e| Error::bad_file(&request.data[0], e.to_string()))?;
-    drop(dataset);
-    let (train_rows, valid_rows, counts) = split_rows(&windows, request.config.validation_fraction, request.seed);
-    let run = DlgpdRun {
-        method: METHOD.into(),
-        env: env.canonical(),
-        data: files,
-        seed: request.seed,
-        observation: kind,
-        action_dim: windows.action_dim,
-        config: request.config.clone(),
-        transitions: counts,
-        provenance: request.provenance.clone(),
-    };
-    let mut trainer = DlgpdTrainer::new(request.config.clone(), request.seed, windows, train_rows, valid_rows)?;
-    let parameters = trainer.parameter_count();
-    let settings = FitSettings {
-        method: METHOD.into(),
-        env: Some(run.env.clone()),
-        total_steps: request.config.steps,
-        validate_every: request.config.validate_every,
-        checkpoint_every: request.config.checkpoint_every,
-    };
-    let config = serde_json::to_value(&run).map_err(|e| Error::config(e.to_string()))?;
-    let observed = match kind {
-        ObservationKind::Images { side } => format!("{side}×{side} frames"),
-        ObservationKind::Angles => "pole angles".to_string(),
-    };
-    let c = &request.config;
-    let view = training_view(
-        &format!("train DLGPD on {}", run.env),
-        vec![
-            loss_panel("loss: −ELBO (train, held-out)", true),
-            crate::run::PanelSpec {
-                title: "reward RMSE on held-out rollouts (open loop 5, 10 steps; constant)".into(),
-                x_label: "step".into(),
-                series: ["valid/reward_rmse_h5", "valid/reward_rmse_h10", "valid/reward_rmse_constant"]
-                    .map(String::from)
-                    .to_vec(),
-                restart_on_rewind: false,
-                path: None,
-            },
-            crate::run::PanelSpec {
-                title: "GP action lengthscale (min; actions span 4)".into(),
-                x_label: "step".into(),
-                series: vec!["dlgpd/action_lengthscale".into()],
-                restart_on_rewind: false,
-                path: None,
-            },
-        ],
-        &[
-            ("observations", observed),
-            ("transitions", format!("{} train / {} valid", run.transitions.train, run.transitions.valid)),
-            ("batch", format!("{} (= GP evidence)", c.batch_size)),
-            ("learning rate", format!("{} (VAE, GPs)", c.learning_rate)),
-            ("latent size", c.latent_dim.to_string()),
-            ("parameters", parameters.to_string()),
-        ],
-    );
-    let outcome = run_training(&request.out, &config, &settings, &mut trainer, start, &view, monitor)?;
-    Ok(TrainReport { run, outcome, parameters })
+
+    fn with_total_steps(config: &DlgpdConfig, steps: u64) -> DlgpdConfig {
+        DlgpdConfig { steps, ..config.clone() }
+    }
+
+    fn schedule(config: &DlgpdConfig) -> (u64, u64) {
+        (config.validate_every, config.checkpoint_every)
+    }
+
+    fn validate(config: &DlgpdConfig) -> Result<()> {
+        config.validate()
+    }
+
+    fn prepare(request: &Request<Self>) -> Result<Prepared<Self>> {
+        let (dataset, files) = load_datasets(&request.data)?;
+        let first = &request.data[0];
+        let env = env_of(&dataset, request.env.as_deref(), first)?;
+        if !env.canonical().starts_with("pendulum") {
+            return Err(Error::bad_file(
+                first,
+                format!(
+                    "holds '{}' rollouts; DLGPD learns the pendulum (pendulum[:variant] datasets)",
+                    env.canonical()
+                ),
+            ));
+        }
+        let c = &request.config;
+        let kind = ObservationKind::of(&dataset, c.images).map_err(|e| Error::bad_file(first, e.to_string()))?;
+        let windows =
+            Windows::from_dataset(&dataset, kind, request.seed).map_err(|e| Error::bad_file(first, e.to_string()))?;
+        drop(dataset);
+        let (train_rows, valid_rows, counts) = split_rows(&windows, c.validation_fraction, request.seed);
+        let details = DlgpdDetails { observation: kind, action_dim: windows.action_dim, transitions: counts };
+        let trainer = DlgpdTrainer::new(c.clone(), request.seed, windows, train_rows, valid_rows)?;
+        let observed = match kind {
+            ObservationKind::Images { side } => format!("{side}×{side} frames"),
+            ObservationKind::Angles => "pole angles".to_string(),
+        };
+        let t = &details.transitions;
+        let view = training_view(
+            &format!("train DLGPD on {}", env.canonical()),
+            vec![
+                loss_panel("loss: −ELBO (train, held-out)", true),
+                crate::run::PanelSpec {
+                    title: "reward RMSE on held-out rollouts (open loop 5, 10 steps; constant)".into(),
+                    x_label: "step".into(),
+                    series: ["valid/reward_rmse_h5", "valid/reward_rmse_h10", "valid/reward_rmse_constant"]
+                        .map(String::from)
+                        .to_vec(),
+                    restart_on_rewind: false,
+                    path: None,
+                },
+                crate::run::PanelSpec {
+                    title: "GP action lengthscale (min; actions span 4)".into(),
+                    x_label: "step".into(),
+                    series: vec!["dlgpd/action_lengthscale".into()],
+                    restart_on_rewind: false,
+                    path: None,
+                },
+            ],
+            &[
+                ("observations", observed),
+                ("transitions", format!("{} train / {} valid", t.train, t.valid)),
+                ("batch", format!("{} (= GP evidence)", c.batch_size)),
+                ("learning rate", format!("{} (VAE, GPs)", c.learning_rate)),
+                ("latent size", c.latent_dim.to_string()),
+                ("parameters", trainer.parameter_count().to_string()),
+            ],
+        );
+        Ok(Prepared { env: Some(env.canonical()), data: files, details, trainer, view })
+    }
+
+    fn variant_of(_record: &DlgpdRun) -> Result<()> {
+        Ok(())
+    }
 }
 
-fn read_run(opened: &OpenedCheckpoint) -> Result<DlgpdRun> {
-    let path = opened.dir.file("config.json");
-    let run: DlgpdRun = serde_json::from_value(opened.config.clone())
-        .map_err(|e| Error::bad_file(&path, format!("not a DLGPD run config: {e}")))?;
-    run.config.validate().map_err(|e| Error::bad_file(&path, e.to_string()))?;
-    Ok(run)
+/// What `mbrl train dlgpd` reports of a finished run.
+pub struct DlgpdSummary {
+    pub record: DlgpdRun,
+    pub outcome: FitOutcome,
+    pub parameters: usize,
+    pub dir: PathBuf,
 }
 
-/// Continues the run in `dir` from its last checkpoint, with the config and data it was started with; with
-/// `extend_to`, on to that many steps in total (the run may be finished: its training does not depend on the
-/// total, so its weights end as those of a run started with that total, provided its old total fell on a
-/// validation).
-pub fn resume(dir: &Path, extend_to: Option<&Extension>, monitor: &dyn Monitor) -> Result<TrainReport> {
-    let opened = OpenedCheckpoint::open(dir)?;
-    let run = read_run(&opened)?;
-    opened.expect_total_steps(run.config.steps as u64)?;
-    let next = continuation(&opened, run.config.steps, &run.provenance, extend_to)?;
-    for file in &run.data {
-        file.verify_unchanged()?;
+impl DlgpdSummary {
+    pub fn of(trained: &Trained<Dlgpd>, dir: &Path) -> Self {
+        DlgpdSummary {
+            record: trained.record.clone(),
+            outcome: trained.outcome.clone(),
+            parameters: trained.trainer.parameter_count(),
+            dir: dir.to_path_buf(),
+        }
     }
-    let request = TrainRequest {
-        out: dir.to_path_buf(),
-        data: run.data.iter().map(|f| f.path.clone()).collect(),
-        env: Some(run.env.clone()),
-        config: DlgpdConfig { steps: next.steps, ..run.config.clone() },
-        seed: run.seed,
-        provenance: next.provenance,
-    };
-    train(&request, next.start, monitor)
+}
+
+impl std::fmt::Display for DlgpdSummary {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let (run, c) = (&self.record, &self.record.config);
+        let observed = match run.details.observation {
+            ObservationKind::Images { side } => format!("{side}×{side} frames (conv VAE)"),
+            ObservationKind::Angles => "pole angles (MLP VAE, small preset)".to_string(),
+        };
+        let t = &run.details.transitions;
+        writeln!(
+            f,
+            "trained DLGPD ({} parameters, latent {}) on {} transitions of {} from {observed} ({} rollouts; {} held out), batch {}",
+            self.parameters,
+            c.latent_dim,
+            t.train,
+            run.env(),
+            t.train_rollouts,
+            t.valid_rollouts,
+            c.batch_size
+        )?;
+        let o = &self.outcome;
+        if let Some(loss) = o.last_train_loss {
+            writeln!(f, "final training loss {loss:.3} after {} steps", o.steps)?;
+        }
+        if let (Some(step), Some(v)) = (o.best_step, o.best_valid_loss) {
+            writeln!(f, "best validation loss {v:.3} at step {step} (saved as model.safetensors)")?;
+        }
+        write!(f, "checkpoint: {}", self.dir.display())
+    }
 }
 
 /// A finished DLGPD checkpoint: the VAE on the inference device, the GPs' trained hyperparameters and the
@@ -200,24 +213,17 @@ pub struct TrainedDlgpd {
     pub progress: TrainingProgress,
 }
 
-/// A finished DLGPD run.
-pub fn load(dir: &Path) -> Result<TrainedDlgpd> {
-    load_accepting(dir, Accept::Finished)
-}
-
 /// A DLGPD run, finished or (with [`Accept::InProgress`]) still training: then its best-validation weights
 /// so far.
-pub fn load_accepting(dir: &Path, accept: Accept) -> Result<TrainedDlgpd> {
-    let opened = OpenedCheckpoint::open(dir)?;
-    opened.expect(METHOD, accept)?;
-    let run = read_run(&opened)?;
+pub fn load(dir: &Path, accept: Accept) -> Result<TrainedDlgpd> {
+    let (opened, run) = open_run::<Dlgpd>(dir, accept)?;
     let stored = opened.tensors(MODEL_FILE)?;
     let path = opened.dir.file(MODEL_FILE);
     let bad = |what: String| Error::bad_file(&path, what);
     let latent = run.config.latent_dim;
     let device = inference_device();
     let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(0);
-    let vae = VaeNet::init(run.observation, latent, run.config.hidden_units, &device, &mut rng)
+    let vae = VaeNet::init(run.details.observation, latent, run.config.hidden_units, &device, &mut rng)
         .map_err(|e| bad(e.to_string()))?;
     let mut params = vae.params();
     for t in &mut params.tensors {
@@ -229,7 +235,8 @@ pub fn load_accepting(dir: &Path, accept: Accept) -> Result<TrainedDlgpd> {
         }
     }
     let vae = vae.with_params(&params, &device)?;
-    let (transition, reward) = gps_from_stored(&stored, "", latent, run.action_dim).map_err(|e| bad(e.to_string()))?;
+    let (transition, reward) =
+        gps_from_stored(&stored, "", latent, run.details.action_dim).map_err(|e| bad(e.to_string()))?;
     let part = |name: &str| {
         f64_tensor(&stored, name, latent)
             .cloned()

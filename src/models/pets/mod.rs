@@ -20,13 +20,11 @@ pub use train::PetsTrainer;
 use crate::envs::EnvName;
 use crate::error::{Error, Result};
 use crate::nn::Normalizer;
-use crate::run::dir::Provenance;
-use crate::run::Monitor;
 use crate::train::datasets::{env_of, load_datasets, TransitionCounts};
 use crate::train::tensors::{to_params, TensorData};
 use crate::train::{
-    continuation, loss_panel, run_training, training_view, validation_panel, Accept, DataFile, Extension, FitOutcome,
-    FitSettings, OpenedCheckpoint, Start, MODEL_FILE,
+    loss_panel, open_run, training_view, validation_panel, Accept, FitOutcome, Method, OpenedCheckpoint, Prepared,
+    Request, RunRecord, Trained, MODEL_FILE,
 };
 
 pub const METHOD: &str = "pets";
@@ -42,112 +40,151 @@ pub struct ModelSpec {
     pub target_dim: usize,
 }
 
-/// config.json of a PETS checkpoint.
+/// What a PETS run records beyond the shared fields.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct PetsRun {
-    pub method: String,
-    pub env: String,
-    pub data: Vec<DataFile>,
-    pub seed: u64,
+pub struct PetsDetails {
     pub model: ModelSpec,
-    pub config: PetsConfig,
     pub transitions: TransitionCounts,
-    pub provenance: Provenance,
 }
 
-pub struct TrainRequest {
-    pub out: PathBuf,
-    pub data: Vec<PathBuf>,
-    /// The env the user named; must agree with the datasets'. `None`: take the datasets' env.
-    pub env: Option<String>,
-    pub config: PetsConfig,
-    pub seed: u64,
-    pub provenance: Provenance,
+/// config.json of a PETS checkpoint.
+pub type PetsRun = RunRecord<Pets>;
+
+/// PETS as the training job drives it.
+pub struct Pets;
+
+impl Method for Pets {
+    const NAME: &'static str = METHOD;
+    const TITLE: &'static str = "PETS";
+    const EXTENDABLE: bool = true;
+    type Config = PetsConfig;
+    type Variant = ();
+    type Details = PetsDetails;
+    type Trainer = PetsTrainer;
+
+    fn total_steps(config: &PetsConfig) -> u64 {
+        config.steps
+    }
+
+    fn with_total_steps(config: &PetsConfig, steps: u64) -> PetsConfig {
+        PetsConfig { steps, ..config.clone() }
+    }
+
+    fn schedule(config: &PetsConfig) -> (u64, u64) {
+        (config.validate_every, config.checkpoint_every)
+    }
+
+    fn validate(config: &PetsConfig) -> Result<()> {
+        config.validate()
+    }
+
+    fn prepare(request: &Request<Self>) -> Result<Prepared<Self>> {
+        let (dataset, files) = load_datasets(&request.data)?;
+        let env = env_of(&dataset, request.env.as_deref(), &request.data[0])?;
+        let spec = env.build()?.spec();
+        let c = &request.config;
+        if c.reward == RewardSource::Known && env.known_reward().is_none() {
+            return Err(Error::config(format!(
+                "env '{}' has no closed-form reward; train with --reward learned",
+                env.canonical()
+            )));
+        }
+        let split = data::split_dataset(&dataset, &spec.angular, c.reward, c.validation_fraction, request.seed)?;
+        let details = PetsDetails {
+            model: ModelSpec {
+                state_names: dataset.meta.state_names.clone(),
+                angular: spec.angular.clone(),
+                action_dim: dataset.meta.action_dim,
+                input_dim: split.train.input_dim,
+                target_dim: split.train.target_dim,
+            },
+            transitions: TransitionCounts {
+                train: split.train.len(),
+                valid: split.valid.len(),
+                train_rollouts: split.train_rollouts,
+                valid_rollouts: split.valid_rollouts,
+            },
+        };
+        let trainer = PetsTrainer::new(c.clone(), request.seed, split.train, split.valid)?;
+        let t = &details.transitions;
+        let view = training_view(
+            &format!("train PETS on {}", env.canonical()),
+            vec![loss_panel("train loss: Gaussian NLL", false), validation_panel("valid: MSE of the mean (held-out)")],
+            &[
+                ("transitions", format!("{} train / {} valid", t.train, t.valid)),
+                ("ensemble", format!("{}{}", c.ensemble, if c.bootstrap { ", bootstrapped" } else { "" })),
+                ("batch", format!("{} per member", c.batch_size)),
+                ("learning rate", format!("{}", c.optimizer.learning_rate)),
+                ("weight decay", format!("{}", c.optimizer.weight_decay)),
+                ("parameters", trainer.parameter_count().to_string()),
+            ],
+        );
+        Ok(Prepared { env: Some(env.canonical()), data: files, details, trainer, view })
+    }
+
+    fn variant_of(_record: &PetsRun) -> Result<()> {
+        Ok(())
+    }
+
+    fn check_record(record: &PetsRun) -> Result<()> {
+        record.details.model.validate(record.config.reward).map_err(|e| Error::config(format!("model: {e}")))?;
+        if record.data.is_empty() {
+            return Err(Error::config("lists no training data file"));
+        }
+        Ok(())
+    }
 }
 
-pub struct TrainReport {
-    pub run: PetsRun,
+/// What `mbrl train pets` reports of a finished run.
+pub struct PetsSummary {
+    pub record: PetsRun,
     pub outcome: FitOutcome,
     pub parameters: usize,
+    pub dir: PathBuf,
 }
 
-/// Trains a PETS ensemble into `request.out`, fresh or continuing the run there (see [`Start`]).
-pub fn train(request: &TrainRequest, start: Start, monitor: &dyn Monitor) -> Result<TrainReport> {
-    request.config.validate()?;
-    let (dataset, files) = load_datasets(&request.data)?;
-    let env = env_of(&dataset, request.env.as_deref(), &request.data[0])?;
-    let spec = env.build()?.spec();
-    if request.config.reward == RewardSource::Known && env.known_reward().is_none() {
-        return Err(Error::config(format!(
-            "env '{}' has no closed-form reward; train with --reward learned",
-            env.canonical()
-        )));
+impl PetsSummary {
+    pub fn of(trained: &Trained<Pets>, dir: &Path) -> Self {
+        PetsSummary {
+            record: trained.record.clone(),
+            outcome: trained.outcome.clone(),
+            parameters: trained.trainer.parameter_count(),
+            dir: dir.to_path_buf(),
+        }
     }
-    let split = data::split_dataset(
-        &dataset,
-        &spec.angular,
-        request.config.reward,
-        request.config.validation_fraction,
-        request.seed,
-    )?;
-    let run = PetsRun {
-        method: METHOD.into(),
-        env: env.canonical(),
-        data: files,
-        seed: request.seed,
-        model: ModelSpec {
-            state_names: dataset.meta.state_names.clone(),
-            angular: spec.angular.clone(),
-            action_dim: dataset.meta.action_dim,
-            input_dim: split.train.input_dim,
-            target_dim: split.train.target_dim,
-        },
-        config: request.config.clone(),
-        transitions: TransitionCounts {
-            train: split.train.len(),
-            valid: split.valid.len(),
-            train_rollouts: split.train_rollouts,
-            valid_rollouts: split.valid_rollouts,
-        },
-        provenance: request.provenance.clone(),
-    };
-    let mut trainer = PetsTrainer::new(request.config.clone(), request.seed, split.train, split.valid)?;
-    let parameters = trainer.parameter_count();
-    let settings = FitSettings {
-        method: METHOD.into(),
-        env: Some(run.env.clone()),
-        total_steps: request.config.steps,
-        validate_every: request.config.validate_every,
-        checkpoint_every: request.config.checkpoint_every,
-    };
-    let config = serde_json::to_value(&run).map_err(|e| Error::config(e.to_string()))?;
-    let c = &request.config;
-    let view = training_view(
-        &format!("train PETS on {}", run.env),
-        vec![loss_panel("train loss: Gaussian NLL", false), validation_panel("valid: MSE of the mean (held-out)")],
-        &[
-            ("transitions", format!("{} train / {} valid", run.transitions.train, run.transitions.valid)),
-            ("ensemble", format!("{}{}", c.ensemble, if c.bootstrap { ", bootstrapped" } else { "" })),
-            ("batch", format!("{} per member", c.batch_size)),
-            ("learning rate", format!("{}", c.optimizer.learning_rate)),
-            ("weight decay", format!("{}", c.optimizer.weight_decay)),
-            ("parameters", parameters.to_string()),
-        ],
-    );
-    let outcome = run_training(&request.out, &config, &settings, &mut trainer, start, &view, monitor)?;
-    Ok(TrainReport { run, outcome, parameters })
 }
 
-fn read_run(opened: &OpenedCheckpoint) -> Result<PetsRun> {
-    let path = opened.dir.file("config.json");
-    let run: PetsRun = serde_json::from_value(opened.config.clone())
-        .map_err(|e| Error::bad_file(&path, format!("not a PETS run config: {e}")))?;
-    run.model.validate(run.config.reward).map_err(|e| Error::bad_file(&path, format!("model: {e}")))?;
-    if run.data.is_empty() {
-        return Err(Error::bad_file(&path, "lists no training data file"));
+impl std::fmt::Display for PetsSummary {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let (run, c) = (&self.record, &self.record.config);
+        let t = &run.details.transitions;
+        writeln!(
+            f,
+            "trained a PETS ensemble of {} ({}×{} {}, {} parameters, reward {}) on {} transitions of {} ({} rollouts; {} held out)",
+            c.ensemble,
+            c.hidden_layers,
+            c.hidden_units,
+            c.activation.name(),
+            self.parameters,
+            match c.reward {
+                RewardSource::Known => "known",
+                RewardSource::Learned => "learned",
+            },
+            t.train,
+            run.env.as_deref().unwrap_or_default(),
+            t.train_rollouts,
+            t.valid_rollouts
+        )?;
+        let o = &self.outcome;
+        if let Some(loss) = o.last_train_loss {
+            writeln!(f, "final training loss (Gaussian NLL) {loss:.4} after {} steps", o.steps)?;
+        }
+        if let (Some(step), Some(v)) = (o.best_step, o.best_valid_loss) {
+            writeln!(f, "best validation MSE {v:.3e} at step {step} (saved as model.safetensors)")?;
+        }
+        write!(f, "checkpoint: {}", self.dir.display())
     }
-    Ok(run)
 }
 
 /// Far above any env mbrl simulates; beyond it a size in config.json is corrupt.
@@ -180,29 +217,6 @@ impl ModelSpec {
     }
 }
 
-/// Continues the run in `dir` from its last checkpoint, with the config and data it was started with; with
-/// `extend_to`, on to that many steps in total (the run may be finished: its training does not depend on the
-/// total, so its weights end as those of a run started with that total, provided its old total fell on a
-/// validation).
-pub fn resume(dir: &Path, extend_to: Option<&Extension>, monitor: &dyn Monitor) -> Result<TrainReport> {
-    let opened = OpenedCheckpoint::open(dir)?;
-    let run = read_run(&opened)?;
-    opened.expect_total_steps(run.config.steps as u64)?;
-    let next = continuation(&opened, run.config.steps, &run.provenance, extend_to)?;
-    for file in &run.data {
-        file.verify_unchanged()?;
-    }
-    let request = TrainRequest {
-        out: dir.to_path_buf(),
-        data: run.data.iter().map(|f| f.path.clone()).collect(),
-        env: Some(run.env.clone()),
-        config: PetsConfig { steps: next.steps, ..run.config.clone() },
-        seed: run.seed,
-        provenance: next.provenance,
-    };
-    train(&request, next.start, monitor)
-}
-
 /// A PETS checkpoint as a planner's dynamics in `env` (which must be the env it was trained on); a run still
 /// in training only when `accept` takes it (then its best-validation weights so far).
 pub fn load_dynamics(
@@ -212,27 +226,43 @@ pub fn load_dynamics(
     particles: usize,
     accept: Accept,
 ) -> Result<PetsDynamics> {
-    let opened = OpenedCheckpoint::open(dir)?;
-    opened.expect(METHOD, accept)?;
-    let run = read_run(&opened)?;
-    if run.env != env.canonical() {
+    let (opened, run) = open_run::<Pets>(dir, accept)?;
+    dynamics_from(&opened, &run, env, propagation, particles)
+}
+
+/// The dynamics of an opened PETS checkpoint whose record is `run`.
+pub fn dynamics_from(
+    opened: &OpenedCheckpoint,
+    run: &PetsRun,
+    env: &EnvName,
+    propagation: Propagation,
+    particles: usize,
+) -> Result<PetsDynamics> {
+    let dir = opened.dir.path();
+    if run.env.as_deref() != Some(env.canonical().as_str()) {
         return Err(Error::bad_file(
             dir,
-            format!("is a model of '{}'; it cannot plan in '{}'", run.env, env.canonical()),
+            format!(
+                "is a model of '{}'; it cannot plan in '{}'",
+                run.env.as_deref().unwrap_or_default(),
+                env.canonical()
+            ),
         ));
     }
-    run.config.validate().map_err(|e| Error::bad_file(&opened.dir.file("config.json"), e.to_string()))?;
     let stored = opened.tensors(MODEL_FILE)?;
     let model_path = opened.dir.file(MODEL_FILE);
     let normalizer_part = |name: &str| -> Result<Vec<f32>> {
         match stored.iter().find(|t| t.name == name).map(|t| &t.data) {
-            Some(TensorData::F32(v)) if v.len() == run.model.input_dim => Ok(v.clone()),
-            _ => Err(Error::bad_file(&model_path, format!("lacks '{name}' with {} f32 values", run.model.input_dim))),
+            Some(TensorData::F32(v)) if v.len() == run.details.model.input_dim => Ok(v.clone()),
+            _ => Err(Error::bad_file(
+                &model_path,
+                format!("lacks '{name}' with {} f32 values", run.details.model.input_dim),
+            )),
         }
     };
     let normalizer = Normalizer { mean: normalizer_part(net::INPUT_MEAN)?, std: normalizer_part(net::INPUT_STD)? };
     normalizer.validate().map_err(|e| Error::bad_file(&model_path, e.to_string()))?;
-    let layout = layout_of(&run)?;
+    let layout = layout_of(run)?;
     let weights: Vec<_> = stored.iter().filter(|t| !t.name.starts_with("input_normalizer.")).cloned().collect();
     let weights = to_params(&model_path, &weights, &layout)?;
     let reward = match run.config.reward {
@@ -245,8 +275,8 @@ pub fn load_dynamics(
         &run.config,
         &weights,
         normalizer,
-        run.model.angular.clone(),
-        run.model.action_dim,
+        run.details.model.angular.clone(),
+        run.details.model.action_dim,
         reward,
         propagation,
         particles,
@@ -260,7 +290,8 @@ fn layout_of(run: &PetsRun) -> Result<crate::nn::ParamSet> {
     use rand::SeedableRng;
     let device = crate::nn::tensor::inference_device();
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0);
-    let net = net::PetsNet::init(&run.config, run.model.input_dim, run.model.target_dim, &device, &mut rng);
+    let net =
+        net::PetsNet::init(&run.config, run.details.model.input_dim, run.details.model.target_dim, &device, &mut rng);
     Ok(crate::nn::ParamSet::<f32>::from_module(&net, net::torch_name))
 }
 

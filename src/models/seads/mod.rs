@@ -24,9 +24,9 @@ use crate::envs::boards::{BoardGame, GameSpec, LightsOut, TileSwap};
 use crate::envs::embodiments::{Embodiment, EMBODIMENT_HELP};
 use crate::envs::EnvName;
 use crate::error::{Error, Result};
-use crate::run::dir::Provenance;
-use crate::run::{Monitor, PanelSpec};
-use crate::train::{run_training, training_view, FitOutcome, FitSettings, OpenedCheckpoint, Start};
+use crate::run::PanelSpec;
+use crate::train::run_dir::Field;
+use crate::train::{training_view, FitOutcome, Method, Prepared, Request, RunRecord, Trained, TrainingMethod};
 
 pub const METHOD: &str = "seads";
 pub const ENV_HELP: &str = "lightsout:cursor, tileswap:cursor, lightsout:reacher, tileswap:reacher";
@@ -66,42 +66,115 @@ impl EmbodiedGame {
     }
 }
 
-/// config.json of a SEADS checkpoint.
+/// What a SEADS run records beyond the shared fields: the sizes its networks are loaded with.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct SeadsRun {
-    pub method: String,
-    pub env: String,
-    pub seed: u64,
-    pub config: SeadsConfig,
+pub struct SeadsDetails {
     /// Network input (observation ⊕ onehot(k)) and action sizes, for loading the policy.
     pub policy_input: usize,
     pub action_dim: usize,
     pub board_bits: usize,
     pub step_limit: usize,
-    pub provenance: Provenance,
 }
 
-pub struct TrainRequest {
-    pub out: PathBuf,
-    pub env: EmbodiedGame,
-    pub config: SeadsConfig,
-    pub seed: u64,
-    pub provenance: Provenance,
+/// config.json of a SEADS checkpoint.
+pub type SeadsRun = RunRecord<Seads>;
+
+/// A SEADS trainer of any game, with the figures its summary reports.
+pub trait SeadsTraining: TrainingMethod {
+    fn last(&self) -> &EpochStats;
+    fn env_steps(&self) -> u64;
 }
 
-pub struct TrainReport {
-    pub run: SeadsRun,
-    pub outcome: FitOutcome,
-    pub last: EpochStats,
-    pub env_steps: u64,
+impl<G: BoardGame> SeadsTraining for SeadsTrainer<G> {
+    fn last(&self) -> &EpochStats {
+        &self.last
+    }
+    fn env_steps(&self) -> u64 {
+        SeadsTrainer::env_steps(self)
+    }
 }
 
-/// Trains (or, with `resume`, continues) SEADS into `request.out`.
-pub fn train(request: &TrainRequest, resume: bool, monitor: &dyn Monitor) -> Result<TrainReport> {
-    match request.env.game {
-        GameSpec::TileSwap => train_game(TileSwap::new(), request, resume, monitor),
-        GameSpec::LightsOut(n) => train_game(LightsOut::new(n)?, request, resume, monitor),
+/// SEADS as the training job drives it. It collects its own episodes, so a request has no data; its env
+/// (the game and embodiment) is required.
+pub struct Seads;
+
+impl Method for Seads {
+    const NAME: &'static str = METHOD;
+    const TITLE: &'static str = "SEADS";
+    type Config = SeadsConfig;
+    type Variant = ();
+    type Details = SeadsDetails;
+    type Trainer = Box<dyn SeadsTraining>;
+
+    fn total_steps(config: &SeadsConfig) -> u64 {
+        config.max_epochs()
+    }
+
+    /// Nothing is held out: the forward model's loss on each epoch's new episodes is the check.
+    fn schedule(config: &SeadsConfig) -> (u64, u64) {
+        (u64::MAX, config.checkpoint_every)
+    }
+
+    fn validate(config: &SeadsConfig) -> Result<()> {
+        config.validate()
+    }
+
+    fn prepare(request: &Request<Self>) -> Result<Prepared<Self>> {
+        let name = request.env.as_deref().ok_or_else(|| Error::config(format!("SEADS needs an env ({ENV_HELP})")))?;
+        let env = EmbodiedGame::parse(name)?;
+        if !request.data.is_empty() {
+            return Err(Error::config("SEADS collects its own episodes; it takes no --data"));
+        }
+        let (trainer, layout, step_limit): (Box<dyn SeadsTraining>, _, _) = match env.game {
+            GameSpec::TileSwap => {
+                let t = SeadsTrainer::new(request.config.clone(), TileSwap::new(), env.embodiment, request.seed)?;
+                let (layout, limit) = (t.layout(), t.step_limit());
+                (Box::new(t), layout, limit)
+            }
+            GameSpec::LightsOut(n) => {
+                let t = SeadsTrainer::new(request.config.clone(), LightsOut::new(n)?, env.embodiment, request.seed)?;
+                let (layout, limit) = (t.layout(), t.step_limit());
+                (Box::new(t), layout, limit)
+            }
+        };
+        let config = &request.config;
+        let details = SeadsDetails {
+            policy_input: layout.obs_dim + config.skills,
+            action_dim: layout.action_dim,
+            board_bits: layout.bits,
+            step_limit,
+        };
+        let panels = vec![
+            panel("loss: forward-model NLL per bit", &["train/loss"]),
+            panel("distinct moves the skills execute", &["seads/distinct_moves"]),
+            panel("intrinsic reward (final steps)", &["seads/intrinsic_reward"]),
+            panel("SAC losses", &["sac/critic_loss", "sac/actor_loss"]),
+        ];
+        let view = training_view(
+            &format!("train SEADS on {}", env.name()),
+            panels,
+            &[
+                ("skills", config.skills.to_string()),
+                ("env steps", config.env_steps.to_string()),
+                ("episodes", format!("{} per epoch", config.episodes_per_epoch)),
+                ("model", format!("lr {}, batch {}", config.model_learning_rate, config.model_batch)),
+                ("SAC", format!("lr {}, batch {}", config.sac_learning_rate, config.sac_batch)),
+            ],
+        );
+        Ok(Prepared { env: Some(env.name()), data: Vec::new(), details, trainer, view })
+    }
+
+    fn variant_of(_record: &SeadsRun) -> Result<()> {
+        Ok(())
+    }
+
+    fn check_record(record: &SeadsRun) -> Result<()> {
+        EmbodiedGame::parse(record.env()).map(|_| ())
+    }
+
+    fn fixed_fields(request: &Request<Self>) -> Vec<Field> {
+        vec![Field::new("--env", "/env", serde_json::Value::from(request.env.clone()))]
     }
 }
 
@@ -115,76 +188,51 @@ fn panel(title: &str, series: &[&str]) -> PanelSpec {
     }
 }
 
-fn train_game<G: BoardGame>(
-    game: G,
-    request: &TrainRequest,
-    resume: bool,
-    monitor: &dyn Monitor,
-) -> Result<TrainReport> {
-    let config = &request.config;
-    config.validate()?;
-    let mut trainer = SeadsTrainer::new(config.clone(), game, request.env.embodiment, request.seed)?;
-    let layout = trainer.layout();
-    let run = SeadsRun {
-        method: METHOD.into(),
-        env: request.env.name(),
-        seed: request.seed,
-        config: config.clone(),
-        policy_input: layout.obs_dim + config.skills,
-        action_dim: layout.action_dim,
-        board_bits: layout.bits,
-        step_limit: trainer.step_limit(),
-        provenance: request.provenance.clone(),
-    };
-    let settings = FitSettings {
-        method: METHOD.into(),
-        env: Some(run.env.clone()),
-        total_steps: config.max_epochs(),
-        // Nothing is held out: the forward model's loss on each epoch's new episodes is the check.
-        validate_every: u64::MAX,
-        checkpoint_every: config.checkpoint_every,
-    };
-    let json = serde_json::to_value(&run).map_err(|e| Error::config(e.to_string()))?;
-    let title = format!("train SEADS on {}", run.env);
-    let panels = vec![
-        panel("loss: forward-model NLL per bit", &["train/loss"]),
-        panel("distinct moves the skills execute", &["seads/distinct_moves"]),
-        panel("intrinsic reward (final steps)", &["seads/intrinsic_reward"]),
-        panel("SAC losses", &["sac/critic_loss", "sac/actor_loss"]),
-    ];
-    let view = training_view(
-        &title,
-        panels,
-        &[
-            ("skills", config.skills.to_string()),
-            ("env steps", config.env_steps.to_string()),
-            ("episodes", format!("{} per epoch", config.episodes_per_epoch)),
-            ("model", format!("lr {}, batch {}", config.model_learning_rate, config.model_batch)),
-            ("SAC", format!("lr {}, batch {}", config.sac_learning_rate, config.sac_batch)),
-        ],
-    );
-    let outcome = run_training(&request.out, &json, &settings, &mut trainer, Start::resuming(resume), &view, monitor)?;
-    Ok(TrainReport { run, outcome, last: trainer.last.clone(), env_steps: trainer.env_steps() })
+/// What `mbrl train seads` reports of a finished run.
+pub struct SeadsSummary {
+    pub record: SeadsRun,
+    pub outcome: FitOutcome,
+    pub last: EpochStats,
+    pub env_steps: u64,
+    pub dir: PathBuf,
 }
 
-pub fn read_run(opened: &OpenedCheckpoint) -> Result<SeadsRun> {
-    serde_json::from_value(opened.config.clone())
-        .map_err(|e| Error::bad_file(&opened.dir.file("config.json"), format!("not a SEADS run config: {e}")))
+impl SeadsSummary {
+    pub fn of(trained: &Trained<Seads>, dir: &Path) -> Self {
+        SeadsSummary {
+            record: trained.record.clone(),
+            outcome: trained.outcome.clone(),
+            last: trained.trainer.last().clone(),
+            env_steps: trained.trainer.env_steps(),
+            dir: dir.to_path_buf(),
+        }
+    }
 }
 
-/// Continues the run in `dir` from its last checkpoint.
-pub fn resume(dir: &Path, monitor: &dyn Monitor) -> Result<TrainReport> {
-    let opened = OpenedCheckpoint::open(dir)?;
-    let run = read_run(&opened)?;
-    opened.expect_total_steps(run.config.max_epochs() as u64)?;
-    let request = TrainRequest {
-        out: dir.to_path_buf(),
-        env: EmbodiedGame::parse(&run.env)?,
-        config: run.config.clone(),
-        seed: run.seed,
-        provenance: run.provenance.clone(),
-    };
-    train(&request, true, monitor)
+impl std::fmt::Display for SeadsSummary {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let c = &self.record.config;
+        writeln!(
+            f,
+            "trained SEADS on {}: {} skills, {} epochs, {} env steps (budget {}), SAC hidden layers {}, forward model {} units",
+            self.record.env(),
+            c.skills,
+            self.outcome.steps,
+            self.env_steps,
+            c.env_steps,
+            c.sac_hidden.iter().map(usize::to_string).collect::<Vec<_>>().join(" × "),
+            c.model_hidden
+        )?;
+        let last = &self.last;
+        writeln!(
+            f,
+            "last epoch: the skills execute {} distinct game moves; forward-model NLL {:.4} nats per bit{}",
+            last.distinct_moves,
+            last.model_loss,
+            last.mean_final_reward.map(|r| format!("; mean intrinsic reward {r:.3}")).unwrap_or_default()
+        )?;
+        write!(f, "checkpoint: {}", self.dir.display())
+    }
 }
 
 #[cfg(test)]

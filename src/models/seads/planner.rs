@@ -11,7 +11,7 @@ use rand_chacha::ChaCha8Rng;
 use super::collect::policy_input;
 use super::forward_model::{FlipModel, FlipScratch};
 use super::trainer::MODEL_PREFIX;
-use super::{read_run, EmbodiedGame, SeadsRun, METHOD};
+use super::{EmbodiedGame, Seads, SeadsRun};
 use crate::control::{run_episode, Agent};
 use crate::envs::boards::BoardGame;
 use crate::envs::embodiments::embodied::EmbodiedBoard;
@@ -22,7 +22,7 @@ use crate::planning::bfs::{bidirectional, breadth_first, SearchLimits, SearchRes
 use crate::planning::board_view::{plan_text, show_boards, EffectorTrace};
 use crate::rl::sac::Sac;
 use crate::run::{Event, Monitor};
-use crate::train::{Accept, OpenedCheckpoint, TrainingProgress, MODEL_FILE};
+use crate::train::{open_run, Accept, TrainingProgress, MODEL_FILE};
 
 /// A trained SEADS checkpoint: the skill policy and the forward model.
 pub struct LoadedSeads {
@@ -34,32 +34,17 @@ pub struct LoadedSeads {
     pub progress: TrainingProgress,
 }
 
-/// A finished SEADS run.
-pub fn load(dir: &Path) -> Result<LoadedSeads> {
-    load_accepting(dir, Accept::Finished)
-}
-
 /// A SEADS run, finished or (with [`Accept::InProgress`]) still training: then the weights of its last
 /// checkpoint, as SEADS has no validation to pick a best from.
-pub fn load_accepting(dir: &Path, accept: Accept) -> Result<LoadedSeads> {
-    let opened = OpenedCheckpoint::open(dir)?;
-    if opened.manifest.method != METHOD {
-        return Err(Error::bad_file(
-            dir,
-            format!(
-                "is a '{}' checkpoint; solving boards with skills needs a '{METHOD}' checkpoint",
-                opened.manifest.method
-            ),
-        ));
-    }
-    opened.expect(METHOD, accept)?;
-    let run = read_run(&opened)?;
-    let env = EmbodiedGame::parse(&run.env)?;
+pub fn load(dir: &Path, accept: Accept) -> Result<LoadedSeads> {
+    let (opened, run) = open_run::<Seads>(dir, accept)?;
+    let env = EmbodiedGame::parse(run.env())?;
     let weights = opened.tensors(MODEL_FILE)?;
     let (model_tensors, policy_tensors): (Vec<_>, Vec<_>) =
         weights.into_iter().partition(|t| t.name.starts_with(MODEL_PREFIX));
     let (manipulator, _) = env.embodiment.build();
-    let sac_config = run.config.sac_config(run.policy_input, manipulator.action_low(), manipulator.action_high());
+    let sac_config =
+        run.config.sac_config(run.details.policy_input, manipulator.action_low(), manipulator.action_high());
     let policy = Sac::from_weights(sac_config, &policy_tensors)
         .map_err(|e| Error::bad_file(&dir.join(MODEL_FILE), e.to_string()))?;
     let mut params = ParamSet::<f32>::default();
@@ -74,7 +59,7 @@ pub fn load_accepting(dir: &Path, accept: Accept) -> Result<LoadedSeads> {
             values,
         });
     }
-    let model = FlipModel::from_params(&params, run.board_bits, run.config.skills)
+    let model = FlipModel::from_params(&params, run.details.board_bits, run.config.skills)
         .map_err(|e| Error::bad_file(&dir.join(MODEL_FILE), e.to_string()))?;
     Ok(LoadedSeads { run, env, policy, model, dir: dir.to_path_buf(), progress: opened.progress() })
 }

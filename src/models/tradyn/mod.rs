@@ -18,8 +18,11 @@ use crate::envs::unicycle::{OBSERVATION_NAMES, TERRAIN_FEATURES};
 use crate::envs::EnvName;
 use crate::error::{Error, Result};
 use crate::models::context::fast::LocalFeatures;
-use crate::models::context::{self, LoadedModel, StateSpace};
-use crate::train::Accept;
+use crate::models::context::{
+    self, ContextConfig, ContextDetails, ContextSummary, ContextTrainer, LoadedModel, StateSpace,
+};
+use crate::train::run_dir::Field;
+use crate::train::{open_run, Accept, Method, Prepared, Request, RunRecord, Trained};
 
 pub const METHOD: &str = "tradyn";
 
@@ -32,6 +35,72 @@ pub fn state_space(terrain_lookup: bool) -> StateSpace {
     }
 }
 
+/// TRADYN as the training job drives it: the context network on the unicycle's observation; its variant is
+/// whether the terrain is looked up (+T) or predicted (−T).
+pub struct Tradyn;
+
+impl Method for Tradyn {
+    const NAME: &'static str = METHOD;
+    const TITLE: &'static str = "TRADYN";
+    type Config = ContextConfig;
+    type Variant = bool;
+    type Details = ContextDetails;
+    type Trainer = ContextTrainer;
+
+    fn total_steps(config: &ContextConfig) -> u64 {
+        config.steps
+    }
+
+    fn schedule(config: &ContextConfig) -> (u64, u64) {
+        (config.validate_every, config.checkpoint_every)
+    }
+
+    fn validate(config: &ContextConfig) -> Result<()> {
+        config.validate()
+    }
+
+    fn prepare(request: &Request<Self>) -> Result<Prepared<Self>> {
+        context::prepare_model(request, &state_space(request.variant))
+    }
+
+    fn variant_of(record: &RunRecord<Self>) -> Result<bool> {
+        Ok(record.details.model.local_dim > 0)
+    }
+
+    fn check_record(record: &RunRecord<Self>) -> Result<()> {
+        context::check_details(&record.details, &record.data)?;
+        let spec = &record.details.model;
+        let names_fit = spec.observations && spec.state_names.iter().map(String::as_str).eq(OBSERVATION_NAMES);
+        if !names_fit || spec.action_dim != 2 || ![0, TERRAIN_FEATURES].contains(&spec.local_dim) {
+            return Err(Error::config(format!(
+                "model: a TRADYN model reads the unicycle's observation ({}) and 2 actions, with 0 or {TERRAIN_FEATURES} \
+                 features read from the map",
+                OBSERVATION_NAMES.join(", ")
+            )));
+        }
+        Ok(())
+    }
+
+    /// The lookup is no config field: the model records it as the size of the terrain features it reads.
+    fn fixed_fields(request: &Request<Self>) -> Vec<Field> {
+        let lookup = if request.variant { serde_json::Value::from(TERRAIN_FEATURES) } else { serde_json::Value::Null };
+        vec![Field {
+            show: |v| if v.is_null() { "off (--no-terrain)".into() } else { "on".into() },
+            ..Field::new("the terrain lookup", "/model/local_dim", lookup)
+        }]
+    }
+}
+
+/// What `mbrl train tradyn` reports of a finished run.
+pub fn summary(trained: &Trained<Tradyn>, dir: &Path) -> ContextSummary {
+    let lookup = if trained.record.details.model.local_dim > 0 {
+        "with terrain lookup"
+    } else {
+        "without terrain lookup (−T: terrain predicted)"
+    };
+    ContextSummary::of(format!("a TRADYN model {lookup}"), trained, dir)
+}
+
 /// A trained TRADYN checkpoint.
 #[derive(Clone)]
 pub struct TradynModel {
@@ -39,25 +108,10 @@ pub struct TradynModel {
 }
 
 impl TradynModel {
-    pub fn load(dir: &Path) -> Result<Self> {
-        Self::load_accepting(dir, Accept::Finished)
-    }
-
-    /// Also a run still in training when `accept` takes it (its best-validation weights so far).
-    pub fn load_accepting(dir: &Path, accept: Accept) -> Result<Self> {
-        let loaded = context::load_method_accepting(dir, &EnvName::Unicycle(None), METHOD, accept)?;
-        let spec = &loaded.run.model;
-        let names_fit = spec.observations && spec.state_names.iter().map(String::as_str).eq(OBSERVATION_NAMES);
-        if !names_fit || spec.action_dim != 2 || ![0, TERRAIN_FEATURES].contains(&spec.local_dim) {
-            return Err(Error::bad_file(
-                &dir.join("config.json"),
-                format!(
-                    "model: a TRADYN model reads the unicycle's observation ({}) and 2 actions, with 0 or {TERRAIN_FEATURES} \
-                     features read from the map",
-                    OBSERVATION_NAMES.join(", ")
-                ),
-            ));
-        }
+    /// A TRADYN run, finished or (when `accept` takes it) still training: then its best-validation weights.
+    pub fn load(dir: &Path, accept: Accept) -> Result<Self> {
+        let (opened, run) = open_run::<Tradyn>(dir, accept)?;
+        let loaded = context::model_from(&opened, run.retag(), &EnvName::Unicycle(None))?;
         Ok(TradynModel { loaded })
     }
 
