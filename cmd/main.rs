@@ -96,7 +96,7 @@ fn main() {
         Command::Completions(args) => completions::run(args),
     });
     if let Err(err) = outcome {
-        let cancelled = err.downcast_ref::<mbrl::Error>().is_some_and(|e| matches!(e, mbrl::Error::Cancelled));
+        let cancelled = err.downcast_ref::<mbrl::Error>().is_some_and(|e| e.is_cancelled());
         eprintln!("error: {}", one_line(&format!("{err:#}")));
         std::process::exit(if cancelled { 130 } else { 1 });
     }

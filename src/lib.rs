@@ -16,7 +16,7 @@ pub mod train;
 pub mod tui;
 pub mod util;
 
-pub use error::{Error, Result};
+pub use error::{Error, ErrorKind, Result};
 
 #[cfg(test)]
 mod layering;

@@ -54,7 +54,7 @@ pub fn run_episode<E: Env + ?Sized, A: Agent + ?Sized>(
     let mut rollout = Rollout::start(env.state(), observation.clone());
     for t in 0..limit {
         if monitor.is_cancelled() {
-            return Err(Error::Cancelled);
+            return Err(Error::cancelled());
         }
         let state = env.state();
         let action = agent.act(t, &state, &observation)?;
@@ -139,21 +139,14 @@ mod tests {
     fn an_error_from_the_caller_ends_the_episode() {
         let mut env = Pendulum::new(PendulumVariant::parse("").unwrap());
         let mut agent = Bang { resets: 0, seen: Vec::new() };
-        let out =
-            run_episode(
-                &mut env,
-                &mut agent,
-                5,
-                &NullMonitor,
-                |tr, _, _| {
-                    if tr.t == 1 {
-                        Err(Error::Cancelled)
-                    } else {
-                        Ok(())
-                    }
-                },
-            );
-        assert!(matches!(out, Err(Error::Cancelled)));
+        let out = run_episode(&mut env, &mut agent, 5, &NullMonitor, |tr, _, _| {
+            if tr.t == 1 {
+                Err(Error::cancelled())
+            } else {
+                Ok(())
+            }
+        });
+        assert!(out.as_ref().is_err_and(|e| e.is_cancelled()));
         assert_eq!(agent.seen, vec![0, 1]);
     }
 }

@@ -35,7 +35,7 @@ pub fn collect_random(settings: &CollectSettings, monitor: &dyn Monitor) -> Resu
     let mut steps = Vec::new();
     for k in 0..settings.rollouts {
         if monitor.is_cancelled() {
-            return Err(Error::Cancelled);
+            return Err(Error::cancelled());
         }
         let mut rng = rng_for(settings.seed, &[k as u64]);
         env.sample_instance(&mut rng);
@@ -78,7 +78,7 @@ pub fn collect_instance_pairs(settings: &InstancePairSettings, monitor: &dyn Mon
     let mut steps = Vec::new();
     for k in 0..settings.instances as u64 {
         if monitor.is_cancelled() {
-            return Err(Error::Cancelled);
+            return Err(Error::cancelled());
         }
         let mut env = instance_env(&settings.env, pair_instance_seed(settings.seed, k))?;
         for role in 0..2 {
@@ -276,6 +276,7 @@ mod tests {
     use super::*;
     use crate::data::instance_pairs;
     use crate::envs::parse_env;
+    use crate::error::ErrorKind;
     use crate::run::NullMonitor;
 
     #[test]
@@ -401,6 +402,6 @@ mod tests {
             command_line: "test".into(),
         };
         let err = collect_instance_pairs(&settings, &NullMonitor).unwrap_err();
-        assert!(matches!(err, Error::Budget(_)) && err.to_string().contains("--instances"), "{err}");
+        assert!(matches!(err.kind(), ErrorKind::Budget { flag, .. } if flag == "--max-memory-gib"), "{err}");
     }
 }

@@ -57,7 +57,7 @@ pub fn collect_ball(settings: &BallCollectSettings, monitor: &dyn Monitor) -> Re
     let mut originals = Vec::with_capacity(settings.trajectories);
     for k in 0..settings.trajectories {
         if monitor.is_cancelled() {
-            return Err(Error::Cancelled);
+            return Err(Error::cancelled());
         }
         let shot = (0..MAX_TRIES_PER_SHOT)
             .map(|attempt| {

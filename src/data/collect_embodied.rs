@@ -145,7 +145,7 @@ fn collect_game<G: BoardGame>(game: G, settings: &EmbodiedCollectSettings, monit
     let mut episodes = Episodes::new(&spec);
     for k in 0..settings.episodes {
         if monitor.is_cancelled() {
-            return Err(Error::Cancelled);
+            return Err(Error::cancelled());
         }
         let mut rng = rng_for(settings.seed, &[k as u64]);
         env.set_board(game.scramble(&mut rng));

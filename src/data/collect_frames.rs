@@ -33,7 +33,7 @@ pub fn add_pendulum_frames(data: &mut Dataset, monitor: &dyn Monitor) -> Result<
     let mut frames = Vec::with_capacity(data.steps.len() + rollouts.len());
     for (k, (_, rollout)) in rollouts.iter().enumerate() {
         if monitor.is_cancelled() {
-            return Err(Error::Cancelled);
+            return Err(Error::cancelled());
         }
         frames.extend(rollout.states.iter().map(|state| renderer.frame(state[0])));
         monitor.progress("render frames", k as u64 + 1, total);

@@ -94,7 +94,7 @@ fn fill(stage: &Path, count: usize, seed: u64, command_line: &str, monitor: &dyn
     let mut maps = Vec::with_capacity(count);
     for index in 0..count {
         if monitor.is_cancelled() {
-            return Err(Error::Cancelled);
+            return Err(Error::cancelled());
         }
         let map = generate_map(seed, index as u64);
         let path = stage.join(&map.name);

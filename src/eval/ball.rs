@@ -210,7 +210,7 @@ pub fn evaluate(
         for (group, recs) in &tests {
             for &h in &settings.horizons {
                 if monitor.is_cancelled() {
-                    return Err(Error::Cancelled);
+                    return Err(Error::cancelled());
                 }
                 let mut errs = Vec::new();
                 let mut too_short = 0;

@@ -218,7 +218,7 @@ pub fn evaluate(
     let mut ground_truth_returns = Vec::new();
     for k in 0..settings.contexts as u64 {
         if monitor.is_cancelled() {
-            return Err(Error::Cancelled);
+            return Err(Error::cancelled());
         }
         monitor.progress("contexts", k, settings.contexts as u64);
         let instance_seed = derive_seed(seed, &[k, 0]);

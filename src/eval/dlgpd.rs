@@ -228,7 +228,7 @@ pub fn evaluate(
             let pool = cached(&mut pools, source, || evidence_rollouts(source, largest, pool_seed, images))?;
             for &rollouts in &settings.evidence_rollouts {
                 if monitor.is_cancelled() {
-                    return Err(Error::Cancelled);
+                    return Err(Error::cancelled());
                 }
                 let evidence = first_rollouts(pool, rollouts);
                 let dynamics = condition_on(trained, &evidence, pool_seed)?;
@@ -288,7 +288,7 @@ fn prediction_checks(
     let mut checks = Vec::with_capacity(plan.len());
     for (index, (variant, kind, source)) in plan.iter().enumerate() {
         if monitor.is_cancelled() {
-            return Err(Error::Cancelled);
+            return Err(Error::cancelled());
         }
         let pool = cached(pools, source, || evidence_rollouts(source, largest, pool_seed, images))?;
         let dynamics = cached(&mut conditioned, source, || condition_on(trained, pool, pool_seed))?;

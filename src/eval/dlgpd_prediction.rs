@@ -88,7 +88,7 @@ fn linear_probe(latents: &[f64], dims: usize, states: &[[f64; 2]]) -> Result<[f6
             _ => s[1],
         };
         let y = DVector::from_iterator(rows, states.iter().map(target));
-        let weights = svd.solve(&y, 1e-12).map_err(|e| Error::Diverged(format!("latent probe: {e}")))?;
+        let weights = svd.solve(&y, 1e-12).map_err(|e| Error::diverged(format!("latent probe: {e}")))?;
         let residual = &design * weights - &y;
         let mean = y.mean();
         let total: f64 = y.iter().map(|v| (v - mean).powi(2)).sum();

@@ -206,7 +206,7 @@ fn ball_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) ->
         (
             "trained (quick)".to_string(),
             LoadedBallModel {
-                model: BallModel::new(trained.params).map_err(|e| Error::Diverged(e.to_string()))?,
+                model: BallModel::new(trained.params).map_err(|e| Error::diverged(e.to_string()))?,
                 spin_net: None,
             },
         ),

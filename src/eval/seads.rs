@@ -9,7 +9,7 @@ use rand::seq::IndexedRandom;
 use serde::Serialize;
 
 use crate::envs::boards::{BoardGame, GameSpec, LightsOut, Split, TileSwap};
-use crate::error::{Error, Result};
+use crate::error::{ErrorKind, Result};
 use crate::eval::plot::{box_plot, line_plot_in, Series};
 use crate::models::seads::boards::BoardPool;
 use crate::models::seads::collect::{Collector, Starts};
@@ -149,7 +149,7 @@ fn success_rows<G: BoardGame>(
                     &NullMonitor,
                 ) {
                     Ok(out) => out,
-                    Err(Error::Budget(_)) => {
+                    Err(e) if matches!(e.kind(), ErrorKind::Budget { .. }) => {
                         row.search_budget_exhausted += 1;
                         continue;
                     }

@@ -199,7 +199,7 @@ pub fn evaluate(
     let mut tasks = Vec::with_capacity(settings.tasks);
     for k in 0..settings.tasks as u64 {
         if monitor.is_cancelled() {
-            return Err(Error::Cancelled);
+            return Err(Error::cancelled());
         }
         monitor.progress("tasks", k, settings.tasks as u64);
         let task = run_task(models, &terrain, settings, seed, k, &monitor)?;

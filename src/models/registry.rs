@@ -113,7 +113,7 @@ pub static METHODS: [&dyn RegisteredMethod; 6] = [
 pub fn method(name: &str, dir: &Path) -> Result<&'static dyn RegisteredMethod> {
     METHODS.iter().copied().find(|m| m.name() == name).ok_or_else(|| {
         let known: Vec<&str> = METHODS.iter().map(|m| m.name()).collect();
-        Error::bad_file(dir, format!("holds a '{name}' run, which mbrl does not train; methods: {}", known.join(", ")))
+        Error::wrong_method(name, known.join(", ")).at(dir)
     })
 }
 

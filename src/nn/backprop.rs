@@ -51,7 +51,7 @@ pub fn tensor_index(params: &ParamSet, name: &str, shape: &[usize]) -> Result<us
         .ok_or_else(|| Error::config(format!("network lacks the tensor '{name}'")))?;
     let t = &params.tensors[index];
     if t.shape != shape || t.values.len() != shape.iter().product::<usize>() {
-        return Err(Error::config(format!("'{name}' has shape {:?}, expected {shape:?}", t.shape)));
+        return Err(Error::bad_shape(format!("the shape of '{name}'"), format!("{:?}", t.shape), format!("{shape:?}")));
     }
     Ok(index)
 }

@@ -55,7 +55,7 @@ impl DenseLayer {
         let w = find(params, &format!("{prefix}.weight"))?;
         let b = find(params, &format!("{prefix}.bias"))?;
         let [d_out, d_in] = w.shape[..] else {
-            return Err(Error::config(format!("'{}' has shape {:?}, expected [out, in]", w.name, w.shape)));
+            return Err(Error::bad_shape(format!("the shape of '{}'", w.name), format!("{:?}", w.shape), "[out, in]"));
         };
         if b.shape != [d_out] || w.values.len() != d_out * d_in || b.values.len() != d_out {
             return Err(Error::config(format!("'{}' {:?} does not fit its weight {:?}", b.name, b.shape, w.shape)));
@@ -160,7 +160,8 @@ impl DenseGru {
         let b_ih = find(params, &format!("{prefix}.bias_ih"))?;
         let b_hh = find(params, &format!("{prefix}.bias_hh"))?;
         let [three_h, d_input] = w_ih.shape[..] else {
-            return Err(Error::config(format!("'{}' has shape {:?}, expected [3H, in]", w_ih.name, w_ih.shape)));
+            let found = format!("{:?}", w_ih.shape);
+            return Err(Error::bad_shape(format!("the shape of '{}'", w_ih.name), found, "[3H, in]"));
         };
         let h = three_h / 3;
         let ok = three_h % 3 == 0

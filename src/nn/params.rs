@@ -176,10 +176,8 @@ impl<T: ParamScalar> ModuleMapper for Loader<'_, T> {
         };
         if source.shape != dims || source.values.len() != dims.iter().product::<usize>() {
             self.error.get_or_insert_with(|| {
-                Error::config(format!(
-                    "tensor '{}' has shape {:?}, the module expects {dims:?}",
-                    source.name, source.shape
-                ))
+                let name = format!("the shape of tensor '{}'", source.name);
+                Error::bad_shape(name, format!("{:?}", source.shape), format!("{dims:?} (the module's)"))
             });
             return param;
         }

@@ -81,7 +81,7 @@ impl CemConfig {
     }
 
     pub fn validate(&self) -> Result<()> {
-        let bad = |msg: String| Err(Error::Config(msg));
+        let bad = |msg: String| Err(Error::config(msg));
         if self.horizon == 0 || self.candidates == 0 || self.iterations == 0 {
             return bad("CEM: horizon, candidates and iterations must be at least 1".into());
         }

@@ -57,7 +57,13 @@ pub fn plan_board<G: BoardGame>(
     monitor.progress(phase, result.stats.stored, result.stats.stored);
     monitor.emit(&Event::text("search", search_text(&result.stats)));
     let plan = result.plan.as_ref().ok_or_else(|| {
-        Error::Budget(format!("no plan of at most {} moves exists; raise --max-depth", limits.max_depth))
+        let depth = limits.max_depth as f64;
+        Error::budget(
+            "--max-depth",
+            depth + 1.0,
+            depth,
+            format!("no plan of at most {} moves exists; raise --max-depth", limits.max_depth),
+        )
     })?;
     monitor.emit(&Event::text("plan", plan_text(&move_names(game, plan), 0, false)));
     let after = plan.iter().fold(board, |b, &m| game.apply(b, m));
@@ -91,7 +97,7 @@ pub fn execute_plan<G: BoardGame>(
     let mut trace = EffectorTrace::default();
     for (i, &mv) in plan.iter().enumerate() {
         if monitor.is_cancelled() {
-            return Err(Error::Cancelled);
+            return Err(Error::cancelled());
         }
         monitor.emit(&Event::text("plan", plan_text(&names, i, true)));
         let outcome = env.execute_observed(controller.as_mut(), mv, |_, p| trace.record(monitor, p));

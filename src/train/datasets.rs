@@ -54,7 +54,7 @@ pub fn load_datasets(paths: &[PathBuf]) -> Result<(Dataset, Vec<DataFile>)> {
 
 /// The env a dataset was collected in, checked against the one the user named (shared by every trainer).
 pub fn env_of(dataset: &Dataset, requested: Option<&str>, data: &Path) -> Result<EnvName> {
-    let env = parse_env(&dataset.meta.env).map_err(|e| Error::bad_file(data, format!("dataset env: {e}")))?;
+    let env = parse_env(&dataset.meta.env).map_err(|e| e.field("dataset env").at(data))?;
     if let Some(requested) = requested {
         let requested_env = parse_env(requested)?;
         if requested_env.canonical() != env.canonical() {

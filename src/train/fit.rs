@@ -232,7 +232,7 @@ pub fn fit(
     let mut steps_done = start;
     for step in start + 1..=settings.total_steps {
         if monitor.is_cancelled() {
-            return Err(Error::Cancelled);
+            return Err(Error::cancelled());
         }
         let loss = method.step(step)?;
         if !loss.is_finite() {
@@ -301,10 +301,11 @@ fn diverged(settings: &FitSettings, step: u64, what: &str, value: f64, checkpoin
         (0, _) | (_, false) => "no checkpoint was written".to_string(),
         _ => format!("the checkpoint of step {checkpoint} is intact and can be resumed"),
     };
-    Error::Diverged(format!(
+    let message = format!(
         "{} diverged: {what} loss {value} at step {step}; {saved}. Lower the learning rate or check the data for outliers",
         settings.method
-    ))
+    );
+    Error::diverged_at(step, value, message)
 }
 
 #[cfg(test)]
@@ -417,8 +418,8 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let err = run(5, dir.path()).err().unwrap();
         let text = err.to_string();
-        assert!(matches!(err, Error::Diverged(_)), "{text}");
-        assert!(text.contains("step 5") && text.contains("step 4"), "{text}");
+        assert!(matches!(err.kind(), crate::ErrorKind::Diverged { step: Some(5), .. }), "{text}");
+        assert!(text.contains("step 4 is intact"), "{text}");
         let manifest: serde_json::Value =
             serde_json::from_slice(&std::fs::read(dir.path().join("checkpoint.json")).unwrap()).unwrap();
         assert_eq!((manifest["step"].as_u64(), manifest["complete"].as_bool()), (Some(4), Some(false)));

@@ -137,8 +137,8 @@ impl<M: Method> RunRecord<M> {
         if record.method != M::NAME {
             return Err(Error::bad_file(path, format!("method '{}', expected '{}'", record.method, M::NAME)));
         }
-        M::validate(&record.config).map_err(|e| Error::bad_file(path, e.to_string()))?;
-        M::check_record(&record).map_err(|e| Error::bad_file(path, e.to_string()))?;
+        M::validate(&record.config).map_err(|e| e.at(path))?;
+        M::check_record(&record).map_err(|e| e.at(path))?;
         Ok(record)
     }
 

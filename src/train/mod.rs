@@ -111,13 +111,7 @@ impl OpenedCheckpoint {
     /// Refuses checkpoints of another method.
     pub fn expect_method(&self, method: &str) -> Result<()> {
         if self.manifest.method != method {
-            return Err(Error::bad_file(
-                self.dir.path(),
-                format!(
-                    "is a '{}' checkpoint; this needs a {method} run (`mbrl train {method}`)",
-                    self.manifest.method
-                ),
-            ));
+            return Err(Error::wrong_method(&self.manifest.method, method).at(self.dir.path()));
         }
         Ok(())
     }
@@ -127,15 +121,7 @@ impl OpenedCheckpoint {
         let path = self.dir.path();
         self.expect_method(method)?;
         if !self.manifest.complete && accept == Accept::Finished {
-            return Err(Error::bad_file(
-                path,
-                format!(
-                    "training stopped at step {} of {}; finish it with `mbrl train --resume {}`",
-                    self.manifest.step,
-                    self.manifest.total_steps,
-                    path.display()
-                ),
-            ));
+            return Err(Error::unfinished(self.manifest.step, self.manifest.total_steps).at(path));
         }
         Ok(())
     }

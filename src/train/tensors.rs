@@ -121,7 +121,9 @@ pub fn parse(path: &Path, bytes: &[u8]) -> Result<Vec<StoredTensor>> {
 /// shaped is an error naming the tensor.
 pub fn to_params(path: &Path, stored: &[StoredTensor], layout: &ParamSet) -> Result<ParamSet> {
     if stored.len() != layout.len() {
-        return Err(Error::bad_file(path, format!("{} tensors; this model has {}", stored.len(), layout.len())));
+        return Err(
+            Error::bad_shape("the tensor count", stored.len(), format!("{} (this model's)", layout.len())).at(path)
+        );
     }
     let mut tensors = Vec::with_capacity(layout.len());
     for expected in &layout.tensors {
@@ -133,10 +135,8 @@ pub fn to_params(path: &Path, stored: &[StoredTensor], layout: &ParamSet) -> Res
             return Err(Error::bad_file(path, format!("tensor '{}' is not F32", expected.name)));
         };
         if found.shape != expected.shape {
-            return Err(Error::bad_file(
-                path,
-                format!("tensor '{}' has shape {:?}; expected {:?}", expected.name, found.shape, expected.shape),
-            ));
+            let name = format!("the shape of tensor '{}'", expected.name);
+            return Err(Error::bad_shape(name, format!("{:?}", found.shape), format!("{:?}", expected.shape)).at(path));
         }
         tensors.push(NamedTensor { name: expected.name.clone(), shape: found.shape.clone(), values: values.clone() });
     }

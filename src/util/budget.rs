@@ -24,11 +24,12 @@ pub fn limit_bytes() -> f64 {
 pub fn check(flags: &str, bytes: f64, advice: &str) -> Result<()> {
     let limit = limit_bytes();
     if bytes.is_nan() || bytes > limit {
-        return Err(Error::Budget(format!(
+        let message = format!(
             "{flags} would hold about {} in memory, over the limit of {}: {advice}, or raise --max-memory-gib",
             human(bytes),
             human(limit)
-        )));
+        );
+        return Err(Error::budget("--max-memory-gib", bytes, limit, message));
     }
     Ok(())
 }

@@ -185,7 +185,7 @@ fn ball_training_resumes_to_the_same_bytes_and_stopped_runs_are_not_models() {
     };
     start(&dir.path().join("whole"), &request, &mbrl::run::NullMonitor).unwrap();
     let stop = StopAfter::new(CHECKPOINT_EVERY + 10);
-    assert!(matches!(start(&dir.path().join("stopped"), &request, &stop), Err(mbrl::Error::Cancelled)));
+    assert!(start(&dir.path().join("stopped"), &request, &stop).is_err_and(|e| e.is_cancelled()));
     let out = mbrl(dir.path()).args(["predict", "--model", "stopped", "--input", "t.mcap", "-q"]).output().unwrap();
     assert!(!out.status.success() && stderr_of(&out).contains("--resume"), "{}", stderr_of(&out));
     // The filter's validation schedule hangs on the total, so a run cannot be lengthened.

@@ -134,7 +134,7 @@ fn resume_ends_with_the_bytes_of_an_uninterrupted_run() {
     start(&run_dir("whole"), &request, &mbrl::run::NullMonitor).unwrap();
     let stop = StopAfter::new(25);
     let err = start(&run_dir("stopped"), &request, &stop).err().unwrap();
-    assert!(matches!(err, mbrl::Error::Cancelled), "{err}");
+    assert!(err.is_cancelled(), "{err}");
 
     // A run still in training is refused, unless asked for; its report then says how far it got.
     let eval = |extra: &[&str]| {

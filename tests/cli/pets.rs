@@ -79,7 +79,7 @@ fn resume_ends_with_the_bytes_of_an_uninterrupted_run() {
     // Stopped after step 50: the last checkpoint is step 40, so steps 41–50 are redone after resuming.
     let stop = StopAfter::new(50);
     let err = start(&run_dir("stopped"), &request, &stop).err().unwrap();
-    assert!(matches!(err, mbrl::Error::Cancelled), "{err}");
+    assert!(err.is_cancelled(), "{err}");
     let manifest: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dir.path().join("stopped/checkpoint.json")).unwrap()).unwrap();
     assert_eq!((manifest["step"].as_u64(), manifest["complete"].as_bool()), (Some(40), Some(false)));

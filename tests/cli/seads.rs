@@ -87,7 +87,7 @@ fn resume_ends_with_the_bytes_of_an_uninterrupted_run() {
     // Stopped after epoch 6: the last checkpoint is epoch 4, so epochs 5 and 6 are redone after resuming.
     let stop = StopAfter::new(6);
     let err = start(&run_dir("stopped"), &request, &stop).err().unwrap();
-    assert!(matches!(err, mbrl::Error::Cancelled), "{err}");
+    assert!(err.is_cancelled(), "{err}");
     let out = mbrl(dir.path()).args(["train", "--resume", "stopped", "--no-tui"]).output().unwrap();
     assert!(out.status.success(), "{}", stderr_of(&out));
     let (a, b) = (dir_bytes(&dir.path().join("whole")), dir_bytes(&dir.path().join("stopped")));

@@ -176,7 +176,7 @@ fn resume_ends_with_the_bytes_of_an_uninterrupted_run() {
     let start = mbrl::train::job::start::<tradyn::Tradyn>;
     start(&d.join("whole"), &request, &mbrl::run::NullMonitor).unwrap();
     let err = start(&d.join("stopped"), &request, &StopAfter::new(25)).err().unwrap();
-    assert!(matches!(err, mbrl::Error::Cancelled), "{err}");
+    assert!(err.is_cancelled(), "{err}");
     run_ok(d, &["train", "--resume", "stopped", "-q"]);
     // The CLI adds its loss report after training; the library run writes none.
     let model_files = |name: &str| -> Vec<(String, Vec<u8>)> {

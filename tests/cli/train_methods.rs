@@ -152,7 +152,7 @@ fn resume_if_stopped_goes_on_with_the_stopped_run_of_the_same_command() {
         provenance: Provenance::new("mbrl train …".into(), 4, 1),
     };
     let err = start(&planned.out, &request, &StopAfter::new(30)).err().unwrap();
-    assert!(matches!(err, mbrl::Error::Cancelled), "{err}");
+    assert!(err.is_cancelled(), "{err}");
     assert_eq!(manifest(&d.join("stopped"))["complete"], false);
     let with_seed = |seed: &str, out: &str, extra: &[&str]| -> Vec<String> {
         let base =

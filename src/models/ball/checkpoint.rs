@@ -80,7 +80,7 @@ fn load_checkpoint(dir: &Path) -> Result<(BallModelParams, Option<SpinNetWeights
             let path = dir.join(SPIN_NET_FILE);
             let net: SpinNetWeights = serde_json::from_slice(&bytes)
                 .map_err(|e| Error::bad_file(&path, format!("not spin-network weights: {e}")))?;
-            net.check().map_err(|e| Error::bad_file(&path, e.to_string()))?;
+            net.check().map_err(|e| e.at(&path))?;
             Some(net)
         }
     };

@@ -60,7 +60,7 @@ pub fn filter_recording(
         next = frame + 1;
     }
     let out = filter_belief(model, &start, &slots)
-        .map_err(|e| Error::Diverged(format!("trajectory {}: filter failed: {e}", recording.id)))?;
+        .map_err(|e| Error::diverged(format!("trajectory {}: filter failed: {e}", recording.id)))?;
     let mut beliefs = vec![start];
     beliefs.extend(out.states.iter().zip(&out.covariances).zip(&out.modes).map(|((m, c), p)| BallBelief {
         mean: *m,

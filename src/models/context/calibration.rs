@@ -391,7 +391,7 @@ pub fn read_context(model: &LoadedModel, path: &std::path::Path) -> Result<Vec<f
         .map_err(|i| Error::bad_file(path, format!("message {i} does not continue its rollout")))?;
     let mut rows = Vec::new();
     for (_, rollout) in &rollouts {
-        rows.extend(context_rows(model, rollout).map_err(|e| Error::bad_file(path, e.to_string()))?);
+        rows.extend(context_rows(model, rollout).map_err(|e| e.at(path))?);
     }
     Ok(rows)
 }

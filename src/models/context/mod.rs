@@ -116,7 +116,7 @@ impl Method for Context {
 
 /// The checks every record of this network passes: sizes that agree, and a dataset to resume from.
 pub fn check_details(details: &ContextDetails, data: &[DataFile]) -> Result<()> {
-    details.model.validate().map_err(|e| Error::config(format!("model: {e}")))?;
+    details.model.validate().map_err(|e| e.field("model"))?;
     if data.len() != 1 {
         return Err(Error::config(format!("lists {} training data files; a context model trains on one", data.len())));
     }
@@ -150,7 +150,7 @@ pub fn instance_pairs(dataset: &Dataset, path: &Path, spec: &ModelSpec) -> Resul
             ),
         ));
     }
-    let grouped = crate::data::instance_pairs(dataset).map_err(|e| Error::bad_file(path, e.to_string()))?;
+    let grouped = crate::data::instance_pairs(dataset).map_err(|e| e.at(path))?;
     if grouped.is_empty() {
         return Err(Error::bad_file(
             path,
@@ -412,7 +412,7 @@ pub fn model_from(opened: &OpenedCheckpoint, run: ContextRun, env: &EnvName) -> 
     let layout_net = train::init_net(&run.config, m.feature_dim, m.action_dim, m.local_dim, 0, &device);
     let layout = crate::nn::ParamSet::<f32>::from_module(&layout_net, net::param_name);
     let params = to_params(&model_path, &opened.tensors(MODEL_FILE)?, &layout)?;
-    let fast = FastContextModel::from_params(&params).map_err(|e| Error::bad_file(&model_path, e.to_string()))?;
+    let fast = FastContextModel::from_params(&params).map_err(|e| e.at(&model_path))?;
     Ok(LoadedModel { run, fast, dir: dir.to_path_buf(), progress: opened.progress() })
 }
 

@@ -13,7 +13,7 @@ use crate::nn::tensor::inference_device;
 pub fn encoded_means(vae: &VaeNet, windows: &Windows, rows: &[usize]) -> Result<Vec<f64>> {
     let latents = widened_means(vae, &windows.observations(rows).0, windows.kind.input_len());
     if latents.iter().any(|v| !v.is_finite()) {
-        return Err(Error::Diverged("the encoder gave non-finite latents".into()));
+        return Err(Error::diverged("the encoder gave non-finite latents"));
     }
     Ok(latents)
 }

@@ -103,9 +103,8 @@ impl Method for Dlgpd {
             ));
         }
         let c = &request.config;
-        let kind = ObservationKind::of(&dataset, c.images).map_err(|e| Error::bad_file(first, e.to_string()))?;
-        let windows =
-            Windows::from_dataset(&dataset, kind, request.seed).map_err(|e| Error::bad_file(first, e.to_string()))?;
+        let kind = ObservationKind::of(&dataset, c.images).map_err(|e| e.at(first))?;
+        let windows = Windows::from_dataset(&dataset, kind, request.seed).map_err(|e| e.at(first))?;
         drop(dataset);
         let (train_rows, valid_rows, counts) = split_rows(&windows, c.validation_fraction, request.seed);
         let details = DlgpdDetails { observation: kind, action_dim: windows.action_dim, transitions: counts };

@@ -105,7 +105,7 @@ pub fn loss_and_gradients(
     let loss = reconstruction + entropy + gp_loss;
     let total = scalar(&loss);
     if !total.is_finite() {
-        return Err(Error::Diverged(format!(
+        return Err(Error::diverged(format!(
             "DLGPD loss is {total} (reconstruction {reconstruction_value}, entropy {entropy_value}, GP {})",
             gp.value
         )));

@@ -56,7 +56,7 @@ pub fn reward_errors(
         }
     }
     if open_loop_rmse.iter().any(|v| !v.is_finite()) {
-        return Err(Error::Diverged("the open-loop latent rollout went non-finite".into()));
+        return Err(Error::diverged("the open-loop latent rollout went non-finite"));
     }
     Ok(RewardErrors { open_loop_rmse, encoded_rmse, constant_rmse, rollouts: starts.len() })
 }

@@ -128,7 +128,7 @@ impl Method for Pets {
     }
 
     fn check_record(record: &PetsRun) -> Result<()> {
-        record.details.model.validate(record.config.reward).map_err(|e| Error::config(format!("model: {e}")))?;
+        record.details.model.validate(record.config.reward).map_err(|e| e.field("model"))?;
         if record.data.is_empty() {
             return Err(Error::config("lists no training data file"));
         }
@@ -261,7 +261,7 @@ pub fn dynamics_from(
         }
     };
     let normalizer = Normalizer { mean: normalizer_part(net::INPUT_MEAN)?, std: normalizer_part(net::INPUT_STD)? };
-    normalizer.validate().map_err(|e| Error::bad_file(&model_path, e.to_string()))?;
+    normalizer.validate().map_err(|e| e.at(&model_path))?;
     let layout = layout_of(run)?;
     let weights: Vec<_> = stored.iter().filter(|t| !t.name.starts_with("input_normalizer.")).cloned().collect();
     let weights = to_params(&model_path, &weights, &layout)?;
@@ -282,7 +282,7 @@ pub fn dynamics_from(
         particles,
     )
     .map(|dynamics| dynamics.with_note(&opened.progress().unfinished_note()))
-    .map_err(|e| Error::bad_file(&model_path, e.to_string()))
+    .map_err(|e| e.at(&model_path))
 }
 
 /// The parameter names and shapes a network of this run has (built on the inference device, weights unused).

@@ -42,7 +42,8 @@ impl PetsTrainer {
             return Err(Error::data("no training transitions"));
         }
         if train.len() > u32::MAX as usize {
-            return Err(Error::Budget(format!("{} training transitions; at most {} supported", train.len(), u32::MAX)));
+            let message = format!("{} training transitions; at most {} supported", train.len(), u32::MAX);
+            return Err(Error::budget("--data", train.len() as f64, f64::from(u32::MAX), message));
         }
         let normalizer = Normalizer::fit(&train.inputs, train.input_dim)?;
         normalizer.apply(&mut train.inputs);

@@ -45,8 +45,7 @@ pub fn load(dir: &Path, accept: Accept) -> Result<LoadedSeads> {
     let (manipulator, _) = env.embodiment.build();
     let sac_config =
         run.config.sac_config(run.details.policy_input, manipulator.action_low(), manipulator.action_high());
-    let policy = Sac::from_weights(sac_config, &policy_tensors)
-        .map_err(|e| Error::bad_file(&dir.join(MODEL_FILE), e.to_string()))?;
+    let policy = Sac::from_weights(sac_config, &policy_tensors).map_err(|e| e.at(&dir.join(MODEL_FILE)))?;
     let mut params = ParamSet::<f32>::default();
     for t in model_tensors {
         let values = match t.data {
@@ -60,7 +59,7 @@ pub fn load(dir: &Path, accept: Accept) -> Result<LoadedSeads> {
         });
     }
     let model = FlipModel::from_params(&params, run.details.board_bits, run.config.skills)
-        .map_err(|e| Error::bad_file(&dir.join(MODEL_FILE), e.to_string()))?;
+        .map_err(|e| e.at(&dir.join(MODEL_FILE)))?;
     Ok(LoadedSeads { run, env, policy, model, dir: dir.to_path_buf(), progress: opened.progress() })
 }
 

@@ -93,18 +93,21 @@ pub struct SearchResult {
 
 fn budget_error(stats: &SearchStats, limits: &SearchLimits) -> Option<Error> {
     if stats.stored as usize > limits.max_nodes {
-        return Some(Error::Budget(format!(
+        let message = format!(
             "search stopped at depth {} after storing {} states, over the node budget of {}; raise --max-nodes",
             stats.depth, stats.stored, limits.max_nodes
-        )));
+        );
+        return Some(Error::budget("--max-nodes", stats.stored as f64, limits.max_nodes as f64, message));
     }
     if stats.peak_memory_bytes > limits.max_memory_bytes {
-        return Some(Error::Budget(format!(
+        let message = format!(
             "search stopped at depth {} using about {} MiB, over the memory budget of {} MiB; raise --max-memory-mib",
             stats.depth,
             stats.peak_memory_bytes >> 20,
             limits.max_memory_bytes >> 20
-        )));
+        );
+        let (need, limit) = (stats.peak_memory_bytes as f64, limits.max_memory_bytes as f64);
+        return Some(Error::budget("--max-memory-mib", need, limit, message));
     }
     None
 }

@@ -206,7 +206,7 @@ impl Sac {
         let critic_loss = (q1 - target.clone()).square().mean() + (q2 - target).square().mean();
         let critic_value = scalar(&critic_loss);
         if !critic_value.is_finite() {
-            return Err(Error::Diverged(format!("sac update {}: critic loss is {critic_value}", self.updates)));
+            return Err(Error::diverged(format!("sac update {}: critic loss is {critic_value}", self.updates)));
         }
         let mut grads = ParamSet::<f32>::gradients(self.critic_module(), &critic_loss.backward());
         self.critic_adam.update(&mut self.critic_params.values_mut(), &mut grads)?;
@@ -228,7 +228,7 @@ impl Sac {
         let actor_loss = (log_prob * alpha - q1.min_pair(q2)).mean();
         let actor_value = scalar(&actor_loss);
         if !actor_value.is_finite() {
-            return Err(Error::Diverged(format!("sac update {}: actor loss is {actor_value}", self.updates)));
+            return Err(Error::diverged(format!("sac update {}: actor loss is {actor_value}", self.updates)));
         }
         let mut grads = ParamSet::<f32>::gradients(self.policy_module(), &actor_loss.backward());
         self.policy_adam.update(&mut self.policy_params.values_mut(), &mut grads)?;

@@ -44,10 +44,9 @@ impl TransitionBatch {
         ];
         for (name, values, width) in fields {
             if Some(values.len()) != n.checked_mul(width) {
-                return Err(Error::data(format!(
-                    "sac update: batch '{name}' has {} values, expected {n} rows × {width}",
-                    values.len()
-                )));
+                let found = format!("{} values", values.len());
+                return Err(Error::bad_shape(format!("batch '{name}'"), found, format!("{n} rows × {width}"))
+                    .field("sac update"));
             }
             if let Some(i) = values.iter().position(|x| !x.is_finite()) {
                 return Err(Error::data(format!(

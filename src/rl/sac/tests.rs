@@ -287,7 +287,8 @@ fn bad_batches_and_configs_are_errors() {
     let good = random_batch(&mut rng, &c, 8);
     let mut short = good.clone();
     short.next_obs.pop();
-    assert!(sac.update(&short, &mut rng).unwrap_err().to_string().contains("next_obs"));
+    let err = sac.update(&short, &mut rng).unwrap_err();
+    assert!(matches!(err.kind(), crate::ErrorKind::BadShape { name, .. } if name.contains("next_obs")), "{err}");
     let mut nan = good.clone();
     nan.rewards[5] = f32::NAN;
     assert!(sac.update(&nan, &mut rng).unwrap_err().to_string().contains("row 5"));

@@ -132,7 +132,7 @@ impl BallSummary {
         let (params, spin_net) = trained.trainer.current();
         params
             .validate()
-            .map_err(|e| Error::Diverged(format!("ball EKF training ended with unusable parameters: {e}")))?;
+            .map_err(|e| Error::diverged(format!("ball EKF training ended with unusable parameters: {e}")))?;
         let history = loss_history(&dir.join(crate::run::dir::METRICS_FILE))?;
         let losses = history.first().zip(history.last()).map(|(first, last)| (first.1, last.1));
         Ok(BallSummary {

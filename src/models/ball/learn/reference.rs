@@ -22,7 +22,7 @@ pub fn chunk_nll(model: &BallModel, spin: Option<&SpinNetWeights>, chunk: &Chunk
     let at = |e: &dyn std::fmt::Display| format!("recording {} frame {}: {e}", chunk.recording, chunk.start_frame);
     let start = initial_belief(model.params(), chunk.m1, chunk.m2, 1, chunk.after_impact, &prior)
         .map_err(|e| Error::data(at(&e)))?;
-    let out = filter_belief(model, &start, &chunk.slots).map_err(|e| Error::Diverged(at(&e)))?;
+    let out = filter_belief(model, &start, &chunk.slots).map_err(|e| Error::diverged(at(&e)))?;
     Ok(-out.log_likelihood / chunk.measured().max(1) as f64)
 }
 

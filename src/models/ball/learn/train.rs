@@ -131,7 +131,7 @@ pub fn train(recordings: &[Recording], settings: &TrainSettings, monitor: &dyn M
     let log = LossLog { inner: monitor, losses: Mutex::new(Vec::with_capacity(settings.steps as usize)) };
     fit(&mut trainer, &fit_settings, &mut MemoryCheckpointer::default(), None, &log)?;
     let (params, spin_net) = trainer.current();
-    params.validate().map_err(|e| Error::Diverged(format!("ball EKF training ended with unusable parameters: {e}")))?;
+    params.validate().map_err(|e| Error::diverged(format!("ball EKF training ended with unusable parameters: {e}")))?;
     let losses = log.losses.into_inner().unwrap_or_else(|e| e.into_inner());
     Ok(TrainOutcome { params, spin_net, losses, chunks: trainer.chunk_count() })
 }

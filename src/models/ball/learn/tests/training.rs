@@ -117,7 +117,7 @@ fn same_seed_same_run_and_cancellation_stops_it() {
     assert_ne!(a.losses, c.losses);
 
     let monitor = Recorder::new(2);
-    assert!(matches!(train(&recs, &settings, &monitor), Err(crate::Error::Cancelled)));
+    assert!(train(&recs, &settings, &monitor).is_err_and(|e| e.is_cancelled()));
     assert_eq!(monitor.progress.load(Ordering::SeqCst), 2);
 }
 
