@@ -1,5 +1,6 @@
 pub mod ball;
 pub mod context;
+pub mod context_net;
 pub mod dlgpd;
 pub mod gp;
 pub mod pets;

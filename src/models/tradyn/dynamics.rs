@@ -8,7 +8,7 @@ use super::{MapLookup, TradynModel};
 use crate::control::{par_candidate_blocks, BatchDynamics};
 use crate::envs::terrain::TerrainMap;
 use crate::envs::unicycle::{clip_action, observation, MAX_SPEED};
-use crate::models::context::fast::{LocalFeatures, RolloutScratch};
+use crate::models::context_net::fast::{LocalFeatures, RolloutScratch};
 
 const CANDIDATES_PER_BLOCK: usize = 64;
 

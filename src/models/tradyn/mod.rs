@@ -1,7 +1,7 @@
 //! TRADYN (thesis chapter 5): the context model of Explore the Context on the unicycle's observation, with the
 //! terrain features under the robot as a third GRU input that is read from the map at every predicted position
 //! (eq. 5.11/5.12). Its ablation ("−T") is the same network without that input, predicting the terrain features
-//! as part of the state. Both train through `models::context`; this module adds what is specific to the robot:
+//! as part of the state. Both train through `models::context_net`, the network they share; this module adds what is specific to the robot:
 //! the map lookup, the learned model as a planner's dynamics, and navigation (eq. 5.13).
 
 pub mod dynamics;
@@ -17,8 +17,8 @@ use crate::envs::terrain::TerrainMap;
 use crate::envs::unicycle::{OBSERVATION_NAMES, TERRAIN_FEATURES};
 use crate::envs::EnvName;
 use crate::error::{Error, Result};
-use crate::models::context::fast::LocalFeatures;
-use crate::models::context::{
+use crate::models::context_net::fast::LocalFeatures;
+use crate::models::context_net::{
     self, ContextConfig, ContextDetails, ContextSummary, ContextTrainer, LoadedModel, StateSpace,
 };
 use crate::train::run_dir::Field;
@@ -60,7 +60,7 @@ impl Method for Tradyn {
     }
 
     fn prepare(request: &Request<Self>) -> Result<Prepared<Self>> {
-        context::prepare_model(request, &state_space(request.variant))
+        context_net::prepare_model(request, &state_space(request.variant))
     }
 
     fn variant_of(record: &RunRecord<Self>) -> Result<bool> {
@@ -68,7 +68,7 @@ impl Method for Tradyn {
     }
 
     fn check_record(record: &RunRecord<Self>) -> Result<()> {
-        context::check_details(&record.details, &record.data)?;
+        context_net::check_details(&record.details, &record.data)?;
         let spec = &record.details.model;
         let names_fit = spec.observations && spec.state_names.iter().map(String::as_str).eq(OBSERVATION_NAMES);
         if !names_fit || spec.action_dim != 2 || ![0, TERRAIN_FEATURES].contains(&spec.local_dim) {
@@ -111,7 +111,7 @@ impl TradynModel {
     /// A TRADYN run, finished or (when `accept` takes it) still training: then its best-validation weights.
     pub fn load(dir: &Path, accept: Accept) -> Result<Self> {
         let (opened, run) = open_run::<Tradyn>(dir, accept)?;
-        let loaded = context::model_from(&opened, run.retag(), &EnvName::Unicycle(None))?;
+        let loaded = context_net::model_from(&opened, run.retag(), &EnvName::Unicycle(None))?;
         Ok(TradynModel { loaded })
     }
 

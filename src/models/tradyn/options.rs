@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use crate::envs::{parse_env, EnvName};
 use crate::error::{Error, Result};
-use crate::models::context::options::{ContextOptions, Planned};
+use crate::models::context_net::options::{ContextOptions, Planned};
 use crate::train::run_dir::default_out;
 
 /// A TRADYN run on `data` (whose env is `data_env`), written to `out` (default `models/tradyn-terrain` or
