@@ -79,6 +79,9 @@ _mbrl() {
             mbrl__subcmd__eval,quick)
                 cmd="mbrl__subcmd__eval__subcmd__quick"
                 ;;
+            mbrl__subcmd__eval,render)
+                cmd="mbrl__subcmd__eval__subcmd__render"
+                ;;
             mbrl__subcmd__eval,seads)
                 cmd="mbrl__subcmd__eval__subcmd__seads"
                 ;;
@@ -111,6 +114,9 @@ _mbrl() {
                 ;;
             mbrl__subcmd__eval__subcmd__help,quick)
                 cmd="mbrl__subcmd__eval__subcmd__help__subcmd__quick"
+                ;;
+            mbrl__subcmd__eval__subcmd__help,render)
+                cmd="mbrl__subcmd__eval__subcmd__help__subcmd__render"
                 ;;
             mbrl__subcmd__eval__subcmd__help,seads)
                 cmd="mbrl__subcmd__eval__subcmd__help__subcmd__seads"
@@ -177,6 +183,9 @@ _mbrl() {
                 ;;
             mbrl__subcmd__help__subcmd__eval,quick)
                 cmd="mbrl__subcmd__help__subcmd__eval__subcmd__quick"
+                ;;
+            mbrl__subcmd__help__subcmd__eval,render)
+                cmd="mbrl__subcmd__help__subcmd__eval__subcmd__render"
                 ;;
             mbrl__subcmd__help__subcmd__eval,seads)
                 cmd="mbrl__subcmd__help__subcmd__eval__subcmd__seads"
@@ -479,7 +488,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval)
-            opts="-q -h -V --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version quick dataset boards embodied ball context tradyn seads dlgpd pendulum-swingup help"
+            opts="-q -h -V --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version quick dataset boards embodied ball context tradyn seads dlgpd pendulum-swingup render help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -505,7 +514,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__ball)
-            opts="-q -h -V --model --train-shots --augment-rotations --test-shots --unseen-shots --out --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --model --train-shots --augment-rotations --test-shots --unseen-shots --out --config --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -535,6 +544,10 @@ _mbrl() {
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
+                --config)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 --seed)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
@@ -555,13 +568,17 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__boards)
-            opts="-q -h -V --out --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --out --config --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
             fi
             case "${prev}" in
                 --out)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --config)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
@@ -585,7 +602,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__context)
-            opts="-q -h -V --model --env --contexts --validation-rollouts --validation-steps --transitions --horizon --strategy --candidates --elites --iters --beta-samples --swingup --swingup-steps --swingup-candidates --allow-incomplete --out --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --model --env --contexts --validation-rollouts --validation-steps --transitions --horizon --strategy --candidates --elites --iters --beta-samples --swingup --swingup-steps --swingup-candidates --allow-incomplete --out --config --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -651,6 +668,10 @@ _mbrl() {
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
+                --config)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 --seed)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
@@ -671,7 +692,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__dataset)
-            opts="-q -h -V --input --out --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --input --out --config --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -682,6 +703,10 @@ _mbrl() {
                     return 0
                     ;;
                 --out)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --config)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
@@ -705,7 +730,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__dlgpd)
-            opts="-q -h -V --model --env --evidence-rollouts --runs --steps --candidates --elites --iters --prediction-only --allow-incomplete --out --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --model --env --evidence-rollouts --runs --steps --candidates --elites --iters --prediction-only --allow-incomplete --out --config --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -747,6 +772,10 @@ _mbrl() {
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
+                --config)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 --seed)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
@@ -767,7 +796,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__embodied)
-            opts="-q -h -V --game --embodiment --max-depth --boards --split --out --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --game --embodiment --max-depth --boards --split --out --config --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -797,6 +826,10 @@ _mbrl() {
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
+                --config)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 --seed)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
@@ -817,7 +850,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__help)
-            opts="quick dataset boards embodied ball context tradyn seads dlgpd pendulum-swingup help"
+            opts="quick dataset boards embodied ball context tradyn seads dlgpd pendulum-swingup render help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -956,6 +989,20 @@ _mbrl() {
             COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
             return 0
             ;;
+        mbrl__subcmd__eval__subcmd__help__subcmd__render)
+            opts=""
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 4 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
         mbrl__subcmd__eval__subcmd__help__subcmd__seads)
             opts=""
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 4 ]] ; then
@@ -985,7 +1032,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__pendulum__subcmd__swingup)
-            opts="-q -h -V --model --particles --propagation --context --allow-incomplete --episodes --env --steps --horizon --candidates --elites --iters --noise --beta --no-warm-start --out --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --model --particles --propagation --context --allow-incomplete --episodes --env --steps --horizon --candidates --elites --iters --noise --beta --no-warm-start --out --config --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1047,6 +1094,10 @@ _mbrl() {
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
+                --config)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 --seed)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
@@ -1067,13 +1118,17 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__quick)
-            opts="-q -h -V --out --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --out --config --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
             fi
             case "${prev}" in
                 --out)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --config)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
@@ -1096,8 +1151,34 @@ _mbrl() {
             COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
             return 0
             ;;
+        mbrl__subcmd__eval__subcmd__render)
+            opts="-q -h -V --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                --seed)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --max-memory-gib)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
         mbrl__subcmd__eval__subcmd__seads)
-            opts="-q -h -V --model --max-depth --boards --coverage-boards --max-replans --split --max-nodes --out --allow-incomplete --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --model --max-depth --boards --coverage-boards --max-replans --split --max-nodes --out --allow-incomplete --config --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1135,6 +1216,10 @@ _mbrl() {
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
+                --config)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 --seed)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
@@ -1155,7 +1240,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__tradyn)
-            opts="-q -h -V --model-terrain --model-no-terrain --maps --tasks --transitions --steps --horizon --candidates --elites --iters --prediction-steps --out --allow-incomplete --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --model-terrain --model-no-terrain --maps --tasks --transitions --steps --horizon --candidates --elites --iters --prediction-steps --out --allow-incomplete --config --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1206,6 +1291,10 @@ _mbrl() {
                     return 0
                     ;;
                 --out)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --config)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
@@ -1365,7 +1454,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__help__subcmd__eval)
-            opts="quick dataset boards embodied ball context tradyn seads dlgpd pendulum-swingup"
+            opts="quick dataset boards embodied ball context tradyn seads dlgpd pendulum-swingup render"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1477,6 +1566,20 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__help__subcmd__eval__subcmd__quick)
+            opts=""
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 4 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mbrl__subcmd__help__subcmd__eval__subcmd__render)
             opts=""
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 4 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )

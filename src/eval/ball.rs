@@ -5,10 +5,12 @@
 
 use std::path::Path;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
+use super::num;
 use super::plot::{band_panels, line_plot, Band, Series};
 use super::stats::quantile_counting_failures;
+use super::summary::{publish, write_config};
 use crate::data::ball_io::{Recording, FRAME_RATE};
 use crate::data::collect_ball::{collect_ball, BallCollectSettings};
 use crate::envs::ball::Orientation;
@@ -24,7 +26,8 @@ use crate::util::atomic::write_text;
 use crate::util::seeding::derive_seed;
 use crate::util::table::write_csv;
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct BallEvalSettings {
     /// Default-pose shots the baseline is fitted on.
     pub train_shots: usize,
@@ -75,7 +78,7 @@ pub struct Method {
     pub predictor: Predictor,
 }
 
-#[derive(Clone, Debug, Serialize, PartialEq)]
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct ErrorSummary {
     pub method: String,
     pub group: String,
@@ -86,8 +89,11 @@ pub struct ErrorSummary {
     pub failed: usize,
     /// Shots too short for this horizon (left out).
     pub too_short: usize,
+    #[serde(with = "num::real")]
     pub q10: f64,
+    #[serde(with = "num::real")]
     pub median: f64,
+    #[serde(with = "num::real")]
     pub q90: f64,
 }
 
@@ -142,8 +148,84 @@ pub fn datasets(
     Ok((train, tests))
 }
 
+pub const PROTOCOL: &str = "ball";
+
+/// `mbrl eval ball`'s settings, as config.json records them.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BallConfig {
+    /// The EKF models as the command named them: thesis, initial, or checkpoint directories.
+    pub models: Vec<String>,
+    pub settings: BallEvalSettings,
+}
+
+impl BallConfig {
+    pub fn validate(&self) -> Result<()> {
+        let s = &self.settings;
+        if s.train_shots == 0 || s.test_shots_default == 0 || s.test_shots_unseen == 0 {
+            return Err(Error::config("--train-shots, --test-shots and --unseen-shots must be at least 1"));
+        }
+        Ok(())
+    }
+}
+
+/// A compared method as the report lists it; an EKF shows its impact matrix.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct MethodRecord {
+    pub name: String,
+    pub impact: Option<[[f64; 6]; 6]>,
+}
+
+/// One trajectory's protocol error (∞: the method could not predict it).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct TrajectoryError {
+    pub method: String,
+    pub group: String,
+    pub horizon_s: f64,
+    pub trajectory: String,
+    #[serde(with = "num::real")]
+    pub error_m: f64,
+}
+
+/// A drawn line of the side view.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct SideViewSeries {
+    pub name: String,
+    #[serde(with = "num::points")]
+    pub points: Vec<(f64, f64)>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct BallEvalSummary {
+    pub provenance: Provenance,
+    pub settings: BallEvalSettings,
+    pub methods: Vec<MethodRecord>,
+    /// The test groups, default pose first.
+    pub groups: Vec<String>,
+    pub errors: Vec<TrajectoryError>,
     pub rows: Vec<ErrorSummary>,
+    pub side_view: Vec<SideViewSeries>,
+}
+
+impl std::fmt::Display for BallEvalSummary {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        write!(f, "median prediction error at 1 s horizon:")?;
+        for r in self.rows.iter().filter(|r| (r.horizon_s - 1.0).abs() < 1e-9) {
+            write!(
+                f,
+                "\n  {:<32} {:<8} {:6.1} cm  (10-90 %: {:.1}-{:.1} cm, n = {}, failed {}, too short {})",
+                r.method,
+                r.group,
+                100.0 * r.median,
+                100.0 * r.q10,
+                100.0 * r.q90,
+                r.count,
+                r.failed,
+                r.too_short
+            )?;
+        }
+        Ok(())
+    }
 }
 
 impl BallEvalSummary {
@@ -158,19 +240,16 @@ impl BallEvalSummary {
 /// Fits the baselines on `train`, evaluates them and the given EKF models on the test sets, writes the
 /// report into `out_dir`.
 pub fn evaluate(
-    settings: &BallEvalSettings,
+    config: &BallConfig,
     ekf_models: Vec<(String, LoadedBallModel)>,
     provenance: &Provenance,
     out_dir: &Path,
     monitor: &dyn Monitor,
 ) -> Result<BallEvalSummary> {
+    config.validate()?;
+    let settings = &config.settings;
     let run = RunDir::create(out_dir)?;
-    run.write_config(&serde_json::json!({
-        "job": "eval ball",
-        "settings": settings,
-        "models": ekf_models.iter().map(|(n, m)| serde_json::json!({"name": n, "params": m.model.params()})).collect::<Vec<_>>(),
-        "provenance": provenance,
-    }))?;
+    write_config(config, provenance, run.path())?;
     let metrics = run.metrics()?;
     let monitor = Tee { first: monitor, second: &metrics };
     let (train, mut tests) = datasets(settings, provenance.seed, &monitor)?;
@@ -225,13 +304,13 @@ pub fn evaluate(
                     let err = method.predictor.predict(rec, cut, h as usize).and_then(|p| prediction_error(&p, rec));
                     // A method that cannot predict a trajectory scores as infinitely wrong, not as absent.
                     let err = err.unwrap_or(f64::INFINITY);
-                    errors.push(vec![
-                        method.name.clone(),
-                        group.clone(),
-                        format!("{:.3}", h as f64 / FRAME_RATE),
-                        rec.id.to_string(),
-                        format!("{err:.6}"),
-                    ]);
+                    errors.push(TrajectoryError {
+                        method: method.name.clone(),
+                        group: group.clone(),
+                        horizon_s: h as f64 / FRAME_RATE,
+                        trajectory: rec.id.to_string(),
+                        error_m: err,
+                    });
                     errs.push(err);
                 }
                 let q = |p| quantile_counting_failures(&errs, p).unwrap_or(f64::NAN);
@@ -251,7 +330,49 @@ pub fn evaluate(
             }
         }
     }
-    write_csv(&run.file("errors.csv"), &["method", "group", "horizon_s", "trajectory", "error_m"], &errors)?;
+    let summary = BallEvalSummary {
+        provenance: provenance.clone(),
+        settings: settings.clone(),
+        methods: methods
+            .iter()
+            .map(|m| MethodRecord {
+                name: m.name.clone(),
+                impact: match &m.predictor {
+                    Predictor::Ekf(LoadedBallModel { model, .. }) => Some(model.params().c),
+                    Predictor::Baseline(_) => None,
+                },
+            })
+            .collect(),
+        groups: tests.iter().map(|(g, _)| g.clone()).collect(),
+        errors,
+        rows,
+        side_view: trajectory_series(&methods, &tests)
+            .into_iter()
+            .map(|s| SideViewSeries { name: s.name, points: s.points })
+            .collect(),
+    };
+    publish(PROTOCOL, &summary, run.path(), render)?;
+    metrics.emit(&Event::Finished { ok: true });
+    Ok(summary)
+}
+
+/// Writes errors.csv, summary.csv, error_vs_horizon.png, trajectories.png and report.md of `summary` into `dir`.
+pub fn render(summary: &BallEvalSummary, dir: &Path) -> Result<()> {
+    let rows = &summary.rows;
+    let errors: Vec<Vec<String>> = summary
+        .errors
+        .iter()
+        .map(|e| {
+            vec![
+                e.method.clone(),
+                e.group.clone(),
+                format!("{:.3}", e.horizon_s),
+                e.trajectory.clone(),
+                format!("{:.6}", e.error_m),
+            ]
+        })
+        .collect();
+    write_csv(&dir.join("errors.csv"), &["method", "group", "horizon_s", "trajectory", "error_m"], &errors)?;
     let summary_rows: Vec<Vec<String>> = rows
         .iter()
         .map(|r| {
@@ -269,15 +390,17 @@ pub fn evaluate(
         })
         .collect();
     write_csv(
-        &run.file("summary.csv"),
+        &dir.join("summary.csv"),
         &["method", "group", "horizon_s", "trajectories", "failed", "too_short", "q10_m", "median_m", "q90_m"],
         &summary_rows,
     )?;
     // One panel per launcher pose, in centimetres like the tables; a method keeps its colour in every panel.
-    let panels: Vec<(String, Vec<Band>)> = tests
+    let panels: Vec<(String, Vec<Band>)> = summary
+        .groups
         .iter()
-        .map(|(group, _)| {
-            let bands = methods
+        .map(|group| {
+            let bands = summary
+                .methods
                 .iter()
                 .map(|m| Band {
                     name: m.name.clone(),
@@ -292,31 +415,23 @@ pub fn evaluate(
         })
         .collect();
     band_panels(
-        &run.file("error_vs_horizon.png"),
+        &dir.join("error_vs_horizon.png"),
         "Prediction error vs horizon per launcher pose (median, 10-90 %)",
         "horizon [s]",
         "error [cm]",
         &panels,
     )?;
-    trajectory_plot(&run.file("trajectories.png"), &methods, &tests)?;
-    let md = report_markdown(settings, &methods, &rows);
-    let path = run.file("report.md");
-    write_text(&path, &md)?;
-    metrics.emit(&Event::Finished { ok: true });
-    Ok(BallEvalSummary { rows })
-}
-
-/// Side view (y, z) of a few test shots: measurements, the filtered part and the 1 s prediction of the
-/// first EKF method; the side view shows the bounce, where prediction is hardest.
-fn trajectory_plot(path: &Path, methods: &[Method], tests: &[TestSet]) -> Result<()> {
-    let series = trajectory_series(methods, tests);
-    if series.is_empty() {
-        return Ok(());
+    if !summary.side_view.is_empty() {
+        let series: Vec<Series> =
+            summary.side_view.iter().map(|s| Series { name: s.name.clone(), points: s.points.clone() }).collect();
+        line_plot(&dir.join("trajectories.png"), "Test shots from the side", "y [m]", "z [m]", &series)?;
     }
-    line_plot(path, "Test shots from the side", "y [m]", "z [m]", &series)
+    let md = report_markdown(&summary.settings, &summary.methods, rows);
+    write_text(&dir.join("report.md"), &md)
 }
 
-/// The (y, z) series of `trajectory_plot`; every series in the side view's coordinates.
+/// The (y, z) series of trajectories.png: measurements, the filtered part and the 1 s prediction of the
+/// first EKF method on a few test shots; the side view shows the bounce, where prediction is hardest. Every series in the side view's coordinates.
 fn trajectory_series(methods: &[Method], tests: &[TestSet]) -> Vec<Series> {
     let Some(Method { predictor: Predictor::Ekf(ekf), name }) = methods.first() else {
         return Vec::new();
@@ -357,7 +472,7 @@ fn format_c(c: &[[f64; 6]; 6]) -> String {
         .join("\n")
 }
 
-fn report_markdown(settings: &BallEvalSettings, methods: &[Method], rows: &[ErrorSummary]) -> String {
+fn report_markdown(settings: &BallEvalSettings, methods: &[MethodRecord], rows: &[ErrorSummary]) -> String {
     let mut md = format!(
         "# Ball trajectory prediction (thesis 6.5.2/6.5.3, simulated shots)\n\n\
          Train: {} default-pose shots + {} rotated copies each (baseline fitting). Test: {} default-pose shots and {} per unseen pose.\n\
@@ -395,8 +510,8 @@ fn report_markdown(settings: &BallEvalSettings, methods: &[Method], rows: &[Erro
     }
     md.push_str("\nAll horizons: `summary.csv`; per trajectory: `errors.csv`.\n\n![error vs horizon](error_vs_horizon.png)\n\n![trajectories](trajectories.png)\n");
     for m in methods {
-        if let Predictor::Ekf(LoadedBallModel { model, .. }) = &m.predictor {
-            md.push_str(&format!("\n## Impact matrix C of `{}`\n\nRows/columns: v_x, v_y, v_z, ω_x, ω_y, ω_z.\n\n|  |  |  |  |  |  |\n|---|---|---|---|---|---|\n{}\n", m.name, format_c(&model.params().c)));
+        if let Some(c) = &m.impact {
+            md.push_str(&format!("\n## Impact matrix C of `{}`\n\nRows/columns: v_x, v_y, v_z, ω_x, ω_y, ω_z.\n\n|  |  |  |  |  |  |\n|---|---|---|---|---|---|\n{}\n", m.name, format_c(c)));
         }
     }
     md.push_str(&format!(

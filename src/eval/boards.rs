@@ -4,9 +4,11 @@
 use std::path::Path;
 
 use rand::seq::IndexedRandom;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
+use super::num;
 use super::plot::{line_panels, Panel, Series};
+use super::summary::{publish, write_config};
 use crate::envs::boards::depth::{DenseIndex, DepthTable};
 use crate::envs::boards::sets::boards_at;
 use crate::envs::boards::{split_of, LightsOut, Split, TileSwap};
@@ -29,7 +31,7 @@ pub const TILESWAP_TABLE_7_1: [u64; 17] =
 pub const LIGHTSOUT_TABLE_7_2: [(u64, u64); 5] = [(7, 18), (99, 201), (785, 1515), (4200, 8450), (17849, 35281)];
 pub const TILESWAP_TABLE_7_2: [(u64, u64); 5] = [(7, 5), (31, 57), (179, 291), (683, 1295), (2237, 4421)];
 
-#[derive(Clone, Debug, Serialize, PartialEq)]
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct DepthRow {
     pub game: String,
     pub depth: usize,
@@ -74,14 +76,49 @@ fn depth_rows<G: DenseIndex>(
     Ok(rows)
 }
 
+pub const BOARDS_PROTOCOL: &str = "boards";
+pub const EMBODIED_PROTOCOL: &str = "embodied";
+
+/// `mbrl eval boards` has no settings: the tables are exhaustive.
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoardsConfig {}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct BoardsSummary {
+    pub provenance: Provenance,
+    pub rows: Vec<DepthRow>,
+}
+
+impl std::fmt::Display for BoardsSummary {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        write!(f, "game        depth   boards    train     test   thesis")?;
+        for r in &self.rows {
+            let thesis = r.thesis.map(|t| t.to_string()).unwrap_or_else(|| "-".into());
+            write!(f, "\n{:<11} {:>5} {:>8} {:>8} {:>8} {:>8}", r.game, r.depth, r.boards, r.train, r.test, thesis)?;
+        }
+        Ok(())
+    }
+}
+
 /// `mbrl eval boards`: depth and split tables of LightsOut 5×5 and TileSwap 3×3.
-pub fn depth_report(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) -> Result<Vec<DepthRow>> {
+pub fn depth_report(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) -> Result<BoardsSummary> {
     let run = RunDir::create(out_dir)?;
-    run.write_config(&serde_json::json!({"job": "eval boards", "provenance": provenance}))?;
+    write_config(&BoardsConfig {}, provenance, run.path())?;
     let metrics = run.metrics()?;
     let monitor = Tee { first: monitor, second: &metrics };
     let mut rows = depth_rows(&LightsOut::new(5)?, &LIGHTSOUT_TABLE_7_1, &LIGHTSOUT_TABLE_7_2, &monitor)?;
     rows.extend(depth_rows(&TileSwap::new(), &TILESWAP_TABLE_7_1, &TILESWAP_TABLE_7_2, &monitor)?);
+    let summary = BoardsSummary { provenance: provenance.clone(), rows };
+    publish(BOARDS_PROTOCOL, &summary, run.path(), render_depths)?;
+    // Only the run's own file is told it finished: the caller's view may have more jobs to show.
+    metrics.emit(&Event::Finished { ok: true });
+    Ok(summary)
+}
+
+/// Writes depth_table.csv, depths.png and report.md of `summary` into `dir`.
+pub fn render_depths(summary: &BoardsSummary, dir: &Path) -> Result<()> {
+    let rows = &summary.rows;
     let csv_rows: Vec<Vec<String>> = rows
         .iter()
         .map(|r| {
@@ -101,7 +138,7 @@ pub fn depth_report(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monit
         })
         .collect();
     write_csv(
-        &run.file("depth_table.csv"),
+        &dir.join("depth_table.csv"),
         &[
             "game",
             "depth",
@@ -122,7 +159,7 @@ pub fn depth_report(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monit
          | game | depth | boards | train | test | 7.1 | 7.2 train | 7.2 test |\n|---|---|---|---|---|---|---|---|\n",
     );
     let dash = || "–".to_string();
-    for r in &rows {
+    for r in rows {
         let thesis = r.thesis.map(|t| t.to_string()).unwrap_or_else(dash);
         let (a, b) = r.thesis_split.map(|(a, b)| (a.to_string(), b.to_string())).unwrap_or_else(|| (dash(), dash()));
         md.push_str(&format!(
@@ -136,15 +173,12 @@ pub fn depth_report(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monit
         "\nRows differing from Table 7.1: {mismatches}. Rows differing from Table 7.2: {split_mismatches}.\n\n\
          ![boards per depth](depths.png)\n"
     ));
-    depth_plot(&run.file("depths.png"), &rows)?;
-    let path = run.file("report.md");
-    write_text(&path, &md)?;
-    // Only the run's own file is told it finished: the caller's view may have more jobs to show.
-    metrics.emit(&Event::Finished { ok: true });
-    Ok(rows)
+    depth_plot(&dir.join("depths.png"), rows)?;
+    write_text(&dir.join("report.md"), &md)
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct EmbodiedSettings {
     pub embodiment: Embodiment,
     pub max_depth: u8,
@@ -152,12 +186,85 @@ pub struct EmbodiedSettings {
     pub split: Split,
 }
 
-#[derive(Clone, Debug, Serialize, PartialEq)]
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct EmbodiedRow {
     pub depth: u8,
     pub boards: usize,
     pub solved: usize,
+    #[serde(with = "num::real")]
     pub mean_control_steps: f64,
+}
+
+/// `mbrl eval embodied`'s settings, as config.json records them.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EmbodiedConfig {
+    /// lightsout (5x5), lightsout:N or tileswap.
+    pub game: String,
+    pub settings: EmbodiedSettings,
+}
+
+impl EmbodiedConfig {
+    pub fn validate(&self) -> Result<()> {
+        if self.settings.max_depth == 0 || self.settings.boards_per_depth == 0 {
+            return Err(crate::error::Error::config("--max-depth and --boards must be at least 1"));
+        }
+        Ok(())
+    }
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct EmbodiedSummary {
+    pub provenance: Provenance,
+    /// The game as the report names it (`LightsOut 5x5`).
+    pub game: String,
+    pub settings: EmbodiedSettings,
+    pub rows: Vec<EmbodiedRow>,
+}
+
+impl EmbodiedSummary {
+    /// (boards, solved) over every depth.
+    pub fn totals(&self) -> (usize, usize) {
+        self.rows.iter().fold((0, 0), |(t, s), r| (t + r.boards, s + r.solved))
+    }
+}
+
+impl std::fmt::Display for EmbodiedSummary {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        for (i, r) in self.rows.iter().enumerate() {
+            if i > 0 {
+                writeln!(f)?;
+            }
+            write!(
+                f,
+                "depth {}: {}/{} solved ({:.1} %), {:.1} control steps per board",
+                r.depth,
+                r.solved,
+                r.boards,
+                100.0 * r.solved as f64 / r.boards.max(1) as f64,
+                r.mean_control_steps
+            )?;
+        }
+        Ok(())
+    }
+}
+
+/// `mbrl eval embodied` from its recorded settings.
+pub fn embodied(
+    config: &EmbodiedConfig,
+    provenance: &Provenance,
+    out_dir: &Path,
+    monitor: &dyn Monitor,
+) -> Result<EmbodiedSummary> {
+    config.validate()?;
+    match crate::envs::boards::GameSpec::parse(&config.game)? {
+        crate::envs::boards::GameSpec::LightsOut(n) => {
+            embodied_report(&LightsOut::new(n)?, config, provenance, out_dir, monitor)
+        }
+        crate::envs::boards::GameSpec::TileSwap => {
+            embodied_report(&TileSwap::new(), config, provenance, out_dir, monitor)
+        }
+    }
 }
 
 fn embodied_rows<G: DenseIndex>(
@@ -197,18 +304,28 @@ fn embodied_rows<G: DenseIndex>(
 /// `mbrl eval embodied`: the scripted controller plays optimal plans for boards of depth 1..=max_depth.
 pub fn embodied_report<G: DenseIndex>(
     game: &G,
-    settings: &EmbodiedSettings,
+    config: &EmbodiedConfig,
     provenance: &Provenance,
     out_dir: &Path,
     monitor: &dyn Monitor,
-) -> Result<Vec<EmbodiedRow>> {
+) -> Result<EmbodiedSummary> {
+    let settings = &config.settings;
     let run = RunDir::create(out_dir)?;
-    run.write_config(&serde_json::json!({
-        "job": "eval embodied", "game": game.name(), "settings": settings, "provenance": provenance
-    }))?;
+    write_config(config, provenance, run.path())?;
     let metrics = run.metrics()?;
     let monitor = Tee { first: monitor, second: &metrics };
     let rows = embodied_rows(game, settings, provenance.seed, &monitor)?;
+    let summary =
+        EmbodiedSummary { provenance: provenance.clone(), game: game.name(), settings: settings.clone(), rows };
+    publish(EMBODIED_PROTOCOL, &summary, run.path(), render_embodied)?;
+    // Only the run's own file is told it finished: the caller's view may have more jobs to show.
+    metrics.emit(&Event::Finished { ok: true });
+    Ok(summary)
+}
+
+/// Writes embodied.csv, embodied.png and report.md of `summary` into `dir`.
+pub fn render_embodied(summary: &EmbodiedSummary, dir: &Path) -> Result<()> {
+    let (rows, settings) = (&summary.rows, &summary.settings);
     let csv_rows: Vec<Vec<String>> = rows
         .iter()
         .map(|r| {
@@ -223,22 +340,22 @@ pub fn embodied_report<G: DenseIndex>(
         })
         .collect();
     write_csv(
-        &run.file("embodied.csv"),
+        &dir.join("embodied.csv"),
         &["depth", "boards", "solved", "success_rate", "mean_control_steps"],
         &csv_rows,
     )?;
-    let (total, solved) = rows.iter().fold((0, 0), |(t, s), r| (t + r.boards, s + r.solved));
+    let (total, solved) = summary.totals();
     let mut md = format!(
         "# {} played by the {} scripted controller\n\n\
          Boards of each depth drawn from the {} split; plans by bidirectional BFS with the true rules, executed\n\
          move by move (skill step limit per move). Overall: {solved}/{total} solved ({:.2} %).\n\n\
          | depth | boards | solved | success rate | mean control steps |\n|---|---|---|---|---|\n",
-        game.name(),
+        summary.game,
         settings.embodiment.name(),
         settings.split.as_str(),
         100.0 * solved as f64 / total.max(1) as f64
     );
-    for r in &rows {
+    for r in rows {
         md.push_str(&format!(
             "| {} | {} | {} | {:.2} % | {:.1} |\n",
             r.depth,
@@ -249,12 +366,8 @@ pub fn embodied_report<G: DenseIndex>(
         ));
     }
     md.push_str("\n![success and control steps per depth](embodied.png)\n");
-    embodied_plot(&run.file("embodied.png"), &game.name(), settings.embodiment.name(), &rows)?;
-    let path = run.file("report.md");
-    write_text(&path, &md)?;
-    // Only the run's own file is told it finished: the caller's view may have more jobs to show.
-    metrics.emit(&Event::Finished { ok: true });
-    Ok(rows)
+    embodied_plot(&dir.join("embodied.png"), &summary.game, settings.embodiment.name(), rows)?;
+    write_text(&dir.join("report.md"), &md)
 }
 
 /// Boards per depth on a log scale, all and per split, one panel per game.

@@ -9,10 +9,12 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use rand::Rng;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
+use super::num;
 use super::plot::{line_plot, rising_line_plot, Series};
 use super::stats::{mean, wilcoxon_signed_rank, Alternative};
+use super::summary::{publish, write_config};
 use super::swingup::{self, SwingupSettings};
 use crate::data::Rollout;
 use crate::envs::{instance_env, EnvName};
@@ -29,7 +31,8 @@ use crate::util::atomic::write_text;
 use crate::util::seeding::{derive_seed, rng_for};
 use crate::util::table::write_csv;
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct ContextEvalSettings {
     pub contexts: usize,
     /// Validation rollouts per context and their length (thesis: 20 × 50).
@@ -44,49 +47,203 @@ pub struct ContextEvalSettings {
     pub swingup: Option<SwingupSettings>,
 }
 
-/// What one strategy achieved in one context.
+pub const PROTOCOL: &str = "context";
+
 /// The reference row's name in CSVs: the model given no calibration transitions.
 const EMPTY_CONTEXT: &str = "empty-context";
 
-#[derive(Clone, Debug)]
-struct Outcome {
+/// `mbrl eval context`'s settings, as config.json records them.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContextEvalConfig {
+    /// The context-model checkpoint.
+    pub model: std::path::PathBuf,
+    /// The env the model was trained on.
+    pub env: String,
+    pub allow_incomplete: bool,
+    pub settings: ContextEvalSettings,
+}
+
+impl ContextEvalConfig {
+    /// The range checks of the command's flags, before the model is loaded.
+    pub fn validate(&self, env: &EnvName) -> Result<()> {
+        let s = &self.settings;
+        s.calibration.validate()?;
+        if let Some(sw) = &s.swingup {
+            if !matches!(env, EnvName::Pendulum(_)) {
+                return Err(Error::config(format!(
+                    "--swingup needs a pendulum env (pendulum:quadrant in the thesis), not '{}'",
+                    env.canonical()
+                )));
+            }
+            if !(2..=100_000).contains(&sw.cem.candidates) || !(1..=10_000).contains(&sw.steps) {
+                return Err(Error::config("--swingup-candidates must be 2..=100000 and --swingup-steps 1..=10000"));
+            }
+        }
+        if !(2..=100_000).contains(&s.contexts)
+            || !(1..=10_000).contains(&s.validation_rollouts)
+            || !(1..=10_000).contains(&s.validation_steps)
+        {
+            return Err(Error::config(
+                "--contexts must be 2..=100000, --validation-rollouts and --validation-steps 1..=10000",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// What one strategy achieved in one context.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Outcome {
     /// Per-step MSE over the validation rollouts (averaged over state dims and rollouts), by horizon.
-    mse_by_horizon: Vec<f64>,
-    final_entropy: f64,
-    quadrants: Option<usize>,
-    swingup_return: Option<f64>,
-    action_response: f64,
+    #[serde(with = "num::reals")]
+    pub mse_by_horizon: Vec<f64>,
+    #[serde(with = "num::real")]
+    pub final_entropy: f64,
+    pub quadrants: Option<usize>,
+    #[serde(with = "num::opt")]
+    pub swingup_return: Option<f64>,
+    #[serde(with = "num::real")]
+    pub action_response: f64,
 }
 
 /// The model given no calibration at all (the mean of q(β | ∅)) in one context: the reference row.
-struct NoCalibration {
-    mse_by_horizon: Vec<f64>,
-    action_response: f64,
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct NoCalibration {
+    #[serde(with = "num::reals")]
+    pub mse_by_horizon: Vec<f64>,
+    #[serde(with = "num::real")]
+    pub action_response: f64,
 }
 
+/// A paired one-sided Wilcoxon signed-rank test between two strategies.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct PairTest {
+    pub better: Strategy,
+    pub worse: Strategy,
+    /// What "better" means (`MSE lower`, `swing-up return higher`).
+    pub label: String,
+    pub n: usize,
+    #[serde(with = "num::real")]
+    pub statistic: f64,
+    #[serde(with = "num::real")]
+    pub p_value: f64,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ContextEvalSummary {
-    /// Mean over contexts of the mean validation MSE, per strategy (in `settings.strategies` order).
+    pub provenance: Provenance,
+    pub settings: ContextEvalSettings,
+    pub env: String,
+    /// The checkpoint and how far it was trained, as the report names it.
+    pub model: String,
+    /// Whether the model space holds angles as (cos, sin).
+    pub angular: bool,
+    /// Entropy of q(β | ∅).
+    #[serde(with = "num::real")]
+    pub prior_entropy: f64,
+    /// Per context, per strategy (in `settings.strategies` order).
+    pub outcomes: Vec<Vec<Outcome>>,
+    pub no_calibration: Vec<NoCalibration>,
+    /// With `swingup`: the return of the swing-up on the simulator's own equations, per context.
+    #[serde(with = "num::reals")]
+    pub ground_truth_returns: Vec<f64>,
+    /// Mean over contexts of the mean validation MSE, per strategy.
+    #[serde(with = "num::reals")]
     pub mean_mse: Vec<f64>,
     /// The same for the model given no calibration at all (the mean of q(β | ∅)): the reference that shows
     /// whether the model uses its context.
+    #[serde(with = "num::real")]
     pub empty_context_mse: f64,
     /// Median over contexts of the action response (model / simulator, 1 = right, 0 = action ignored), per
     /// strategy, and for the model given no calibration.
+    #[serde(with = "num::reals")]
     pub action_response: Vec<f64>,
+    #[serde(with = "num::real")]
     pub empty_context_action_response: f64,
-    /// One-sided p-values that the first strategy named has lower MSE than the second.
-    pub tests: Vec<(Strategy, Strategy, f64)>,
-    /// Toy only: (mean entropy after one informative transition, after one non-informative transition).
-    pub toy_entropy: Option<(f64, f64)>,
-    /// With `swingup`: mean swing-up return per strategy, the ground-truth model's mean return, and one-sided
-    /// p-values that the first strategy named gives a higher return than the second.
+    /// First strategy named has lower MSE than the second.
+    pub tests: Vec<PairTest>,
+    /// Per strategy: p that it has lower MSE than no calibration.
+    #[serde(with = "num::reals")]
+    pub against_empty: Vec<f64>,
+    /// With `swingup`: mean swing-up return per strategy, the ground truth's, and the return tests.
     pub swingup: Option<SwingupSummary>,
+    /// Toy only: the entropy after one transition from s = 0 against the action (Fig. 4.4a), the prior entropy
+    /// of that belief, and its means over informative and non-informative actions.
+    pub toy: Option<ToyEntropy>,
 }
 
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct SwingupSummary {
+    #[serde(with = "num::reals")]
     pub mean_return: Vec<f64>,
+    #[serde(with = "num::real")]
     pub ground_truth_mean_return: f64,
-    pub tests: Vec<(Strategy, Strategy, f64)>,
+    pub tests: Vec<PairTest>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ToyEntropy {
+    /// (action, entropy) pairs.
+    #[serde(with = "num::points")]
+    pub curve: Vec<(f64, f64)>,
+    #[serde(with = "num::real")]
+    pub prior: f64,
+    #[serde(with = "num::real")]
+    pub informative: f64,
+    #[serde(with = "num::real")]
+    pub non_informative: f64,
+}
+
+impl ContextEvalSummary {
+    /// The one-sided p of `better` over `worse` in the MSE tests.
+    pub fn p_value(&self, better: Strategy, worse: Strategy) -> Option<f64> {
+        self.tests.iter().find(|t| t.better == better && t.worse == worse).map(|t| t.p_value)
+    }
+}
+
+impl std::fmt::Display for ContextEvalSummary {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        let strategies = &self.settings.strategies;
+        for ((s, m), r) in strategies.iter().zip(&self.mean_mse).zip(&self.action_response) {
+            writeln!(f, "{:<10} mean prediction MSE {m:.4e}, action response {r:.3}", s.name())?;
+        }
+        writeln!(
+            f,
+            "no calibration (empty context, reference) mean prediction MSE {:.4e}, action response {:.3}",
+            self.empty_context_mse, self.empty_context_action_response
+        )?;
+        write!(
+            f,
+            "(action response: the model's one-step response to the action over the simulator's; 1 right, 0 ignored)"
+        )?;
+        for t in &self.tests {
+            write!(f, "\nWilcoxon: {} lower than {}: p = {:.3e}", t.better.name(), t.worse.name(), t.p_value)?;
+        }
+        if let Some(sw) = &self.swingup {
+            for (s, r) in strategies.iter().zip(&sw.mean_return) {
+                write!(f, "\n{:<10} mean swing-up return {r:.1}", s.name())?;
+            }
+            write!(f, "\nground truth mean swing-up return {:.1}", sw.ground_truth_mean_return)?;
+            for t in &sw.tests {
+                write!(
+                    f,
+                    "\nWilcoxon: {} higher swing-up return than {}: p = {:.3e}",
+                    t.better.name(),
+                    t.worse.name(),
+                    t.p_value
+                )?;
+            }
+        }
+        if let Some(toy) = &self.toy {
+            write!(
+                f,
+                "\nentropy after one transition: informative actions {:.3}, non-informative {:.3} nats",
+                toy.informative, toy.non_informative
+            )?;
+        }
+        Ok(())
+    }
 }
 
 fn layout(title: &str) -> Event {
@@ -176,11 +333,12 @@ pub fn entropy_after_one_action(model: &LoadedModel, actions: &[f64], samples: u
 pub fn evaluate(
     model: &LoadedModel,
     env: &EnvName,
-    settings: &ContextEvalSettings,
+    config: &ContextEvalConfig,
     provenance: &Provenance,
     report_dir: &Path,
     monitor: &dyn Monitor,
 ) -> Result<ContextEvalSummary> {
+    let settings = &config.settings;
     if settings.contexts < 2 || settings.validation_rollouts == 0 || settings.validation_steps == 0 {
         return Err(Error::config("eval context needs at least 2 contexts and 1 validation rollout of ≥ 1 step"));
     }
@@ -200,13 +358,7 @@ pub fn evaluate(
         }
     }
     let run = RunDir::create(report_dir)?;
-    run.write_config(&serde_json::json!({
-        "job": "eval context",
-        "provenance": provenance,
-        "model": model.dir,
-        "env": env.canonical(),
-        "settings": settings,
-    }))?;
+    write_config(config, provenance, run.path())?;
     let metrics = run.metrics()?;
     let monitor = Tee { first: monitor, second: &metrics };
     monitor.emit(&layout(&format!("eval context: {} on {}", model.dir.display(), env.canonical())));
@@ -299,7 +451,8 @@ pub fn evaluate(
         outcomes.push(per_strategy);
     }
     monitor.progress("contexts", settings.contexts as u64, settings.contexts as u64);
-    let summary = write_report(model, env, settings, &run, &outcomes, &no_calibration, &ground_truth_returns)?;
+    let summary = summarize(model, env, settings, provenance, outcomes, no_calibration, ground_truth_returns)?;
+    publish(PROTOCOL, &summary, run.path(), render)?;
     metrics.emit(&Event::Finished { ok: true });
     Ok(summary)
 }
@@ -375,8 +528,7 @@ fn paired_tests(
     metric: &dyn Fn(usize) -> Vec<f64>,
     alternative: Alternative,
     label: &str,
-    rows: &mut Vec<Vec<String>>,
-) -> Result<Vec<(Strategy, Strategy, f64)>> {
+) -> Result<Vec<PairTest>> {
     let position = |s: Strategy| strategies.iter().position(|x| *x == s);
     let mut tests = Vec::new();
     for (better, worse) in
@@ -384,26 +536,27 @@ fn paired_tests(
     {
         let (Some(a), Some(b)) = (position(better), position(worse)) else { continue };
         let result = wilcoxon_signed_rank(&metric(a), &metric(b), alternative)?;
-        tests.push((better, worse, result.p_value));
-        rows.push(vec![
-            format!("{} ({label})", better.name()),
-            worse.name().to_string(),
-            result.n.to_string(),
-            format!("{}", result.statistic),
-            format!("{:.4e}", result.p_value),
-        ]);
+        tests.push(PairTest {
+            better,
+            worse,
+            label: label.into(),
+            n: result.n,
+            statistic: result.statistic,
+            p_value: result.p_value,
+        });
     }
     Ok(tests)
 }
 
-fn write_report(
+/// The figures of the report from what every context gave.
+fn summarize(
     model: &LoadedModel,
     env: &EnvName,
     settings: &ContextEvalSettings,
-    run: &RunDir,
-    outcomes: &[Vec<Outcome>],
-    no_calibration: &[NoCalibration],
-    ground_truth_returns: &[f64],
+    provenance: &Provenance,
+    outcomes: Vec<Vec<Outcome>>,
+    no_calibration: Vec<NoCalibration>,
+    ground_truth_returns: Vec<f64>,
 ) -> Result<ContextEvalSummary> {
     let strategies = &settings.strategies;
     let per_context_mse =
@@ -417,6 +570,99 @@ fn write_report(
         .map(|j| median(&outcomes.iter().map(|o| o[j].action_response).collect::<Vec<_>>()))
         .collect();
     let empty_context_action_response = median(&no_calibration.iter().map(|n| n.action_response).collect::<Vec<_>>());
+    // Paired one-sided tests between strategies, per context: lower MSE, and (pendulum) higher swing-up return.
+    let tests = paired_tests(strategies, &per_context_mse, Alternative::Less, "MSE lower")?;
+    let against_empty = (0..strategies.len())
+        .map(|j| Ok(wilcoxon_signed_rank(&per_context_mse(j), &empty_per_context, Alternative::Less)?.p_value))
+        .collect::<Result<Vec<f64>>>()?;
+    let swingup = if settings.swingup.is_some() {
+        let per_context_return =
+            |j: usize| -> Vec<f64> { outcomes.iter().map(|o| o[j].swingup_return.unwrap_or(f64::NAN)).collect() };
+        let tests = paired_tests(strategies, &per_context_return, Alternative::Greater, "swing-up return higher")?;
+        Some(SwingupSummary {
+            mean_return: (0..strategies.len()).map(|j| mean(&per_context_return(j)).unwrap_or(f64::NAN)).collect(),
+            ground_truth_mean_return: mean(&ground_truth_returns).unwrap_or(f64::NAN),
+            tests,
+        })
+    } else {
+        None
+    };
+    let toy = if let EnvName::Toy(sq) = env {
+        let actions: Vec<f64> = (0..=80).map(|i| -2.0 + 0.05 * i as f64).collect();
+        let entropies = entropy_after_one_action(model, &actions, 20, 11);
+        let informative = |a: f64| sq.name() == "inner" && a.abs() < 0.9 || sq.name() == "outer" && a.abs() > 1.1;
+        let non_informative = |a: f64| sq.name() == "inner" && a.abs() > 1.1 || sq.name() == "outer" && a.abs() < 0.9;
+        let pick = |f: &dyn Fn(f64) -> bool| {
+            mean(&actions.iter().zip(&entropies).filter(|(a, _)| f(**a)).map(|(_, e)| *e).collect::<Vec<_>>())
+                .unwrap_or(f64::NAN)
+        };
+        Some(ToyEntropy {
+            informative: pick(&informative),
+            non_informative: pick(&non_informative),
+            prior: gaussian_entropy(&model.fast.belief(&vec![0.0; model.fast.transition_features], 1).std),
+            curve: actions.iter().copied().zip(entropies.iter().copied()).collect(),
+        })
+    } else {
+        None
+    };
+    Ok(ContextEvalSummary {
+        provenance: provenance.clone(),
+        settings: settings.clone(),
+        env: env.canonical(),
+        model: model.progress.name_model(&model.dir),
+        angular: model.run.details.model.angular.iter().any(|a| *a),
+        prior_entropy,
+        outcomes,
+        no_calibration,
+        ground_truth_returns,
+        mean_mse,
+        empty_context_mse,
+        action_response,
+        empty_context_action_response,
+        tests,
+        against_empty,
+        swingup,
+        toy,
+    })
+}
+
+fn test_row(t: &PairTest) -> Vec<String> {
+    vec![
+        format!("{} ({})", t.better.name(), t.label),
+        t.worse.name().to_string(),
+        t.n.to_string(),
+        format!("{}", t.statistic),
+        format!("{:.4e}", t.p_value),
+    ]
+}
+
+/// Writes per_context.csv, mse_vs_horizon.csv/.png, wilcoxon.csv, the toy's entropy_vs_action.csv/.png and
+/// report.md of `summary` into `dir`.
+pub fn render(summary: &ContextEvalSummary, dir: &Path) -> Result<()> {
+    let settings = &summary.settings;
+    let strategies = &settings.strategies;
+    let (outcomes, no_calibration) = (&summary.outcomes, &summary.no_calibration);
+    if outcomes.is_empty() || outcomes.iter().any(|o| o.len() != strategies.len()) {
+        return Err(Error::config(format!(
+            "outcomes: expected {} per context over at least one context",
+            strategies.len()
+        )));
+    }
+    let horizon = settings.validation_steps;
+    if outcomes
+        .iter()
+        .flatten()
+        .map(|o| &o.mse_by_horizon)
+        .chain(no_calibration.iter().map(|n| &n.mse_by_horizon))
+        .any(|m| m.len() != horizon)
+        || no_calibration.len() != outcomes.len()
+    {
+        return Err(Error::config(format!("mse_by_horizon: expected {horizon} values per context")));
+    }
+    let empty_per_context: Vec<f64> =
+        no_calibration.iter().map(|n| mean(&n.mse_by_horizon).unwrap_or(f64::NAN)).collect();
+    let prior_entropy = summary.prior_entropy;
+    let file = |name: &str| dir.join(name);
 
     // Per-context table.
     let mut rows = Vec::new();
@@ -443,13 +689,12 @@ fn write_report(
         }
     }
     write_csv(
-        &run.file("per_context.csv"),
+        &file("per_context.csv"),
         &["context", "strategy", "mean_mse", "final_entropy", "quadrants", "swingup_return", "action_response"],
         &rows,
     )?;
 
     // MSE against the horizon.
-    let horizon = settings.validation_steps;
     let by_horizon: Vec<Vec<f64>> = (0..strategies.len())
         .map(|j| {
             (0..horizon)
@@ -472,89 +717,50 @@ fn write_report(
             row
         })
         .collect();
-    write_csv(&run.file("mse_vs_horizon.csv"), &header_refs, &rows)?;
+    write_csv(&file("mse_vs_horizon.csv"), &header_refs, &rows)?;
     let curve = |v: &[f64]| v.iter().enumerate().map(|(t, m)| ((t + 1) as f64, *m)).collect();
     let mut series: Vec<Series> =
         strategies.iter().zip(&by_horizon).map(|(s, v)| Series { name: s.name().into(), points: curve(v) }).collect();
     series.push(Series { name: "no calibration (empty context)".into(), points: curve(&empty_by_horizon) });
     rising_line_plot(
-        &run.file("mse_vs_horizon.png"),
-        &format!("{}: prediction MSE after calibration ({} contexts)", env.canonical(), outcomes.len()),
+        &file("mse_vs_horizon.png"),
+        &format!("{}: prediction MSE after calibration ({} contexts)", summary.env, outcomes.len()),
         "prediction horizon [steps]",
         "MSE (model space, mean over dims)",
         &series,
     )?;
 
-    // Paired one-sided tests between strategies, per context: lower MSE, and (pendulum) higher swing-up return.
-    let mut test_rows = Vec::new();
-    let tests = paired_tests(strategies, &per_context_mse, Alternative::Less, "MSE lower", &mut test_rows)?;
-    let swingup = if settings.swingup.is_some() {
-        let per_context_return =
-            |j: usize| -> Vec<f64> { outcomes.iter().map(|o| o[j].swingup_return.unwrap_or(f64::NAN)).collect() };
-        let tests = paired_tests(
-            strategies,
-            &per_context_return,
-            Alternative::Greater,
-            "swing-up return higher",
-            &mut test_rows,
-        )?;
-        Some(SwingupSummary {
-            mean_return: (0..strategies.len()).map(|j| mean(&per_context_return(j)).unwrap_or(f64::NAN)).collect(),
-            ground_truth_mean_return: mean(ground_truth_returns).unwrap_or(f64::NAN),
-            tests,
-        })
-    } else {
-        None
-    };
-    write_csv(
-        &run.file("wilcoxon.csv"),
-        &["better", "than", "n_nonzero", "statistic", "p_value_one_sided"],
-        &test_rows,
-    )?;
+    let mut test_rows: Vec<Vec<String>> = summary.tests.iter().map(test_row).collect();
+    if let Some(sw) = &summary.swingup {
+        test_rows.extend(sw.tests.iter().map(test_row));
+    }
+    write_csv(&file("wilcoxon.csv"), &["better", "than", "n_nonzero", "statistic", "p_value_one_sided"], &test_rows)?;
 
-    let toy_entropy = if matches!(env, EnvName::Toy(_)) {
-        let actions: Vec<f64> = (0..=80).map(|i| -2.0 + 0.05 * i as f64).collect();
-        let entropies = entropy_after_one_action(model, &actions, 20, 11);
+    if let Some(toy) = &summary.toy {
         write_csv(
-            &run.file("entropy_vs_action.csv"),
+            &file("entropy_vs_action.csv"),
             &["action", "entropy"],
-            &actions
-                .iter()
-                .zip(&entropies)
-                .map(|(a, e)| vec![format!("{a:.2}"), format!("{e:.5}")])
-                .collect::<Vec<_>>(),
+            &toy.curve.iter().map(|(a, e)| vec![format!("{a:.2}"), format!("{e:.5}")]).collect::<Vec<_>>(),
         )?;
         line_plot(
-            &run.file("entropy_vs_action.png"),
-            &format!("{}: entropy of q(β | one transition from s = 0) vs action", env.canonical()),
+            &file("entropy_vs_action.png"),
+            &format!("{}: entropy of q(β | one transition from s = 0) vs action", summary.env),
             "action a",
             "entropy [nats]",
-            &[Series {
-                name: "learned model".into(),
-                points: actions.iter().copied().zip(entropies.iter().copied()).collect(),
-            }],
+            &[Series { name: "learned model".into(), points: toy.curve.clone() }],
         )?;
-        let informative = |a: f64| match env {
-            EnvName::Toy(sq) => sq.name() == "inner" && a.abs() < 0.9 || sq.name() == "outer" && a.abs() > 1.1,
-            _ => false,
-        };
-        let non_informative = |a: f64| match env {
-            EnvName::Toy(sq) => sq.name() == "inner" && a.abs() > 1.1 || sq.name() == "outer" && a.abs() < 0.9,
-            _ => false,
-        };
-        let pick = |f: &dyn Fn(f64) -> bool| {
-            mean(&actions.iter().zip(&entropies).filter(|(a, _)| f(**a)).map(|(_, e)| *e).collect::<Vec<_>>())
-                .unwrap_or(f64::NAN)
-        };
-        Some((pick(&informative), pick(&non_informative)))
-    } else {
-        None
-    };
+    }
+    write_text(&file("report.md"), &markdown(summary))
+}
 
-    // report.md
+fn markdown(summary: &ContextEvalSummary) -> String {
+    let settings = &summary.settings;
+    let strategies = &settings.strategies;
+    let outcomes = &summary.outcomes;
+    let swingup = &summary.swingup;
     let mut md = String::new();
     let c = &settings.calibration;
-    let _ = writeln!(md, "# Explore the Context: calibration on {}\n", env.canonical());
+    let _ = writeln!(md, "# Explore the Context: calibration on {}\n", summary.env);
     let _ = writeln!(
         md,
         "Model {}. {} unseen contexts (instances), per context {} random validation rollouts of {} \
@@ -562,7 +768,7 @@ fn write_report(
          {} elites / {} iterations, {} β samples, MPC horizon min({}, N − n). Predictions: open loop from each validation \
          rollout's first state with the mean of q(β | calibration transitions); error = squared error averaged over the \
          model-space state dimensions{}.\n",
-        model.progress.name_model(&model.dir),
+        summary.model,
         outcomes.len(),
         settings.validation_rollouts,
         settings.validation_steps,
@@ -572,7 +778,7 @@ fn write_report(
         c.iterations,
         c.beta_samples,
         c.horizon_max,
-        if model.run.details.model.angular.iter().any(|a| *a) { " (angles as cos, sin)" } else { "" }
+        if summary.angular { " (angles as cos, sin)" } else { "" }
     );
     let has_quadrants = outcomes[0][0].quadrants.is_some();
     let _ = writeln!(
@@ -589,8 +795,11 @@ fn write_report(
     );
     let _ = writeln!(
         md,
-        "| no calibration (empty context, reference) | {empty_context_mse:.4e} | {prior_entropy:.3} | \
-         {empty_context_action_response:.3} |{}{}",
+        "| no calibration (empty context, reference) | {:.4e} | {:.3} | \
+         {:.3} |{}{}",
+        summary.empty_context_mse,
+        summary.prior_entropy,
+        summary.empty_context_action_response,
         if has_quadrants { " - |" } else { "" },
         if swingup.is_some() { " - |" } else { "" }
     );
@@ -603,14 +812,17 @@ fn write_report(
             md,
             "| {} | {:.4e} | {:.3} | {:.3} |{}{}",
             s.name(),
-            mean_mse[j],
+            summary.mean_mse.get(j).copied().unwrap_or(f64::NAN),
             median(&entropies),
-            action_response[j],
+            summary.action_response.get(j).copied().unwrap_or(f64::NAN),
             quad.unwrap_or_default(),
-            swingup.as_ref().map(|sw| format!(" {:.1} |", sw.mean_return[j])).unwrap_or_default()
+            swingup
+                .as_ref()
+                .map(|sw| format!(" {:.1} |", sw.mean_return.get(j).copied().unwrap_or(f64::NAN)))
+                .unwrap_or_default()
         );
     }
-    if let (Some(sw), Some(settings)) = (&swingup, &settings.swingup) {
+    if let (Some(sw), Some(settings)) = (swingup, &settings.swingup) {
         let _ = writeln!(
             md,
             "\nSwing-up after calibration (thesis 4.5.3): MPC on the model conditioned on each strategy's transitions \
@@ -625,8 +837,8 @@ fn write_report(
             sw.ground_truth_mean_return
         );
         let _ = writeln!(md, "| higher return | than | p |\n|---|---|---|");
-        for (a, b, p) in &sw.tests {
-            let _ = writeln!(md, "| {} | {} | {:.3e} |", a.name(), b.name(), p);
+        for t in &sw.tests {
+            let _ = writeln!(md, "| {} | {} | {:.3e} |", t.better.name(), t.worse.name(), t.p_value);
         }
     }
     let _ = writeln!(
@@ -634,11 +846,10 @@ fn write_report(
         "\nPaired Wilcoxon signed-rank tests on the per-context mean MSE (one-sided: the first strategy lower):\n"
     );
     let _ = writeln!(md, "| lower | than | p |\n|---|---|---|");
-    for (a, b, p) in &tests {
-        let _ = writeln!(md, "| {} | {} | {:.3e} |", a.name(), b.name(), p);
+    for t in &summary.tests {
+        let _ = writeln!(md, "| {} | {} | {:.3e} |", t.better.name(), t.worse.name(), t.p_value);
     }
-    for (j, s) in strategies.iter().enumerate() {
-        let p = wilcoxon_signed_rank(&per_context_mse(j), &empty_per_context, Alternative::Less)?.p_value;
+    for (s, p) in strategies.iter().zip(&summary.against_empty) {
         let _ = writeln!(md, "| {} | no calibration | {p:.3e} |", s.name());
     }
     let _ = writeln!(
@@ -648,30 +859,21 @@ fn write_report(
          compares the model's one-step prediction under the highest minus the middle action with the simulator's, \
          from every validation state: 1 is the true response, 0 a model that ignores the action."
     );
-    if let Some((informative, non_informative)) = toy_entropy {
+    if let Some(toy) = &summary.toy {
         let _ = writeln!(
             md,
             "\nEntropy after one transition from s = 0 (model-imagined next state, 20 prior β samples; Fig. 4.4a): \
-             {informative:.3} nats for informative actions, {non_informative:.3} for non-informative ones \
+             {:.3} nats for informative actions, {:.3} for non-informative ones \
              (prior: {:.3}). See entropy_vs_action.png.",
-            gaussian_entropy(&model.fast.belief(&vec![0.0; model.fast.transition_features], 1).std)
+            toy.informative, toy.non_informative, toy.prior
         );
     }
     let _ = writeln!(
         md,
         "\nFiles: per_context.csv, mse_vs_horizon.csv/.png, wilcoxon.csv{}.",
-        if toy_entropy.is_some() { ", entropy_vs_action.csv/.png" } else { "" }
+        if summary.toy.is_some() { ", entropy_vs_action.csv/.png" } else { "" }
     );
-    write_text(&run.file("report.md"), &md)?;
-    Ok(ContextEvalSummary {
-        mean_mse,
-        empty_context_mse,
-        action_response,
-        empty_context_action_response,
-        tests,
-        toy_entropy,
-        swingup,
-    })
+    md
 }
 
 /// The median of the finite values (NaN when there are none).
@@ -726,11 +928,13 @@ mod tests {
             },
             swingup: None,
         };
-        let summary = evaluate(&model, &env, &settings, &provenance, &dir.path().join("eval"), &NullMonitor).unwrap();
-        let (better, worse, p) = summary.tests[0];
+        let config = ContextEvalConfig { model: out.clone(), env: env.canonical(), allow_incomplete: false, settings };
+        let summary = evaluate(&model, &env, &config, &provenance, &dir.path().join("eval"), &NullMonitor).unwrap();
+        let (better, worse, p) = (summary.tests[0].better, summary.tests[0].worse, summary.tests[0].p_value);
         assert_eq!((better, worse), (Strategy::OpenLoop, Strategy::Random));
         assert!(p < 0.05, "open-loop vs random: p = {p}, mean MSE {:?}", summary.mean_mse);
-        let (informative, non_informative) = summary.toy_entropy.unwrap();
+        let toy = summary.toy.as_ref().unwrap();
+        let (informative, non_informative) = (toy.informative, toy.non_informative);
         assert!(informative < non_informative, "entropy {informative} (informative) vs {non_informative}");
         // Without a context the model cannot know the sign of α, so it predicts little action effect (the
         // median over contexts is noisy where α is near 0); one informative transition tells it.

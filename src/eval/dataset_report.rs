@@ -2,10 +2,12 @@
 
 use std::path::Path;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
+use super::num;
 use super::plot::{histogram, line_panels, Panel, Series};
 use super::stats::{mean, quantile};
+use super::summary::{publish, write_config};
 use crate::data::{read_dataset, Rollout};
 use crate::error::{Error, Result};
 use crate::run::dir::{Provenance, RunDir};
@@ -18,20 +20,79 @@ const PLOTTED_ROLLOUTS: usize = 10;
 /// State dimensions drawn (an embodied board game has dozens of board bits; the first are the manipulator's).
 const PLOTTED_DIMENSIONS: usize = 6;
 
-#[derive(Clone, Debug, Serialize)]
+pub const PROTOCOL: &str = "dataset";
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct DimensionStats {
     pub name: String,
+    #[serde(with = "num::real")]
     pub min: f64,
+    #[serde(with = "num::real")]
     pub max: f64,
+    #[serde(with = "num::real")]
     pub mean: f64,
 }
 
+/// `mbrl eval dataset`'s settings, as config.json records them.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DatasetConfig {
+    pub input: std::path::PathBuf,
+}
+
+/// What the dataset's metadata says about it, as the report quotes it.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct DatasetHeader {
+    pub env: String,
+    pub seed: u64,
+    pub mbrl_version: String,
+    pub command_line: String,
+    #[serde(with = "num::real")]
+    pub dt: f64,
+    pub state_names: Vec<String>,
+    /// Which state dimensions are angles (wrapped in the plot).
+    pub angular: Vec<bool>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct RolloutRecord {
+    pub id: u32,
+    pub steps: usize,
+    #[serde(with = "num::real")]
+    pub total_return: f64,
+}
+
+/// The states of a plotted rollout (the first dimensions only).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct PlottedRollout {
+    pub id: u32,
+    pub states: Vec<Vec<f64>>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct DatasetSummary {
+    pub provenance: Provenance,
+    /// The dataset file, as the command named it.
+    pub input: String,
+    pub header: DatasetHeader,
     pub env: String,
     pub rollouts: usize,
     pub transitions: usize,
+    #[serde(with = "num::real")]
     pub mean_return: f64,
     pub dimensions: Vec<DimensionStats>,
+    pub per_rollout: Vec<RolloutRecord>,
+    pub plotted: Vec<PlottedRollout>,
+}
+
+impl std::fmt::Display for DatasetSummary {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        write!(
+            f,
+            "{}: {} rollouts, {} transitions of {}, mean return {:.2}",
+            self.input, self.rollouts, self.transitions, self.env, self.mean_return
+        )
+    }
 }
 
 pub fn report(input: &Path, provenance: &Provenance, out_dir: &Path) -> Result<DatasetSummary> {
@@ -43,12 +104,7 @@ pub fn report(input: &Path, provenance: &Provenance, out_dir: &Path) -> Result<D
         )
     })?;
     let run = RunDir::create(out_dir)?;
-    run.write_config(&serde_json::json!({
-        "job": "eval dataset",
-        "input": input.display().to_string(),
-        "mbrl_version": provenance.mbrl_version,
-        "command_line": provenance.command_line,
-    }))?;
+    write_config(&DatasetConfig { input: input.to_path_buf() }, provenance, run.path())?;
     let returns: Vec<f64> = grouped.iter().map(|(_, r)| r.total_reward()).collect();
     let dimensions: Vec<DimensionStats> = data
         .meta
@@ -65,46 +121,79 @@ pub fn report(input: &Path, provenance: &Provenance, out_dir: &Path) -> Result<D
             }
         })
         .collect();
-    let rows: Vec<Vec<String>> = grouped
-        .iter()
-        .map(|(id, r)| vec![id.to_string(), r.len().to_string(), format!("{:.6}", r.total_reward())])
-        .collect();
-    write_csv(&run.file("rollouts.csv"), &["rollout", "steps", "return"], &rows)?;
-    histogram(&run.file("returns.png"), "Rollout returns", "return", &returns, 20)?;
-    state_panels(&run.file("states.png"), &data.meta, &grouped)?;
+    let meta = &data.meta;
+    let angular =
+        crate::envs::parse_env(&meta.env).and_then(|env| env.build()).map(|env| env.spec().angular).unwrap_or_default();
     let summary = DatasetSummary {
+        provenance: provenance.clone(),
+        input: input.display().to_string(),
+        header: DatasetHeader {
+            env: meta.env.clone(),
+            seed: meta.seed,
+            mbrl_version: meta.mbrl_version.clone(),
+            command_line: meta.command_line.clone(),
+            dt: meta.dt,
+            state_names: meta.state_names.clone(),
+            angular,
+        },
         env: data.meta.env.clone(),
         rollouts: grouped.len(),
         transitions: data.steps.len(),
         mean_return: mean(&returns).unwrap_or(f64::NAN),
         dimensions,
+        per_rollout: grouped
+            .iter()
+            .map(|(id, r)| RolloutRecord { id: *id, steps: r.len(), total_return: r.total_reward() })
+            .collect(),
+        plotted: grouped
+            .iter()
+            .take(PLOTTED_ROLLOUTS)
+            .map(|(id, r)| PlottedRollout {
+                id: *id,
+                states: r.states.iter().map(|s| s.iter().take(PLOTTED_DIMENSIONS).copied().collect()).collect(),
+            })
+            .collect(),
     };
-    let md = markdown(input, &data.meta, &summary, &returns);
-    let path = run.file("report.md");
-    write_text(&path, &md)?;
+    publish(PROTOCOL, &summary, run.path(), render)?;
     Ok(summary)
 }
 
+/// Writes rollouts.csv, returns.png, states.png and report.md of `summary` into `dir`.
+pub fn render(summary: &DatasetSummary, dir: &Path) -> Result<()> {
+    let rows: Vec<Vec<String>> = summary
+        .per_rollout
+        .iter()
+        .map(|r| vec![r.id.to_string(), r.steps.to_string(), format!("{:.6}", r.total_return)])
+        .collect();
+    write_csv(&dir.join("rollouts.csv"), &["rollout", "steps", "return"], &rows)?;
+    let returns: Vec<f64> = summary.per_rollout.iter().map(|r| r.total_return).collect();
+    histogram(&dir.join("returns.png"), "Rollout returns", "return", &returns, 20)?;
+    state_panels(&dir.join("states.png"), &summary.header, &summary.plotted, summary.rollouts)?;
+    let md = markdown(&summary.input, &summary.header, summary, &returns);
+    write_text(&dir.join("report.md"), &md)
+}
+
 /// One panel per state dimension over time, angles wrapped to [−π, π) with the line broken at each wrap.
-fn state_panels(path: &Path, meta: &crate::data::DatasetMeta, grouped: &[(u32, Rollout)]) -> Result<()> {
-    let angular =
-        crate::envs::parse_env(&meta.env).and_then(|env| env.build()).map(|env| env.spec().angular).unwrap_or_default();
+fn state_panels(path: &Path, meta: &DatasetHeader, plotted: &[PlottedRollout], rollouts: usize) -> Result<()> {
+    let angular = &meta.angular;
     let dims = meta.state_names.len().min(PLOTTED_DIMENSIONS);
     let panels: Vec<Panel> = (0..dims)
         .map(|d| {
             let is_angle = angular.get(d).copied().unwrap_or(false);
-            let series = grouped
+            let series = plotted
                 .iter()
-                .take(PLOTTED_ROLLOUTS)
-                .map(|(id, r)| Series { name: format!("rollout {id}"), points: state_trace(r, d, meta.dt, is_angle) })
+                .map(|r| Series {
+                    name: format!("rollout {}", r.id),
+                    points: state_trace(&r.states, d, meta.dt, is_angle),
+                })
                 .collect();
             let label =
                 if is_angle { format!("{} [rad, wrapped]", meta.state_names[d]) } else { meta.state_names[d].clone() };
             Panel { y_label: label, series, y_range: None }
         })
         .collect();
-    let shown = grouped.len().min(PLOTTED_ROLLOUTS);
-    let mut title = format!("States over time ({shown} of {} rollouts", grouped.len());
+    let shown = plotted.len();
+    let mut title = format!("States over time ({shown} of {rollouts} rollouts");
     if dims < meta.state_names.len() {
         title += &format!(", first {dims} of {} dimensions", meta.state_names.len());
     }
@@ -113,11 +202,11 @@ fn state_panels(path: &Path, meta: &crate::data::DatasetMeta, grouped: &[(u32, R
 }
 
 /// (t, x_d) of a rollout; an angle is wrapped and a NaN breaks the line where it jumps across ±π.
-fn state_trace(rollout: &Rollout, d: usize, dt: f64, is_angle: bool) -> Vec<(f64, f64)> {
+fn state_trace(states: &[Vec<f64>], d: usize, dt: f64, is_angle: bool) -> Vec<(f64, f64)> {
     let wrap = |x: f64| (x + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
-    let mut points = Vec::with_capacity(rollout.states.len());
+    let mut points = Vec::with_capacity(states.len());
     let mut previous: Option<f64> = None;
-    for (t, state) in rollout.states.iter().enumerate() {
+    for (t, state) in states.iter().enumerate() {
         let Some(&raw) = state.get(d) else { continue };
         let value = if is_angle { wrap(raw) } else { raw };
         if is_angle && previous.is_some_and(|p| (value - p).abs() > std::f64::consts::PI) {
@@ -129,14 +218,14 @@ fn state_trace(rollout: &Rollout, d: usize, dt: f64, is_angle: bool) -> Vec<(f64
     points
 }
 
-fn markdown(input: &Path, meta: &crate::data::DatasetMeta, s: &DatasetSummary, returns: &[f64]) -> String {
+fn markdown(input: &str, meta: &DatasetHeader, s: &DatasetSummary, returns: &[f64]) -> String {
     let q = |p| quantile(returns, p).map(|x| format!("{x:.2}")).unwrap_or_else(|| "–".into());
     let mut md = format!(
         "# Dataset `{}`\n\nEnvironment `{}`, seed {}, written by mbrl {} with `{}`.\n\n\
          {} rollouts, {} transitions, dt {} s.\n\n\
          Returns: mean {:.2}, 10 % {}, median {}, 90 % {}.\n\n\
          | state | min | max | mean |\n|---|---|---|---|\n",
-        input.display(),
+        input,
         meta.env,
         meta.seed,
         meta.mbrl_version,

@@ -7,12 +7,14 @@
 
 use std::path::Path;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::dlgpd_action_response::RESPONSE_HORIZONS;
 use super::dlgpd_prediction::{reward_prediction, RewardPrediction};
+use super::num;
 use super::plot::{line_plot, line_plot_in, rising_line_plot, strip_plot, Series, StripDot};
 use super::stats::{wilcoxon_signed_rank, Alternative};
+use super::summary::{publish, write_config};
 use crate::data::collect::{collect_random, CollectSettings};
 use crate::data::collect_frames::add_pendulum_frames;
 use crate::data::Dataset;
@@ -27,6 +29,7 @@ use crate::models::dlgpd::vae::encode_rows;
 use crate::nn::tensor::{inference_device, tensor};
 use crate::run::dir::{Provenance, RunDir};
 use crate::run::{Event, Monitor, NullMonitor, Tee};
+use crate::util::atomic::write_text;
 use crate::util::png::encode_rgb;
 use crate::util::seeding::derive_seed;
 use crate::util::table::write_csv;
@@ -39,9 +42,68 @@ pub const HELD_OUT_ROLLOUTS: usize = 20;
 /// Frames per evidence rollout: the authors' 30 (29 steps, 28 transitions).
 pub const EVIDENCE_STEPS: usize = 29;
 
-#[derive(Clone, Debug, Serialize)]
+pub const PROTOCOL: &str = "dlgpd";
+
+/// `mbrl eval dlgpd`'s settings, as config.json records them (the command's flags).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DlgpdEvalConfig {
+    pub model: std::path::PathBuf,
+    /// Pendulum settings; empty: the thesis' four.
+    pub envs: Vec<String>,
+    pub evidence_rollouts: Vec<usize>,
+    pub runs: usize,
+    pub steps: usize,
+    pub candidates: usize,
+    pub elites: usize,
+    pub iters: usize,
+    pub prediction_only: bool,
+    pub allow_incomplete: bool,
+}
+
+impl DlgpdEvalConfig {
+    /// The protocol's settings; the command's range checks first.
+    pub fn settings(&self) -> Result<DlgpdEvalSettings> {
+        let variants = if self.envs.is_empty() {
+            DlgpdEvalSettings::thesis_variants()
+        } else {
+            self.envs
+                .iter()
+                .map(|e| match crate::envs::parse_env(e)? {
+                    EnvName::Pendulum(v) => Ok(v),
+                    other => Err(Error::config(format!(
+                        "--env '{}': eval dlgpd swings up pendulum envs only",
+                        other.canonical()
+                    ))),
+                })
+                .collect::<Result<Vec<_>>>()?
+        };
+        if !(1..=1000).contains(&self.runs)
+            || !(1..=10_000).contains(&self.steps)
+            || !(2..=100_000).contains(&self.candidates)
+        {
+            return Err(Error::config("--runs must be 1..=1000, --steps 1..=10000 and --candidates 2..=100000"));
+        }
+        let mut cem = ControlSettings::authors(PendulumVariant::Standard).cem;
+        cem.candidates = self.candidates;
+        cem.elites = self.elites;
+        cem.iterations = self.iters;
+        let settings = DlgpdEvalSettings {
+            variants,
+            evidence_rollouts: self.evidence_rollouts.clone(),
+            runs: self.runs,
+            steps: self.steps,
+            cem,
+            swing_ups: !self.prediction_only,
+        };
+        settings.validate()?;
+        Ok(settings)
+    }
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct DlgpdEvalSettings {
-    #[serde(serialize_with = "variant_names")]
+    #[serde(serialize_with = "variant_names", deserialize_with = "parse_variants")]
     pub variants: Vec<PendulumVariant>,
     pub evidence_rollouts: Vec<usize>,
     pub runs: usize,
@@ -53,6 +115,16 @@ pub struct DlgpdEvalSettings {
 
 fn variant_names<S: serde::Serializer>(v: &[PendulumVariant], s: S) -> std::result::Result<S::Ok, S::Error> {
     s.collect_seq(v.iter().map(PendulumVariant::env_name))
+}
+
+fn parse_variants<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Vec<PendulumVariant>, D::Error> {
+    Vec::<String>::deserialize(d)?
+        .iter()
+        .map(|name| match crate::envs::parse_env(name).map_err(serde::de::Error::custom)? {
+            EnvName::Pendulum(v) => Ok(v),
+            other => Err(serde::de::Error::custom(format!("'{}' is not a pendulum env", other.canonical()))),
+        })
+        .collect()
 }
 
 impl DlgpdEvalSettings {
@@ -84,23 +156,26 @@ impl DlgpdEvalSettings {
 }
 
 /// One swing-up.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Outcome {
     pub env: String,
-    pub evidence: &'static str,
+    pub evidence: String,
     pub rollouts: usize,
     pub run: usize,
+    #[serde(with = "num::real")]
     pub total_return: f64,
     pub success: bool,
+    #[serde(with = "num::real")]
     pub mean_cem_iterations: f64,
 }
 
 /// One point of the figures: a setting, an evidence kind and size over the runs.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Point {
     pub env: String,
-    pub evidence: &'static str,
+    pub evidence: String,
     pub rollouts: usize,
+    #[serde(with = "num::real")]
     pub mean_return: f64,
     pub successes: usize,
     pub runs: usize,
@@ -108,30 +183,143 @@ pub struct Point {
 
 /// Matching against mismatching evidence on one setting and evidence size: one-sided Wilcoxon signed-rank
 /// test that matching evidence gives higher returns, paired by run (same start state and evidence seeds).
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct EvidenceTest {
     pub env: String,
     pub rollouts: usize,
     pub pairs: usize,
+    #[serde(with = "num::real")]
     pub statistic: f64,
+    #[serde(with = "num::real")]
     pub p_value: f64,
 }
 
 /// Reward prediction on held-out rollouts of one system, by the model conditioned on the largest evidence
 /// set of run 0 (matching or mismatching).
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct PredictionCheck {
     pub env: String,
-    pub evidence: &'static str,
+    pub evidence: String,
     pub evidence_rollouts: usize,
-    pub prediction: RewardPrediction,
+    pub prediction: PredictionRecord,
 }
 
+/// A [`RewardPrediction`], as the report shows it.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct PredictionRecord {
+    /// Reward RMSE h steps after the encoded start, h = 0, 1, ….
+    #[serde(with = "num::reals")]
+    pub open_loop_rmse: Vec<f64>,
+    #[serde(with = "num::real")]
+    pub encoded_rmse: f64,
+    #[serde(with = "num::real")]
+    pub constant_rmse: f64,
+    pub rollouts: usize,
+    /// R² of cos θ, sin θ and θ̇ on the latent means.
+    #[serde(with = "num::reals")]
+    pub linear_probe_r2: Vec<f64>,
+    pub action_response: Vec<ResponseRecord>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ResponseRecord {
+    pub horizon: usize,
+    #[serde(with = "num::real")]
+    pub response: f64,
+    #[serde(with = "num::real")]
+    pub true_effect: f64,
+}
+
+impl From<RewardPrediction> for PredictionRecord {
+    fn from(p: RewardPrediction) -> Self {
+        PredictionRecord {
+            open_loop_rmse: p.errors.open_loop_rmse,
+            encoded_rmse: p.errors.encoded_rmse,
+            constant_rmse: p.errors.constant_rmse,
+            rollouts: p.errors.rollouts,
+            linear_probe_r2: p.linear_probe_r2.to_vec(),
+            action_response: p
+                .action_response
+                .iter()
+                .map(|r| ResponseRecord { horizon: r.horizon, response: r.response, true_effect: r.true_effect })
+                .collect(),
+        }
+    }
+}
+
+/// The trained model, as the report describes it.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ModelRecord {
+    pub env: String,
+    pub transitions: usize,
+    /// How far it was trained.
+    pub trained: String,
+    pub batch_size: usize,
+    /// What the model observes, in words.
+    pub observation: String,
+    /// Whether it sees rendered frames (the report then lists reconstructions.png).
+    pub images: bool,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct DlgpdEvalSummary {
+    pub provenance: Provenance,
+    pub settings: DlgpdEvalSettings,
+    pub model: ModelRecord,
     pub points: Vec<Point>,
     pub outcomes: Vec<Outcome>,
     pub tests: Vec<EvidenceTest>,
     pub predictions: Vec<PredictionCheck>,
+}
+
+impl std::fmt::Display for DlgpdEvalSummary {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        let mut lines = Vec::new();
+        if !self.points.is_empty() {
+            lines.push("env                   evidence     rollouts  mean return  successes".to_string());
+        }
+        for p in &self.points {
+            lines.push(format!(
+                "{:<21} {:<12} {:>8} {:>12.1} {:>7}/{}",
+                p.env, p.evidence, p.rollouts, p.mean_return, p.successes, p.runs
+            ));
+        }
+        if !self.predictions.is_empty() {
+            lines.push(format!(
+                "{:<34} {:>8} {:>14} {:>6} {:>10} {:>9} {:>20}",
+                "reward RMSE, held-out rollouts",
+                "encoded",
+                "open loop h=1",
+                "h=10",
+                "constant",
+                "θ̇ R²",
+                "action response h=5"
+            ));
+        }
+        for p in &self.predictions {
+            let at = |h: usize| p.prediction.open_loop_rmse.get(h).copied().unwrap_or(f64::NAN);
+            let response =
+                p.prediction.action_response.iter().find(|r| r.horizon == 5).map_or(f64::NAN, |r| r.response);
+            lines.push(format!(
+                "{:<21} {:<12} {:>8.2} {:>14.2} {:>6.2} {:>10.2} {:>9.2} {:>20.2}",
+                p.env,
+                p.evidence,
+                p.prediction.encoded_rmse,
+                at(1),
+                at(10),
+                p.prediction.constant_rmse,
+                p.prediction.linear_probe_r2.get(2).copied().unwrap_or(f64::NAN),
+                response
+            ));
+        }
+        for t in &self.tests {
+            lines.push(format!(
+                "Wilcoxon: {} with {} rollouts, matching evidence higher return than mismatching: p = {:.3e} ({} pairs)",
+                t.env, t.rollouts, t.p_value, t.pairs
+            ));
+        }
+        write!(f, "{}", lines.join("\n"))
+    }
 }
 
 fn evidence_tests(outcomes: &[Outcome]) -> Result<Vec<EvidenceTest>> {
@@ -186,19 +374,14 @@ pub fn evidence_rollouts(variant: &PendulumVariant, rollouts: usize, seed: u64, 
 
 pub fn evaluate(
     trained: &TrainedDlgpd,
-    settings: &DlgpdEvalSettings,
+    config: &DlgpdEvalConfig,
     provenance: &Provenance,
     report_dir: &Path,
     monitor: &dyn Monitor,
 ) -> Result<DlgpdEvalSummary> {
-    settings.validate()?;
+    let settings = &config.settings()?;
     let run_dir = RunDir::create(report_dir)?;
-    run_dir.write_config(&serde_json::json!({
-        "job": "eval dlgpd",
-        "provenance": provenance,
-        "model": trained.run,
-        "settings": settings,
-    }))?;
+    write_config(config, provenance, run_dir.path())?;
     let metrics = run_dir.metrics()?;
     let monitor = Tee { first: monitor, second: &metrics };
     monitor.emit(&crate::eval::swingup::layout("eval dlgpd: swing-ups on swapped evidence", false));
@@ -239,7 +422,7 @@ pub fn evaluate(
                     episode.iterations.iter().sum::<usize>() as f64 / episode.iterations.len().max(1) as f64;
                 let outcome = Outcome {
                     env: variant.env_name(),
-                    evidence: kind,
+                    evidence: kind.to_string(),
                     rollouts,
                     run,
                     total_return: episode.total_return,
@@ -254,18 +437,36 @@ pub fn evaluate(
     }
     let points = summarize(&outcomes);
     let tests = evidence_tests(&outcomes)?;
-    write_report(
-        trained,
-        settings,
-        &run_dir,
-        &Findings { points: &points, outcomes: &outcomes, tests: &tests, predictions: &predictions },
-    )?;
+    let observation = match trained.run.details.observation {
+        ObservationKind::Images { side } => format!("{side}×{side} rendered frames (the paper's conv VAE)"),
+        ObservationKind::Angles => {
+            "pole angles (cos θ, sin θ) with an MLP VAE: the small preset, not the paper's images".to_string()
+        }
+    };
+    let summary = DlgpdEvalSummary {
+        provenance: provenance.clone(),
+        settings: settings.clone(),
+        model: ModelRecord {
+            env: trained.run.env().to_string(),
+            transitions: trained.run.details.transitions.train,
+            trained: trained.progress.describe(),
+            batch_size: trained.run.config.batch_size,
+            observation,
+            images,
+        },
+        points,
+        outcomes,
+        tests,
+        predictions,
+    };
+    publish(PROTOCOL, &summary, run_dir.path(), render)?;
+    // The decoded frames come from the model itself: they are the one output `render` cannot redraw.
     if images {
         let pool = evidence_rollouts(&settings.variants[0], 1, derive_seed(seed, &[EVIDENCE_STREAM, 0]), true)?;
         write_reconstructions(trained, &pool, &run_dir.file("reconstructions.png"))?;
     }
     metrics.emit(&Event::Finished { ok: true });
-    Ok(DlgpdEvalSummary { points, outcomes, tests, predictions })
+    Ok(summary)
 }
 
 /// For every setting, the model conditioned on run 0's largest evidence set predicts the rewards of held-out
@@ -297,9 +498,9 @@ fn prediction_checks(
         let prediction = reward_prediction(trained, dynamics, held_out, variant, held_out_seed)?;
         checks.push(PredictionCheck {
             env: variant.env_name(),
-            evidence: kind,
+            evidence: kind.to_string(),
             evidence_rollouts: largest,
-            prediction,
+            prediction: prediction.into(),
         });
         monitor.progress("reward prediction checks", index as u64 + 1, plan.len() as u64);
     }
@@ -341,7 +542,7 @@ fn summarize(outcomes: &[Outcome]) -> Vec<Point> {
             }
             None => points.push(Point {
                 env: o.env.clone(),
-                evidence: o.evidence,
+                evidence: o.evidence.clone(),
                 rollouts: o.rollouts,
                 mean_return: o.total_return,
                 successes: usize::from(o.success),
@@ -352,62 +553,47 @@ fn summarize(outcomes: &[Outcome]) -> Vec<Point> {
     for p in &mut points {
         p.mean_return /= p.runs as f64;
     }
-    points.sort_by(|a, b| (&a.env, a.evidence, a.rollouts).cmp(&(&b.env, b.evidence, b.rollouts)));
+    points.sort_by(|a, b| (&a.env, &a.evidence, a.rollouts).cmp(&(&b.env, &b.evidence, b.rollouts)));
     points
 }
 
-/// What an evaluation found, for its report.
-struct Findings<'a> {
-    points: &'a [Point],
-    outcomes: &'a [Outcome],
-    tests: &'a [EvidenceTest],
-    predictions: &'a [PredictionCheck],
-}
-
-fn write_report(
-    trained: &TrainedDlgpd,
-    settings: &DlgpdEvalSettings,
-    run_dir: &RunDir,
-    findings: &Findings,
-) -> Result<()> {
+/// Writes the swing-up CSVs and plots (with swing-ups), prediction.csv/.png, action_response.csv and report.md
+/// of `summary` into `dir`.
+pub fn render(summary: &DlgpdEvalSummary, dir: &Path) -> Result<()> {
+    let (settings, model) = (&summary.settings, &summary.model);
     let mut md = String::new();
     md.push_str("# DLGPD: swing-up on swapped evidence (thesis 3.5.3, Figs. 3.4/3.5)\n\n");
-    let observed = match trained.run.details.observation {
-        ObservationKind::Images { side } => format!("{side}×{side} rendered frames (the paper's conv VAE)"),
-        ObservationKind::Angles => {
-            "pole angles (cos θ, sin θ) with an MLP VAE: the small preset, not the paper's images".to_string()
-        }
-    };
     md.push_str(&format!(
-        "One model trained on {} transitions of `{}` from {observed}, {} at batch {}. No retraining: for \
+        "One model trained on {} transitions of `{}` from {}, {} at batch {}. No retraining: for \
          each setting the GPs are conditioned on encoded evidence rollouts (random actions, {} frames each) of \
          the system at hand (**matching**) or of the standard pendulum (**mismatching**).\n\n",
-        trained.run.details.transitions.train,
-        trained.run.env(),
-        trained.progress.describe(),
-        trained.run.config.batch_size,
+        model.transitions,
+        model.env,
+        model.observation,
+        model.trained,
+        model.batch_size,
         EVIDENCE_STEPS + 1,
     ));
     let mut files: Vec<String> = Vec::new();
     if settings.swing_ups {
-        write_swing_up_section(settings, run_dir, findings, &mut md)?;
+        write_swing_up_section(summary, dir, &mut md)?;
         files.push("`results.csv` (every run)".into());
         files.extend(
             ["summary.csv", "wilcoxon.csv", "returns.png", "success.png", "runs.png"].map(|f| format!("`{f}`")),
         );
     }
-    write_prediction_section(run_dir, findings.predictions, &mut md)?;
+    write_prediction_section(dir, &summary.predictions, &mut md)?;
     files.extend(["prediction.csv", "prediction.png", "action_response.csv"].map(|f| format!("`{f}`")));
-    if matches!(trained.run.details.observation, ObservationKind::Images { .. }) {
+    if model.images {
         files.push("`reconstructions.png` (top: observed newer frames; bottom: decoded from the encoder mean)".into());
     }
     md.push_str(&format!("\nFiles: {}.\n", files.join(", ")));
-    std::fs::write(run_dir.file("report.md"), md).map_err(|e| Error::io(&run_dir.file("report.md"), e))
+    write_text(&dir.join("report.md"), &md)
 }
 
 /// Every run's return at the largest evidence size, the one the claims are about: with one evidence size
 /// `returns.png` shows a single mean per setting.
-fn write_runs_plot(run_dir: &RunDir, outcomes: &[Outcome]) -> Result<()> {
+fn write_runs_plot(dir: &Path, outcomes: &[Outcome]) -> Result<()> {
     let largest = outcomes.iter().map(|o| o.rollouts).max().unwrap_or(0);
     let kinds = ["matching", "mismatching"];
     let mut groups: Vec<String> = Vec::new();
@@ -424,7 +610,7 @@ fn write_runs_plot(run_dir: &RunDir, outcomes: &[Outcome]) -> Result<()> {
         dots.push(StripDot { group, kind, value: o.total_return, filled: o.success });
     }
     strip_plot(
-        &run_dir.file("runs.png"),
+        &dir.join("runs.png"),
         &format!("DLGPD return of every run, {largest} evidence rollouts (filled: swung up)"),
         "return",
         &groups,
@@ -433,19 +619,15 @@ fn write_runs_plot(run_dir: &RunDir, outcomes: &[Outcome]) -> Result<()> {
     )
 }
 
-fn write_swing_up_section(
-    settings: &DlgpdEvalSettings,
-    run_dir: &RunDir,
-    findings: &Findings,
-    md: &mut String,
-) -> Result<()> {
-    let (points, outcomes, tests) = (findings.points, findings.outcomes, findings.tests);
+fn write_swing_up_section(summary: &DlgpdEvalSummary, dir: &Path, md: &mut String) -> Result<()> {
+    let (points, outcomes, tests) = (&summary.points, &summary.outcomes, &summary.tests);
+    let settings = &summary.settings;
     let rows: Vec<Vec<String>> = outcomes
         .iter()
         .map(|o| {
             vec![
                 o.env.clone(),
-                o.evidence.to_string(),
+                o.evidence.clone(),
                 o.rollouts.to_string(),
                 o.run.to_string(),
                 format!("{:.3}", o.total_return),
@@ -455,7 +637,7 @@ fn write_swing_up_section(
         })
         .collect();
     write_csv(
-        &run_dir.file("results.csv"),
+        &dir.join("results.csv"),
         &["env", "evidence", "evidence_rollouts", "run", "return", "success", "mean_cem_iterations"],
         &rows,
     )?;
@@ -473,7 +655,7 @@ fn write_swing_up_section(
         })
         .collect();
     write_csv(
-        &run_dir.file("summary.csv"),
+        &dir.join("summary.csv"),
         &["env", "evidence", "evidence_rollouts", "mean_return", "success_rate", "runs"],
         &summary_rows,
     )?;
@@ -490,21 +672,21 @@ fn write_swing_up_section(
         series
     };
     line_plot(
-        &run_dir.file("returns.png"),
+        &dir.join("returns.png"),
         "DLGPD swing-up return vs evidence (Fig. 3.4 analogue)",
         "rollouts in evidence",
         &format!("mean return ({} runs per point)", settings.runs),
         &curves(&|p| p.mean_return),
     )?;
     line_plot_in(
-        &run_dir.file("success.png"),
+        &dir.join("success.png"),
         "DLGPD swing-up success vs evidence (Fig. 3.5 analogue)",
         "rollouts in evidence",
         "success rate (last 25 rewards > -1)",
         &curves(&|p| p.successes as f64 / p.runs as f64),
         (-0.05, 1.05),
     )?;
-    write_runs_plot(run_dir, outcomes)?;
+    write_runs_plot(dir, outcomes)?;
     md.push_str(&format!(
         "## Swing-ups\n\nCEM: {} candidates, {} elites, ≤ {} iterations (stopping at first-action std ≤ 0.01), \
          horizon {}; {} steps from the hanging position; success = each of the last 25 rewards > −1. Each point \
@@ -547,7 +729,7 @@ fn write_swing_up_section(
             ]
         })
         .collect();
-    write_csv(&run_dir.file("wilcoxon.csv"), &["env", "evidence_rollouts", "pairs", "w_plus", "p_value"], &test_rows)?;
+    write_csv(&dir.join("wilcoxon.csv"), &["env", "evidence_rollouts", "pairs", "w_plus", "p_value"], &test_rows)?;
     md.push_str(
         "\nThe thesis reports these as figures only (27 runs per point: 3 models × 3 evidence pools × 3 trials, \
          evidence of 10 to 200 rollouts, 1000 candidates); it states that DLGPD reaches 100 % success on the \
@@ -559,11 +741,11 @@ fn write_swing_up_section(
 /// Horizons of the open-loop reward prediction that the report's table shows.
 const TABLE_HORIZONS: [usize; 5] = [0, 1, 5, 10, 20];
 
-fn write_prediction_section(run_dir: &RunDir, predictions: &[PredictionCheck], md: &mut String) -> Result<()> {
+fn write_prediction_section(dir: &Path, predictions: &[PredictionCheck], md: &mut String) -> Result<()> {
     let name = |p: &PredictionCheck| format!("{} ({})", p.env, p.evidence);
     let mut rows = Vec::new();
     for p in predictions {
-        for (h, e) in p.prediction.errors.open_loop_rmse.iter().enumerate() {
+        for (h, e) in p.prediction.open_loop_rmse.iter().enumerate() {
             rows.push(vec![
                 p.env.clone(),
                 p.evidence.to_string(),
@@ -573,11 +755,7 @@ fn write_prediction_section(run_dir: &RunDir, predictions: &[PredictionCheck], m
             ]);
         }
     }
-    write_csv(
-        &run_dir.file("prediction.csv"),
-        &["env", "evidence", "evidence_rollouts", "horizon", "reward_rmse"],
-        &rows,
-    )?;
+    write_csv(&dir.join("prediction.csv"), &["env", "evidence", "evidence_rollouts", "horizon", "reward_rmse"], &rows)?;
     let responses: Vec<Vec<String>> = predictions
         .iter()
         .flat_map(|p| {
@@ -593,7 +771,7 @@ fn write_prediction_section(run_dir: &RunDir, predictions: &[PredictionCheck], m
         })
         .collect();
     write_csv(
-        &run_dir.file("action_response.csv"),
+        &dir.join("action_response.csv"),
         &["env", "evidence", "horizon", "response", "true_effect"],
         &responses,
     )?;
@@ -601,23 +779,23 @@ fn write_prediction_section(run_dir: &RunDir, predictions: &[PredictionCheck], m
         .iter()
         .map(|p| Series {
             name: name(p),
-            points: p.prediction.errors.open_loop_rmse.iter().enumerate().map(|(h, e)| (h as f64, *e)).collect(),
+            points: p.prediction.open_loop_rmse.iter().enumerate().map(|(h, e)| (h as f64, *e)).collect(),
         })
         .collect();
     // The line a model must stay under to know anything about the state: its held-out rewards' spread.
     if let Some(p) = predictions.iter().find(|p| p.evidence == "matching") {
-        let last = p.prediction.errors.open_loop_rmse.len().saturating_sub(1) as f64;
-        let level = p.prediction.errors.constant_rmse;
+        let last = p.prediction.open_loop_rmse.len().saturating_sub(1) as f64;
+        let level = p.prediction.constant_rmse;
         series.push(Series { name: format!("best constant ({})", p.env), points: vec![(0.0, level), (last, level)] });
     }
     rising_line_plot(
-        &run_dir.file("prediction.png"),
+        &dir.join("prediction.png"),
         "DLGPD open-loop reward prediction on held-out rollouts",
         "steps after the encoded start",
         "reward RMSE",
         &series,
     )?;
-    let rollouts = predictions.first().map_or(0, |p| p.prediction.errors.rollouts);
+    let rollouts = predictions.first().map_or(0, |p| p.prediction.rollouts);
     md.push_str(&format!(
         "\n## Reward prediction on held-out rollouts\n\nWhat the planner optimizes, checked against the simulator: \
          {rollouts} random-action rollouts of each system (not in any evidence); the model conditioned on run 0's \
@@ -643,17 +821,18 @@ fn write_prediction_section(run_dir: &RunDir, predictions: &[PredictionCheck], m
     for p in predictions {
         let cells: Vec<String> = TABLE_HORIZONS
             .iter()
-            .map(|&h| p.prediction.errors.open_loop_rmse.get(h).map_or("–".into(), |e| format!("{e:.2}")))
+            .map(|&h| p.prediction.open_loop_rmse.get(h).map_or("–".into(), |e| format!("{e:.2}")))
             .collect();
-        let [c, s, v] = p.prediction.linear_probe_r2;
+        let r2 = |i: usize| p.prediction.linear_probe_r2.get(i).copied().unwrap_or(f64::NAN);
+        let (c, s, v) = (r2(0), r2(1), r2(2));
         let responses = &p.prediction.action_response;
         md.push_str(&format!(
             "| {} | {} | {:.2} | {} | {:.2} | {c:.2} / {s:.2} / {v:.2} | {} | {} |\n",
             p.env,
             p.evidence,
-            p.prediction.errors.encoded_rmse,
+            p.prediction.encoded_rmse,
             cells.join(" | "),
-            p.prediction.errors.constant_rmse,
+            p.prediction.constant_rmse,
             responses.iter().map(|r| format!("{:.2}", r.response)).collect::<Vec<_>>().join(" / "),
             responses.iter().map(|r| format!("{:.2}", r.true_effect)).collect::<Vec<_>>().join(" / "),
         ));

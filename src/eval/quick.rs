@@ -3,11 +3,15 @@
 
 use std::path::Path;
 
-use super::ball::{self, BallEvalSettings};
-use super::boards::{self, EmbodiedSettings};
+use serde::{Deserialize, Serialize};
+
+use super::ball::{self, BallConfig, BallEvalSettings};
+use super::boards::{self, EmbodiedConfig, EmbodiedSettings};
 use super::context::{self as context_eval, ContextEvalSettings};
-use super::seads::{seads_report, SeadsEvalSettings};
-use super::swingup::{self, SwingupSettings};
+use super::num;
+use super::seads::{seads_report, SeadsEvalConfig, SeadsEvalSettings};
+use super::summary::{publish, write_config};
+use super::swingup::{self, ModelSpec, SwingupConfig, SwingupSettings};
 use crate::data::collect::{collect_instance_pairs, collect_random, CollectSettings, InstancePairSettings};
 use crate::data::collect_ball::{collect_ball, BallCollectSettings};
 use crate::data::write_dataset;
@@ -72,33 +76,285 @@ pub const QUICK_TRADYN_INSTANCES: usize = 400;
 pub const QUICK_TRADYN_TRAIN_STEPS: u64 = 600;
 pub const QUICK_TRADYN_TASKS: usize = 4;
 
+pub const PROTOCOL: &str = "quick";
+
+/// `mbrl eval quick` has no settings but the seed: its scale is fixed.
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct QuickConfig {}
+
+/// The ground-truth swing-up slice.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct SwingupSlice {
+    pub candidates: usize,
+    pub horizon: usize,
+    pub iterations: usize,
+    pub successes: usize,
+    pub episodes: usize,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct BoardsSlice {
+    pub depths: usize,
+    /// Depths whose count differs from Table 7.1.
+    pub differing: usize,
+    pub split_depths: usize,
+    pub split_differing: usize,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct EmbodiedSlice {
+    pub solved: usize,
+    pub boards: usize,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct PetsSlice {
+    pub train_steps: u64,
+    pub transitions: usize,
+    #[serde(with = "num::opt")]
+    pub best_valid_loss: Option<f64>,
+    pub candidates: usize,
+    pub horizon: usize,
+    pub iterations: usize,
+    pub particles: usize,
+    pub successes: usize,
+    pub episodes: usize,
+    #[serde(with = "num::real")]
+    pub mean_return: f64,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct BallSlice {
+    pub train_steps: u64,
+    #[serde(with = "num::real")]
+    pub first_loss: f64,
+    #[serde(with = "num::real")]
+    pub last_loss: f64,
+    /// Median 1 s prediction errors on unseen poses (m).
+    #[serde(with = "num::opt")]
+    pub trained: Option<f64>,
+    #[serde(with = "num::opt")]
+    pub ridge: Option<f64>,
+    #[serde(with = "num::opt")]
+    pub oracle: Option<f64>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ContextSlice {
+    pub env: String,
+    pub train_steps: u64,
+    #[serde(with = "num::real")]
+    pub mse_random: f64,
+    #[serde(with = "num::real")]
+    pub mse_open_loop: f64,
+    /// One-sided Wilcoxon p that open-loop EIG predicts better than random.
+    #[serde(with = "num::opt")]
+    pub p_value: Option<f64>,
+    /// Entropy after one informative and after one non-informative action.
+    #[serde(with = "num::opt_pair")]
+    pub entropy: Option<(f64, f64)>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct SeadsSlice {
+    pub env_steps: u64,
+    pub distinct_moves: usize,
+    pub moves: usize,
+    pub solved: usize,
+    pub boards: usize,
+}
+
+/// A DLGPD swing-up: its return and whether it swung up.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct DlgpdRun {
+    #[serde(with = "num::real")]
+    pub total_return: f64,
+    pub success: bool,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct DlgpdSlice {
+    pub transitions: usize,
+    pub matching: Option<DlgpdRun>,
+    pub mismatching: Option<DlgpdRun>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct TradynVariantSlice {
+    pub variant: String,
+    #[serde(with = "num::real")]
+    pub median_energy: f64,
+    #[serde(with = "num::real")]
+    pub median_distance: f64,
+    pub failures: usize,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct TradynSlice {
+    pub variants: Vec<TradynVariantSlice>,
+}
+
+/// What each slice found; the quick report and the printed lines are drawn from it.
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct QuickSummary {
-    pub lines: Vec<String>,
+    pub provenance: Provenance,
+    pub swingup: SwingupSlice,
+    pub boards: BoardsSlice,
+    pub embodied: EmbodiedSlice,
+    pub pets: PetsSlice,
+    pub ball: BallSlice,
+    pub context: Vec<ContextSlice>,
+    pub seads: SeadsSlice,
+    pub dlgpd: DlgpdSlice,
+    pub tradyn: TradynSlice,
+}
+
+impl QuickSummary {
+    /// One line per slice, as printed and listed in report.md.
+    pub fn lines(&self) -> Vec<String> {
+        let (sw, b, e, p, ball) = (&self.swingup, &self.boards, &self.embodied, &self.pets, &self.ball);
+        let mut lines = vec![
+            format!(
+                "pendulum swing-up (ground-truth model, CEM {}×{}×{}): {}/{} episodes succeeded; see pendulum-swingup/report.md",
+                sw.candidates, sw.horizon, sw.iterations, sw.successes, sw.episodes
+            ),
+            format!(
+                "board depth tables (LightsOut 5×5, TileSwap 3×3): {} depths, {} differ from thesis Table 7.1; \
+                 train/test split of {} depths, {} differ from Table 7.2; see boards/report.md",
+                b.depths, b.differing, b.split_depths, b.split_differing
+            ),
+            format!(
+                "LightsOut played by the Reacher's scripted controller, depths 1-5 (test split): {}/{} boards solved; see lightsout-reacher/report.md",
+                e.solved, e.boards
+            ),
+            format!(
+                "PETS: ensemble of 5 trained {} steps on {} random transitions (validation MSE {}); swing-up planned on the \
+                 learned model (CEM {}×{}×{}, {} TS-∞ particles): {}/{} episodes succeeded, mean return {:.1}; see pets/swingup/report.md",
+                p.train_steps,
+                p.transitions,
+                p.best_valid_loss.map(|v| format!("{v:.2e}")).unwrap_or_else(|| "–".into()),
+                p.candidates,
+                p.horizon,
+                p.iterations,
+                p.particles,
+                p.successes,
+                p.episodes,
+                p.mean_return
+            ),
+        ];
+        let cm = |m: Option<f64>| m.map(|m| format!("{:.1} cm", 100.0 * m)).unwrap_or_else(|| "–".into());
+        lines.push(format!(
+            "ball EKF: {} training steps lowered the loss {:.2} -> {:.2}; median 1 s prediction error on unseen poses: \
+             trained EKF {} vs ridge baseline {} (oracle with the simulator's own constants: {}); see ball/report.md",
+            ball.train_steps,
+            ball.first_loss,
+            ball.last_loss,
+            cm(ball.trained),
+            cm(ball.ridge),
+            cm(ball.oracle)
+        ));
+        for c in &self.context {
+            let p_value = c.p_value.map(|p| format!("{p:.1e}")).unwrap_or_else(|| "–".into());
+            let entropy = c
+                .entropy
+                .map(|(informative, other)| format!("{informative:.2} vs {other:.2} nats"))
+                .unwrap_or_else(|| "–".into());
+            lines.push(format!(
+                "Explore the Context, {name}: context model (small preset, {} steps on {} instance pairs); one calibration \
+                 transition in {} unseen contexts: prediction MSE random {:.2e}, open-loop EIG {:.2e} (Wilcoxon one-sided p = \
+                 {p_value}); entropy of q(β) after one informative vs non-informative action {entropy}; see {}/eval/report.md",
+                c.train_steps,
+                QUICK_CONTEXT_INSTANCES,
+                QUICK_CONTEXT_CONTEXTS,
+                c.mse_random,
+                c.mse_open_loop,
+                c.env.replace(':', "-"),
+                name = c.env,
+            ));
+        }
+        let sd = &self.seads;
+        lines.push(format!(
+            "SEADS, tileswap:cursor (small preset, {} env steps, no game reward): the skills cover {}/{} moves; {}/{} \
+             test boards of depth 1-{} solved by planning over the learned forward model; see seads-tileswap-cursor/eval/report.md",
+            sd.env_steps, sd.distinct_moves, sd.moves, sd.solved, sd.boards, QUICK_SEADS_DEPTH
+        ));
+        let describe = |run: &Option<DlgpdRun>| {
+            run.as_ref()
+                .map(|o| {
+                    format!("return {:.1}, {}", o.total_return, if o.success { "swung up" } else { "not swung up" })
+                })
+                .unwrap_or_else(|| "not run".into())
+        };
+        lines.push(format!(
+            "DLGPD (small preset: MLP VAE on pole angles instead of images, {QUICK_DLGPD_TRAIN_STEPS} steps on {} random \
+             transitions of the standard pendulum), inverted-action pendulum, no retraining, {} steps: with {} matching \
+             evidence rollouts {}; with the standard pendulum's evidence {}; see dlgpd/eval/report.md",
+            self.dlgpd.transitions,
+            QUICK_DLGPD_SWINGUP_STEPS,
+            QUICK_DLGPD_EVIDENCE_ROLLOUTS,
+            describe(&self.dlgpd.matching),
+            describe(&self.dlgpd.mismatching)
+        ));
+        let per_variant: Vec<String> = self
+            .tradyn
+            .variants
+            .iter()
+            .map(|v| {
+                format!(
+                    "{} energy {:.2} / distance {:.0} mm / failed {}",
+                    v.variant,
+                    v.median_energy,
+                    v.median_distance * 1000.0,
+                    v.failures
+                )
+            })
+            .collect();
+        lines.push(format!(
+            "TRADYN: tiny models with and without terrain lookup ({QUICK_TRADYN_TRAIN_STEPS} steps on {QUICK_TRADYN_INSTANCES} \
+             unicycle pairs over {} train maps), {QUICK_TRADYN_TASKS} navigation tasks on test maps, 30 steps, CEM 100×4 \
+             (medians): {}; a smoke test of the pipeline, not the thesis' claim (`make repro-tradyn`); see tradyn/eval/report.md",
+            QUICK_TRADYN_MAPS.div_ceil(2),
+            per_variant.join("; ")
+        ));
+        lines
+    }
+}
+
+impl std::fmt::Display for QuickSummary {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        write!(f, "{}", self.lines().join("\n"))
+    }
 }
 
 pub fn run_quick(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) -> Result<QuickSummary> {
     std::fs::create_dir_all(out_dir).map_err(|e| Error::io(out_dir, e))?;
+    write_config(&QuickConfig {}, provenance, out_dir)?;
     let settings = SwingupSettings::thesis(PendulumVariant::Standard);
-    let swing =
-        swingup::evaluate(&settings, None, SWINGUP_EPISODES, provenance, &out_dir.join("pendulum-swingup"), monitor)?;
-    let mut lines = vec![format!(
-        "pendulum swing-up (ground-truth model, CEM {}×{}×{}): {}/{} episodes succeeded; see pendulum-swingup/report.md",
-        settings.cem.candidates, settings.cem.horizon, settings.cem.iterations, swing.successes, swing.episodes
-    )];
-    let rows = boards::depth_report(provenance, &out_dir.join("boards"), monitor)?;
-    let differing = rows.iter().filter(|r| r.thesis.is_some_and(|t| t != r.boards)).count();
-    let split_rows = rows.iter().filter(|r| r.thesis_split.is_some()).count();
-    let split_differing = rows.iter().filter(|r| r.thesis_split.is_some_and(|t| t != (r.train, r.test))).count();
-    lines.push(format!(
-        "board depth tables (LightsOut 5×5, TileSwap 3×3): {} depths, {differing} differ from thesis Table 7.1; \
-         train/test split of {split_rows} depths, {split_differing} differ from Table 7.2; see boards/report.md",
-        rows.len()
-    ));
-    let embodied = EmbodiedSettings {
-        embodiment: Embodiment::Reacher,
-        max_depth: 5,
-        boards_per_depth: EMBODIED_BOARDS_PER_DEPTH,
-        split: Split::Test,
+    let config = SwingupConfig::ground_truth(settings.clone(), SWINGUP_EPISODES);
+    let swing = swingup::evaluate(&config, None, provenance, &out_dir.join("pendulum-swingup"), monitor)?;
+    let swingup = SwingupSlice {
+        candidates: settings.cem.candidates,
+        horizon: settings.cem.horizon,
+        iterations: settings.cem.iterations,
+        successes: swing.successes(),
+        episodes: swing.episodes.len(),
+    };
+    let rows = boards::depth_report(provenance, &out_dir.join("boards"), monitor)?.rows;
+    let boards = BoardsSlice {
+        depths: rows.len(),
+        differing: rows.iter().filter(|r| r.thesis.is_some_and(|t| t != r.boards)).count(),
+        split_depths: rows.iter().filter(|r| r.thesis_split.is_some()).count(),
+        split_differing: rows.iter().filter(|r| r.thesis_split.is_some_and(|t| t != (r.train, r.test))).count(),
+    };
+    let embodied = EmbodiedConfig {
+        game: "lightsout".into(),
+        settings: EmbodiedSettings {
+            embodiment: Embodiment::Reacher,
+            max_depth: 5,
+            boards_per_depth: EMBODIED_BOARDS_PER_DEPTH,
+            split: Split::Test,
+        },
     };
     let played = boards::embodied_report(
         &LightsOut::new(5)?,
@@ -107,30 +363,45 @@ pub fn run_quick(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor)
         &out_dir.join("lightsout-reacher"),
         monitor,
     )?;
-    let (total, solved) = played.iter().fold((0, 0), |(t, s), r| (t + r.boards, s + r.solved));
-    lines.push(format!(
-        "LightsOut played by the Reacher's scripted controller, depths 1-5 (test split): {solved}/{total} boards solved; see lightsout-reacher/report.md"
-    ));
-    lines.push(pets_slice(provenance, out_dir, monitor)?);
-    lines.push(ball_slice(provenance, out_dir, monitor)?);
+    let (total, solved) = played.totals();
+    let embodied = EmbodiedSlice { solved, boards: total };
+    let pets = pets_slice(provenance, out_dir, monitor)?;
+    let ball = ball_slice(provenance, out_dir, monitor)?;
+    let mut context = Vec::new();
     for squash in [Squash::Inner, Squash::Outer] {
-        lines.push(context_slice(squash, provenance, out_dir, monitor)?);
+        context.push(context_slice(squash, provenance, out_dir, monitor)?);
     }
-    lines.push(seads_slice(provenance, out_dir, monitor)?);
-    lines.push(dlgpd_slice(provenance, out_dir, monitor)?);
-    lines.push(tradyn_slice(provenance, out_dir, monitor)?);
+    let seads = seads_slice(provenance, out_dir, monitor)?;
+    let dlgpd = dlgpd_slice(provenance, out_dir, monitor)?;
+    let tradyn = tradyn_slice(provenance, out_dir, monitor)?;
+    let summary = QuickSummary {
+        provenance: provenance.clone(),
+        swingup,
+        boards,
+        embodied,
+        pets,
+        ball,
+        context,
+        seads,
+        dlgpd,
+        tradyn,
+    };
+    publish(PROTOCOL, &summary, out_dir, render)?;
+    Ok(summary)
+}
+
+/// Writes the quick report.md of `summary` into `dir` (each slice's own report is in its subdirectory).
+pub fn render(summary: &QuickSummary, dir: &Path) -> Result<()> {
     let mut md = String::from("# mbrl quick reproduction\n\nSmall-scale runs of each implemented method.\n\n");
-    for line in &lines {
+    for line in summary.lines() {
         md.push_str(&format!("- {line}\n"));
     }
-    let path = out_dir.join("report.md");
-    write_text(&path, &md)?;
-    Ok(QuickSummary { lines })
+    write_text(&dir.join("report.md"), &md)
 }
 
 /// The basic model-based loop: random pendulum data → a trained PETS ensemble → MPC swing-ups planned on the
 /// learned model (and executed in the simulator).
-fn pets_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) -> Result<String> {
+fn pets_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) -> Result<PetsSlice> {
     let dir = out_dir.join("pets");
     let data_path = dir.join("pendulum-random.mcap");
     let collect = CollectSettings {
@@ -164,27 +435,36 @@ fn pets_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) ->
     settings.steps = QUICK_PETS_SWINGUP_STEPS;
     settings.cem.candidates = QUICK_PETS_CANDIDATES;
     settings.cem.elites = QUICK_PETS_CANDIDATES / 10;
-    let swing =
-        swingup::evaluate(&settings, Some(&model), QUICK_PETS_EPISODES, provenance, &dir.join("swingup"), monitor)?;
-    let mean_return = swing.returns.iter().sum::<f64>() / swing.episodes.max(1) as f64;
-    Ok(format!(
-        "PETS: ensemble of 5 trained {} steps on {} random transitions (validation MSE {}); swing-up planned on the \
-         learned model (CEM {}×{}×{}, {} TS-∞ particles): {}/{} episodes succeeded, mean return {mean_return:.1}; see pets/swingup/report.md",
-        QUICK_PETS_TRAIN_STEPS,
-        trained.record.details.transitions.train,
-        trained.outcome.best_valid_loss.map(|v| format!("{v:.2e}")).unwrap_or_else(|| "–".into()),
-        settings.cem.candidates,
-        settings.cem.horizon,
-        settings.cem.iterations,
-        QUICK_PETS_PARTICLES,
-        swing.successes,
-        swing.episodes
-    ))
+    let config = SwingupConfig {
+        model: ModelSpec {
+            model: out.display().to_string(),
+            particles: QUICK_PETS_PARTICLES,
+            propagation: "tsinf".into(),
+            context: None,
+            allow_incomplete: false,
+        },
+        env: collect.env.canonical(),
+        episodes: QUICK_PETS_EPISODES,
+        settings: settings.clone(),
+    };
+    let swing = swingup::evaluate(&config, Some(&model), provenance, &dir.join("swingup"), monitor)?;
+    Ok(PetsSlice {
+        train_steps: QUICK_PETS_TRAIN_STEPS,
+        transitions: trained.record.details.transitions.train,
+        best_valid_loss: trained.outcome.best_valid_loss,
+        candidates: settings.cem.candidates,
+        horizon: settings.cem.horizon,
+        iterations: settings.cem.iterations,
+        particles: QUICK_PETS_PARTICLES,
+        successes: swing.successes(),
+        episodes: swing.episodes.len(),
+        mean_return: swing.returns().iter().sum::<f64>() / swing.episodes.len().max(1) as f64,
+    })
 }
 
 /// Ball: a short EKF training run from Table C.1 on simulated shots, then the prediction protocol for
 /// the trained model, the thesis' parameters and the black-box baseline.
-fn ball_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) -> Result<String> {
+fn ball_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) -> Result<BallSlice> {
     let train_settings = BallCollectSettings {
         trajectories: 12,
         orientation: Orientation::Default,
@@ -212,29 +492,36 @@ fn ball_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) ->
         ),
         (report_name("thesis"), load_ball_model("thesis")?),
     ];
-    let eval = BallEvalSettings {
-        train_shots: 20,
-        augment_rotations: 3,
-        test_shots_default: 30,
-        test_shots_unseen: 6,
-        ..BallEvalSettings::default()
+    let eval = BallConfig {
+        models: vec!["trained (quick)".into(), "thesis".into()],
+        settings: BallEvalSettings {
+            train_shots: 20,
+            augment_rotations: 3,
+            test_shots_default: 30,
+            test_shots_unseen: 6,
+            ..BallEvalSettings::default()
+        },
     };
     let summary = ball::evaluate(&eval, models, provenance, &out_dir.join("ball"), monitor)?;
-    let median = |method: &str| {
-        summary.median_at(method, "unseen", 1.0).map(|m| format!("{:.1} cm", 100.0 * m)).unwrap_or_else(|| "–".into())
-    };
-    Ok(format!(
-        "ball EKF: {QUICK_BALL_TRAIN_STEPS} training steps lowered the loss {first:.2} -> {last:.2}; median 1 s prediction error on unseen poses: \
-         trained EKF {} vs ridge baseline {} (oracle with the simulator's own constants: {}); see ball/report.md",
-        median("trained (quick)"),
-        median("ridge baseline"),
-        median(ORACLE_NAME)
-    ))
+    let median = |method: &str| summary.median_at(method, "unseen", 1.0);
+    Ok(BallSlice {
+        train_steps: QUICK_BALL_TRAIN_STEPS,
+        first_loss: first,
+        last_loss: last,
+        trained: median("trained (quick)"),
+        ridge: median("ridge baseline"),
+        oracle: median(ORACLE_NAME),
+    })
 }
 
 /// Explore the Context on one toy system: instance pairs → a `small` context model → random vs open-loop EIG
 /// calibration with one transition in unseen contexts, and the entropy after one (non-)informative action.
-fn context_slice(squash: Squash, provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) -> Result<String> {
+fn context_slice(
+    squash: Squash,
+    provenance: &Provenance,
+    out_dir: &Path,
+    monitor: &dyn Monitor,
+) -> Result<ContextSlice> {
     let env = EnvName::Toy(squash);
     let name = env.canonical();
     let dir = out_dir.join(name.replace(':', "-"));
@@ -274,32 +561,22 @@ fn context_slice(squash: Squash, provenance: &Provenance, out_dir: &Path, monito
         },
         swingup: None,
     };
-    let summary = context_eval::evaluate(&model, &env, &settings, provenance, &dir.join("eval"), monitor)?;
-    let p_value = summary
-        .tests
-        .iter()
-        .find(|(better, worse, _)| *better == Strategy::OpenLoop && *worse == Strategy::Random)
-        .map(|(_, _, p)| format!("{p:.1e}"))
-        .unwrap_or_else(|| "–".into());
-    let entropy = summary
-        .toy_entropy
-        .map(|(informative, other)| format!("{informative:.2} vs {other:.2} nats"))
-        .unwrap_or_else(|| "–".into());
-    Ok(format!(
-        "Explore the Context, {name}: context model (small preset, {steps} steps on {} instance pairs); one calibration \
-         transition in {} unseen contexts: prediction MSE random {:.2e}, open-loop EIG {:.2e} (Wilcoxon one-sided p = \
-         {p_value}); entropy of q(β) after one informative vs non-informative action {entropy}; see {}/eval/report.md",
-        QUICK_CONTEXT_INSTANCES,
-        QUICK_CONTEXT_CONTEXTS,
-        summary.mean_mse[0],
-        summary.mean_mse[1],
-        name.replace(':', "-"),
-    ))
+    let config =
+        context_eval::ContextEvalConfig { model: out.clone(), env: name.clone(), allow_incomplete: false, settings };
+    let summary = context_eval::evaluate(&model, &env, &config, provenance, &dir.join("eval"), monitor)?;
+    Ok(ContextSlice {
+        env: name,
+        train_steps: steps,
+        mse_random: summary.mean_mse[0],
+        mse_open_loop: summary.mean_mse[1],
+        p_value: summary.p_value(Strategy::OpenLoop, Strategy::Random),
+        entropy: summary.toy.as_ref().map(|t| (t.informative, t.non_informative)),
+    })
 }
 
 /// SEADS on tileswap:cursor: skills and forward model learned without reward (small preset), then the skills'
 /// coverage of the 12 moves and test boards of depth 1-3 solved by planning over the learned model.
-fn seads_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) -> Result<String> {
+fn seads_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) -> Result<SeadsSlice> {
     let env = seads::EmbodiedGame::parse("tileswap:cursor")?;
     let dir = out_dir.join("seads-tileswap-cursor");
     let out = dir.join("model");
@@ -313,27 +590,32 @@ fn seads_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) -
     };
     let trained = start(&out, &request, monitor)?;
     let loaded = seads::planner::load(&out, Accept::Finished)?;
-    let settings = SeadsEvalSettings {
-        max_depth: QUICK_SEADS_DEPTH,
-        boards_per_depth: QUICK_SEADS_BOARDS,
-        coverage_boards: 40,
-        max_replans: 10,
-        split: Split::Test,
-        max_search_nodes: 2_000_000,
+    let config = SeadsEvalConfig {
+        models: vec![out.clone()],
+        allow_incomplete: false,
+        settings: SeadsEvalSettings {
+            max_depth: QUICK_SEADS_DEPTH,
+            boards_per_depth: QUICK_SEADS_BOARDS,
+            coverage_boards: 40,
+            max_replans: 10,
+            split: Split::Test,
+            max_search_nodes: 2_000_000,
+        },
     };
-    let summary = seads_report(&loaded, &settings, provenance, &dir.join("eval"), monitor)?;
+    let summary = seads_report(&loaded, &config, provenance, &dir.join("eval"), monitor)?;
     let (boards, solved) = summary.depths.iter().fold((0, 0), |(b, s), r| (b + r.boards, s + r.solved_with_replanning));
-    Ok(format!(
-        "SEADS, tileswap:cursor (small preset, {} env steps, no game reward): the skills cover {}/{} moves; {solved}/{boards} \
-         test boards of depth 1-{} solved by planning over the learned forward model; see seads-tileswap-cursor/eval/report.md",
-        trained.trainer.env_steps(), summary.distinct_moves, summary.moves, QUICK_SEADS_DEPTH
-    ))
+    Ok(SeadsSlice {
+        env_steps: trained.trainer.env_steps(),
+        distinct_moves: summary.distinct_moves,
+        moves: summary.moves,
+        solved,
+        boards,
+    })
 }
 
-fn dlgpd_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) -> Result<String> {
-    use super::dlgpd::{evaluate, DlgpdEvalSettings, EVIDENCE_STEPS};
+fn dlgpd_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) -> Result<DlgpdSlice> {
+    use super::dlgpd::{evaluate, DlgpdEvalConfig, EVIDENCE_STEPS};
     use crate::models::dlgpd::config::{DlgpdConfig, Preset as DlgpdPreset};
-    use crate::models::dlgpd::control::ControlSettings;
     use crate::models::dlgpd::job as dlgpd;
     let dir = out_dir.join("dlgpd");
     let data_path = dir.join("pendulum-random.mcap");
@@ -356,47 +638,41 @@ fn dlgpd_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) -
     };
     start(&out, &request, monitor)?;
     let trained = dlgpd::load(&out, Accept::Finished)?;
-    let mut cem = ControlSettings::authors(PendulumVariant::Inverted).cem;
-    cem.candidates = QUICK_DLGPD_CANDIDATES;
-    cem.elites = QUICK_DLGPD_CANDIDATES / 10;
-    cem.iterations = 8;
-    let settings = DlgpdEvalSettings {
-        variants: vec![PendulumVariant::Inverted],
+    let config = DlgpdEvalConfig {
+        model: out.clone(),
+        envs: vec![PendulumVariant::Inverted.env_name()],
         evidence_rollouts: vec![QUICK_DLGPD_EVIDENCE_ROLLOUTS],
         runs: 1,
         steps: QUICK_DLGPD_SWINGUP_STEPS,
-        cem,
-        swing_ups: true,
+        candidates: QUICK_DLGPD_CANDIDATES,
+        elites: QUICK_DLGPD_CANDIDATES / 10,
+        iters: 8,
+        prediction_only: false,
+        allow_incomplete: false,
     };
-    let summary = evaluate(&trained, &settings, provenance, &dir.join("eval"), monitor)?;
-    let describe = |kind: &str| {
+    let summary = evaluate(&trained, &config, provenance, &dir.join("eval"), monitor)?;
+    let run = |kind: &str| {
         summary
             .outcomes
             .iter()
             .find(|o| o.evidence == kind)
-            .map(|o| format!("return {:.1}, {}", o.total_return, if o.success { "swung up" } else { "not swung up" }))
-            .unwrap_or_else(|| "not run".into())
+            .map(|o| DlgpdRun { total_return: o.total_return, success: o.success })
     };
-    Ok(format!(
-        "DLGPD (small preset: MLP VAE on pole angles instead of images, {QUICK_DLGPD_TRAIN_STEPS} steps on {} random \
-         transitions of the standard pendulum), inverted-action pendulum, no retraining, {} steps: with {} matching \
-         evidence rollouts {}; with the standard pendulum's evidence {}; see dlgpd/eval/report.md",
-        trained.run.details.transitions.train,
-        QUICK_DLGPD_SWINGUP_STEPS,
-        QUICK_DLGPD_EVIDENCE_ROLLOUTS,
-        describe("matching"),
-        describe("mismatching")
-    ))
+    Ok(DlgpdSlice {
+        transitions: trained.run.details.transitions.train,
+        matching: run("matching"),
+        mismatching: run("mismatching"),
+    })
 }
 
 /// TRADYN: maps → unicycle instance pairs → tiny models with and without terrain lookup → the four variants on a
 /// few navigation tasks on test maps.
-fn tradyn_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) -> Result<String> {
-    use super::tradyn::{evaluate, variant_name, TradynEvalModels, TradynEvalSettings, VARIANTS};
+fn tradyn_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) -> Result<TradynSlice> {
+    use super::tradyn::{evaluate, variant_name, TradynEvalConfig, TradynEvalModels, VARIANTS};
     use crate::data::terrain_set::{read_terrain_set, write_terrain_set};
     use crate::envs::terrain::TerrainSplit;
     use crate::envs::unicycle::UnicycleTerrain;
-    use crate::models::tradyn::{self, navigation::NavigationSettings, TradynModel};
+    use crate::models::tradyn::{self, TradynModel};
     let dir = out_dir.join("tradyn");
     let maps_dir = dir.join("maps");
     let data_seed = derive_seed(provenance.seed, &[u64::from_le_bytes(*b"tradyn-d")]);
@@ -436,43 +712,39 @@ fn tradyn_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) 
     }
     let no_terrain = models.pop().expect("two models trained");
     let terrain = models.pop().expect("two models trained");
-    let mut navigation = NavigationSettings::thesis();
-    (navigation.steps, navigation.horizon) = (30, 15);
-    (navigation.cem.candidates, navigation.cem.elites, navigation.cem.iterations) = (100, 10, 4);
-    let settings = TradynEvalSettings {
+    let config = TradynEvalConfig {
+        model_terrain: dir.join("model-terrain"),
+        model_no_terrain: dir.join("model-no-terrain"),
+        maps: maps_dir.clone(),
+        allow_incomplete: false,
         tasks: QUICK_TRADYN_TASKS,
-        calibration_transitions: 10,
-        navigation,
+        transitions: 10,
+        steps: 30,
+        horizon: 15,
+        candidates: 100,
+        elites: 10,
+        iters: 4,
         prediction_steps: 30,
-        example_tasks: 3,
     };
     let test_maps = read_terrain_set(&maps_dir, Some(TerrainSplit::Test))?;
     let summary = evaluate(
         &TradynEvalModels { terrain, no_terrain },
         test_maps,
-        &settings,
+        &config,
         provenance,
         &dir.join("eval"),
         monitor,
     )?;
-    let per_variant: Vec<String> = VARIANTS
-        .iter()
-        .enumerate()
-        .map(|(v, variant)| {
-            format!(
-                "{} energy {:.2} / distance {:.0} mm / failed {}",
-                variant_name(*variant),
-                summary.median_energy[v],
-                summary.median_distance[v] * 1000.0,
-                summary.failures[v]
-            )
-        })
-        .collect();
-    Ok(format!(
-        "TRADYN: tiny models with and without terrain lookup ({QUICK_TRADYN_TRAIN_STEPS} steps on {QUICK_TRADYN_INSTANCES} \
-         unicycle pairs over {} train maps), {QUICK_TRADYN_TASKS} navigation tasks on test maps, 30 steps, CEM 100×4 \
-         (medians): {}; a smoke test of the pipeline, not the thesis' claim (`make repro-tradyn`); see tradyn/eval/report.md",
-        QUICK_TRADYN_MAPS.div_ceil(2),
-        per_variant.join("; ")
-    ))
+    Ok(TradynSlice {
+        variants: VARIANTS
+            .iter()
+            .enumerate()
+            .map(|(v, variant)| TradynVariantSlice {
+                variant: variant_name(*variant),
+                median_energy: summary.median_energy[v],
+                median_distance: summary.median_distance[v],
+                failures: summary.failures[v],
+            })
+            .collect(),
+    })
 }

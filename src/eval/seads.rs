@@ -6,11 +6,13 @@
 use std::path::Path;
 
 use rand::seq::IndexedRandom;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::envs::boards::{BoardGame, GameSpec, LightsOut, Split, TileSwap};
-use crate::error::{ErrorKind, Result};
+use crate::error::{Error, ErrorKind, Result};
+use crate::eval::num;
 use crate::eval::plot::{box_plot, line_plot_in, Series};
+use crate::eval::summary::{publish, write_config};
 use crate::models::seads::boards::BoardPool;
 use crate::models::seads::collect::{Collector, Starts};
 use crate::models::seads::planner::{solve_with_skills, LoadedSeads};
@@ -21,7 +23,55 @@ use crate::util::atomic::write_text;
 use crate::util::seeding::rng_for;
 use crate::util::table::write_csv;
 
-#[derive(Clone, Debug, Serialize)]
+pub const PROTOCOL: &str = "seads";
+pub const COMPARE_PROTOCOL: &str = "seads-compare";
+
+/// `mbrl eval seads`'s settings, as config.json records them.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SeadsEvalConfig {
+    /// The checkpoints evaluated (several: compared).
+    pub models: Vec<std::path::PathBuf>,
+    pub allow_incomplete: bool,
+    pub settings: SeadsEvalSettings,
+}
+
+/// The name a checkpoint directory gets in reports and comparisons.
+pub fn run_name(dir: &Path) -> String {
+    dir.file_name().and_then(|n| n.to_str()).unwrap_or("model").to_string()
+}
+
+impl SeadsEvalConfig {
+    pub fn validate(&self) -> Result<()> {
+        let s = &self.settings;
+        if s.max_depth == 0 || s.max_depth > 10 || s.boards_per_depth == 0 || s.coverage_boards == 0 {
+            return Err(Error::config("--max-depth must be 1..=10 and --boards, --coverage-boards at least 1"));
+        }
+        if self.models.is_empty() {
+            return Err(Error::config("eval seads needs at least one --model"));
+        }
+        let mut names: Vec<String> = self.models.iter().map(|m| run_name(m)).collect();
+        names.sort();
+        if self.models.len() > 1 && names.windows(2).any(|w| w[0] == w[1]) {
+            return Err(Error::config(
+                "--model directories to compare need distinct names (each gets a report subdirectory of that name)",
+            ));
+        }
+        Ok(())
+    }
+
+    /// The report directory when none is given: reports/seads-<checkpoint name>, or reports/seads-compare.
+    pub fn default_out(&self) -> std::path::PathBuf {
+        std::path::PathBuf::from(if self.models.len() == 1 {
+            format!("reports/seads-{}", run_name(&self.models[0]))
+        } else {
+            "reports/seads-compare".into()
+        })
+    }
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SeadsEvalSettings {
     pub max_depth: u8,
     pub boards_per_depth: usize,
@@ -34,24 +84,29 @@ pub struct SeadsEvalSettings {
     pub max_search_nodes: usize,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct SkillRow {
     pub skill: usize,
     /// The game move this skill performs most often, if it performs any.
     pub mode_move: Option<usize>,
+    #[serde(with = "num::real")]
     pub mode_share: f64,
     /// Share of executions that changed nothing before the step limit.
+    #[serde(with = "num::real")]
     pub no_move_share: f64,
+    #[serde(with = "num::real")]
     pub mean_steps: f64,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct DepthRow {
     pub depth: usize,
     pub boards: usize,
     pub solved_with_replanning: usize,
     pub solved_without_replanning: usize,
+    #[serde(with = "num::real")]
     pub mean_planning_seconds: f64,
+    #[serde(with = "num::real")]
     pub mean_control_steps: f64,
     /// Searches (with and without replanning) that hit the node budget; their boards count as unsolved.
     pub search_budget_exhausted: usize,
@@ -59,9 +114,15 @@ pub struct DepthRow {
     pub skill_lengths: Vec<usize>,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct SeadsEvalSummary {
+    pub provenance: Provenance,
+    pub settings: SeadsEvalSettings,
+    /// The checkpoint directory's name.
+    pub name: String,
     pub env: String,
+    /// The game's move names, by move index.
+    pub move_names: Vec<String>,
     /// The checkpoint and how far it was trained, as the report names it.
     pub model: String,
     pub skills: Vec<SkillRow>,
@@ -69,6 +130,29 @@ pub struct SeadsEvalSummary {
     pub distinct_moves: usize,
     pub moves: usize,
     pub depths: Vec<DepthRow>,
+}
+
+impl std::fmt::Display for SeadsEvalSummary {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        write!(
+            f,
+            "{} ({}): the skills' most frequent moves cover {} of {} game moves",
+            self.name, self.env, self.distinct_moves, self.moves
+        )?;
+        for r in &self.depths {
+            let n = r.boards.max(1) as f64;
+            write!(
+                f,
+                "\n  depth {}: {:.1} % solved with ≤ {} replans, {:.1} % without; planning {:.4} s per board",
+                r.depth,
+                100.0 * r.solved_with_replanning as f64 / n,
+                self.settings.max_replans,
+                100.0 * r.solved_without_replanning as f64 / n,
+                r.mean_planning_seconds
+            )?;
+        }
+        Ok(())
+    }
 }
 
 fn coverage<G: BoardGame>(
@@ -179,32 +263,32 @@ fn success_rows<G: BoardGame>(
 
 /// Runs the protocol on a loaded checkpoint and writes report.md, skills.csv, success.csv, success.png,
 /// skill_lengths.csv and skill_lengths.png.
+/// `config` is what this report's config.json records: the one checkpoint evaluated here.
 pub fn seads_report(
     loaded: &LoadedSeads,
-    settings: &SeadsEvalSettings,
+    config: &SeadsEvalConfig,
     provenance: &Provenance,
     out_dir: &Path,
     monitor: &dyn Monitor,
 ) -> Result<SeadsEvalSummary> {
+    config.validate()?;
     match loaded.env.game {
-        GameSpec::TileSwap => report_game(&TileSwap::new(), loaded, settings, provenance, out_dir, monitor),
-        GameSpec::LightsOut(n) => report_game(&LightsOut::new(n)?, loaded, settings, provenance, out_dir, monitor),
+        GameSpec::TileSwap => report_game(&TileSwap::new(), loaded, config, provenance, out_dir, monitor),
+        GameSpec::LightsOut(n) => report_game(&LightsOut::new(n)?, loaded, config, provenance, out_dir, monitor),
     }
 }
 
 fn report_game<G: BoardGame>(
     game: &G,
     loaded: &LoadedSeads,
-    settings: &SeadsEvalSettings,
+    config: &SeadsEvalConfig,
     provenance: &Provenance,
     out_dir: &Path,
     monitor: &dyn Monitor,
 ) -> Result<SeadsEvalSummary> {
+    let settings = &config.settings;
     let run = RunDir::create(out_dir)?;
-    run.write_config(&serde_json::json!({
-        "job": "eval seads", "env": loaded.env.name(), "settings": settings, "provenance": provenance,
-        "model": loaded.run, "training": loaded.progress,
-    }))?;
+    write_config(config, provenance, run.path())?;
     let metrics = run.metrics()?;
     let monitor = Tee { first: monitor, second: &metrics };
     let seed = provenance.seed;
@@ -218,34 +302,45 @@ fn report_game<G: BoardGame>(
     modes.dedup();
     let depths = success_rows(game, loaded, &pool, settings, seed, &monitor)?;
     let summary = SeadsEvalSummary {
+        provenance: provenance.clone(),
+        settings: settings.clone(),
+        name: run_name(&loaded.dir),
         env: loaded.env.name(),
+        move_names: (0..game.num_moves()).map(|m| game.move_name(m)).collect(),
         model: loaded.progress.name_model(&loaded.dir),
         distinct_moves: modes.len(),
         moves: game.num_moves(),
         skills,
         depths,
     };
-    write_files(game, &summary, settings, &run)?;
+    publish(PROTOCOL, &summary, run.path(), render)?;
     metrics.emit(&Event::Finished { ok: true });
     Ok(summary)
 }
 
-fn write_files<G: BoardGame>(game: &G, s: &SeadsEvalSummary, settings: &SeadsEvalSettings, run: &RunDir) -> Result<()> {
+/// Writes skills.csv, success.csv/.png, skill_lengths.csv/.png and report.md of `s` into `dir`.
+pub fn render(s: &SeadsEvalSummary, dir: &Path) -> Result<()> {
+    let settings = &s.settings;
+    let move_name = |m: usize| {
+        s.move_names.get(m).cloned().ok_or_else(|| {
+            Error::config(format!("skills: move {m} is not among the {} move_names", s.move_names.len()))
+        })
+    };
     let skill_rows: Vec<Vec<String>> = s
         .skills
         .iter()
         .map(|r| {
-            vec![
+            Ok(vec![
                 r.skill.to_string(),
-                r.mode_move.map(|m| game.move_name(m)).unwrap_or_else(|| "none".into()),
+                r.mode_move.map(move_name).transpose()?.unwrap_or_else(|| "none".into()),
                 format!("{:.4}", r.mode_share),
                 format!("{:.4}", r.no_move_share),
                 format!("{:.2}", r.mean_steps),
-            ]
+            ])
         })
-        .collect();
+        .collect::<Result<_>>()?;
     write_csv(
-        &run.file("skills.csv"),
+        &dir.join("skills.csv"),
         &["skill", "most_frequent_move", "share", "no_move_share", "mean_steps"],
         &skill_rows,
     )?;
@@ -265,7 +360,7 @@ fn write_files<G: BoardGame>(game: &G, s: &SeadsEvalSummary, settings: &SeadsEva
         })
         .collect();
     write_csv(
-        &run.file("success.csv"),
+        &dir.join("success.csv"),
         &[
             "depth",
             "boards",
@@ -281,7 +376,7 @@ fn write_files<G: BoardGame>(game: &G, s: &SeadsEvalSummary, settings: &SeadsEva
         s.depths.iter().map(|r| (r.depth as f64, 100.0 * f(r) as f64 / r.boards.max(1) as f64)).collect()
     };
     line_plot_in(
-        &run.file("success.png"),
+        &dir.join("success.png"),
         &format!("{}: boards solved by planning with learned skills", s.env),
         "solution depth",
         "solved (%)",
@@ -301,13 +396,13 @@ fn write_files<G: BoardGame>(game: &G, s: &SeadsEvalSummary, settings: &SeadsEva
         .iter()
         .flat_map(|r| r.skill_lengths.iter().map(move |l| vec![r.depth.to_string(), l.to_string()]))
         .collect();
-    write_csv(&run.file("skill_lengths.csv"), &["depth", "steps"], &length_rows)?;
+    write_csv(&dir.join("skill_lengths.csv"), &["depth", "steps"], &length_rows)?;
     let lengths = |r: &DepthRow| r.skill_lengths.iter().map(|&l| l as f64).collect::<Vec<f64>>();
     let mut groups: Vec<(String, Vec<f64>)> =
         s.depths.iter().map(|r| (format!("depth {}", r.depth), lengths(r))).collect();
     groups.push(("all".into(), s.depths.iter().flat_map(lengths).collect()));
     box_plot(
-        &run.file("skill_lengths.png"),
+        &dir.join("skill_lengths.png"),
         &format!("{}: skill lengths on solved boards", s.env),
         "solution depth of the board",
         "manipulator steps per skill",
@@ -372,8 +467,7 @@ fn write_files<G: BoardGame>(game: &G, s: &SeadsEvalSummary, settings: &SeadsEva
         fmt_quantile(all, 0.75),
         all.len()
     ));
-    write_text(&run.file("report.md"), &md)?;
-    Ok(())
+    write_text(&dir.join("report.md"), &md)
 }
 
 fn fmt_quantile(values: &[f64], q: f64) -> String {
@@ -416,19 +510,66 @@ impl ComparedRun {
     }
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct VariantTest {
     pub better: String,
     pub worse: String,
     pub metric: String,
+    #[serde(with = "num::real")]
     pub u: f64,
+    #[serde(with = "num::real")]
     pub p_value: f64,
 }
 
+/// One run in a comparison's table.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct RunRow {
+    pub name: String,
+    pub variant: String,
+    pub seed: u64,
+    pub distinct_moves: usize,
+    #[serde(with = "num::real")]
+    pub success_rate: f64,
+}
+
+/// Several SEADS runs compared over seeds (each run's own report is in a subdirectory).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct SeadsComparison {
+    pub provenance: Provenance,
+    pub runs: Vec<RunRow>,
+    pub tests: Vec<VariantTest>,
+}
+
+impl std::fmt::Display for SeadsComparison {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        for (i, t) in self.tests.iter().enumerate() {
+            if i > 0 {
+                writeln!(f)?;
+            }
+            write!(
+                f,
+                "{} > {} on {}: Mann-Whitney U = {}, one-sided p = {:.3e}",
+                t.better, t.worse, t.metric, t.u, t.p_value
+            )?;
+        }
+        Ok(())
+    }
+}
+
 /// Seeds of each variant against the `full` method (one-sided Mann-Whitney U: full is better), or, without a
-/// `full` group, every ordered pair of variants. Writes runs.csv, tests.csv and report.md in `out_dir`.
-pub fn compare_runs(runs: &[ComparedRun], out_dir: &Path) -> Result<Vec<VariantTest>> {
+/// `full` group, every ordered pair of variants. Writes config.json, summary.json, runs.csv, tests.csv and
+/// report.md in `out_dir`.
+pub fn compare_runs(
+    runs: &[ComparedRun],
+    config: &SeadsEvalConfig,
+    provenance: &Provenance,
+    out_dir: &Path,
+) -> Result<SeadsComparison> {
     use crate::eval::stats::{mann_whitney_u, Alternative};
+    let envs: Vec<&str> = runs.iter().map(|r| r.summary.env.as_str()).collect();
+    if envs.iter().any(|e| *e != envs[0]) {
+        return Err(Error::config(format!("runs to compare must share one env, got {}", envs.join(", "))));
+    }
     let mut variants: Vec<String> = runs.iter().map(|r| r.variant.clone()).collect();
     variants.sort();
     variants.dedup();
@@ -458,26 +599,50 @@ pub fn compare_runs(runs: &[ComparedRun], out_dir: &Path) -> Result<Vec<VariantT
             });
         }
     }
-    let rows: Vec<Vec<String>> = runs
+    let comparison = SeadsComparison {
+        provenance: provenance.clone(),
+        runs: runs
+            .iter()
+            .map(|r| RunRow {
+                name: r.name.clone(),
+                variant: r.variant.clone(),
+                seed: r.seed,
+                distinct_moves: r.summary.distinct_moves,
+                success_rate: r.success_rate(),
+            })
+            .collect(),
+        tests,
+    };
+    std::fs::create_dir_all(out_dir).map_err(|e| Error::io(out_dir, e))?;
+    write_config(config, provenance, out_dir)?;
+    publish(COMPARE_PROTOCOL, &comparison, out_dir, render_comparison)?;
+    Ok(comparison)
+}
+
+/// Writes runs.csv, tests.csv and report.md of a comparison into `dir`.
+pub fn render_comparison(c: &SeadsComparison, dir: &Path) -> Result<()> {
+    let rows: Vec<Vec<String>> = c
+        .runs
         .iter()
         .map(|r| {
             vec![
                 r.name.clone(),
                 r.variant.clone(),
                 r.seed.to_string(),
-                r.summary.distinct_moves.to_string(),
-                format!("{:.4}", r.success_rate()),
+                r.distinct_moves.to_string(),
+                format!("{:.4}", r.success_rate),
             ]
         })
         .collect();
-    write_csv(&out_dir.join("runs.csv"), &["run", "variant", "seed", "distinct_moves", "success_rate"], &rows)?;
-    let test_rows: Vec<Vec<String>> = tests
+    write_csv(&dir.join("runs.csv"), &["run", "variant", "seed", "distinct_moves", "success_rate"], &rows)?;
+    let test_rows: Vec<Vec<String>> = c
+        .tests
         .iter()
         .map(|t| {
             vec![t.better.clone(), t.worse.clone(), t.metric.clone(), format!("{}", t.u), format!("{:.4e}", t.p_value)]
         })
         .collect();
-    write_csv(&out_dir.join("tests.csv"), &["better", "worse", "metric", "u", "p_value"], &test_rows)?;
+    write_csv(&dir.join("tests.csv"), &["better", "worse", "metric", "u", "p_value"], &test_rows)?;
     let mut md = String::from(
         "# SEADS runs compared\n\nEach run evaluated as in its own report (subdirectory of the same name). Success \
          rate = boards of every depth solved with replanning.\n\n| run | variant | seed | distinct moves | success rate |\n\
@@ -494,6 +659,5 @@ pub fn compare_runs(runs: &[ComparedRun], out_dir: &Path) -> Result<Vec<VariantT
     for t in &test_rows {
         md.push_str(&format!("| {} | {} | {} | {} | {} |\n", t[0], t[1], t[2], t[3], t[4]));
     }
-    write_text(&out_dir.join("report.md"), &md)?;
-    Ok(tests)
+    write_text(&dir.join("report.md"), &md)
 }

@@ -3,10 +3,12 @@
 
 use std::path::Path;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
+use super::num;
 use super::plot::{histogram, line_plot, Series};
 use super::stats::{mean, quantile};
+use super::summary::{publish, write_config};
 use crate::control::BatchDynamics;
 use crate::data::{write_dataset, Dataset, DatasetLayout, DatasetMeta, Rollout};
 use crate::envs::pendulum::{angle_normalize, Pendulum, PendulumVariant, StartDistribution};
@@ -22,9 +24,9 @@ use crate::util::table::write_csv;
 
 use crate::envs::pendulum::swingup::{is_success, SUCCESS_MIN_REWARD, SUCCESS_WINDOW};
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct SwingupSettings {
-    #[serde(serialize_with = "serialize_variant")]
+    #[serde(serialize_with = "serialize_variant", deserialize_with = "deserialize_variant")]
     pub variant: PendulumVariant,
     pub cem: CemConfig,
     pub steps: usize,
@@ -34,6 +36,14 @@ pub struct SwingupSettings {
 
 fn serialize_variant<S: serde::Serializer>(v: &PendulumVariant, s: S) -> std::result::Result<S::Ok, S::Error> {
     s.serialize_str(&v.env_name())
+}
+
+fn deserialize_variant<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<PendulumVariant, D::Error> {
+    let name = String::deserialize(d)?;
+    match crate::envs::parse_env(&name).map_err(serde::de::Error::custom)? {
+        crate::envs::EnvName::Pendulum(v) => Ok(v),
+        other => Err(serde::de::Error::custom(format!("'{}' is not a pendulum env", other.canonical()))),
+    }
 }
 
 impl SwingupSettings {
@@ -162,40 +172,118 @@ pub fn episodes_dataset(
     }
 }
 
-#[derive(Clone, Debug, Serialize)]
-struct SwingupConfigRecord<'a> {
-    job: &'static str,
-    #[serde(flatten)]
-    provenance: &'a Provenance,
-    episodes: usize,
-    model: String,
-    settings: &'a SwingupSettings,
+pub const PROTOCOL: &str = "pendulum-swingup";
+
+/// Which dynamics the planner used, as the command named them (`true` or a checkpoint directory).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ModelSpec {
+    pub model: String,
+    pub particles: usize,
+    /// ts1, tsinf or expectation.
+    pub propagation: String,
+    pub context: Option<std::path::PathBuf>,
+    pub allow_incomplete: bool,
 }
 
-pub struct SwingupSummary {
-    pub returns: Vec<f64>,
-    pub successes: usize,
+/// `mbrl eval pendulum-swingup`'s settings, as config.json records them.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SwingupConfig {
+    pub model: ModelSpec,
+    pub env: String,
     pub episodes: usize,
+    pub settings: SwingupSettings,
+}
+
+impl SwingupConfig {
+    /// Swing-ups planned on the simulator's own equations.
+    pub fn ground_truth(settings: SwingupSettings, episodes: usize) -> Self {
+        SwingupConfig {
+            model: ModelSpec {
+                model: "true".into(),
+                particles: 20,
+                propagation: "tsinf".into(),
+                context: None,
+                allow_incomplete: false,
+            },
+            env: settings.variant.env_name(),
+            episodes,
+            settings,
+        }
+    }
+
+    /// The range checks the protocol needs before anything is loaded.
+    pub fn validate(&self) -> Result<()> {
+        if self.episodes == 0 || self.settings.steps < SUCCESS_WINDOW {
+            return Err(crate::error::Error::config(format!(
+                "--episodes must be at least 1 and --steps at least {SUCCESS_WINDOW}"
+            )));
+        }
+        self.settings.cem.validate()
+    }
+}
+
+/// One executed episode, as the report shows it.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct EpisodeRecord {
+    pub episode: u64,
+    #[serde(with = "num::real")]
+    pub total_return: f64,
+    pub success: bool,
+    /// The pole angle θ at every state (unwrapped, as simulated).
+    #[serde(with = "num::reals")]
+    pub angles: Vec<f64>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct SwingupSummary {
+    pub provenance: Provenance,
+    pub settings: SwingupSettings,
+    /// What the planner planned on, in words.
+    pub model: String,
+    pub episodes: Vec<EpisodeRecord>,
+}
+
+impl SwingupSummary {
+    pub fn returns(&self) -> Vec<f64> {
+        self.episodes.iter().map(|e| e.total_return).collect()
+    }
+
+    pub fn successes(&self) -> usize {
+        self.episodes.iter().filter(|e| e.success).count()
+    }
+
+    pub fn mean_return(&self) -> f64 {
+        self.returns().iter().sum::<f64>() / self.episodes.len() as f64
+    }
+}
+
+impl std::fmt::Display for SwingupSummary {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        write!(
+            f,
+            "{}/{} episodes succeeded; mean return {:.1}",
+            self.successes(),
+            self.episodes.len(),
+            self.mean_return()
+        )
+    }
 }
 
 /// `mbrl eval pendulum-swingup`: `episodes` MPC swing-ups, written to `report_dir` as report.md,
 /// episodes.csv, angle.png, returns.png, rollouts.mcap, config.json and metrics.jsonl.
 pub fn evaluate(
-    settings: &SwingupSettings,
+    config: &SwingupConfig,
     model: Option<&dyn BatchDynamics>,
-    episodes: usize,
     provenance: &Provenance,
     report_dir: &Path,
     monitor: &dyn Monitor,
 ) -> Result<SwingupSummary> {
+    config.validate()?;
+    let (settings, episodes) = (&config.settings, config.episodes);
     let run = RunDir::create(report_dir)?;
-    run.write_config(&SwingupConfigRecord {
-        job: "eval pendulum-swingup",
-        provenance,
-        episodes,
-        model: model_description(model),
-        settings,
-    })?;
+    write_config(config, provenance, report_dir)?;
     let metrics = run.metrics()?;
     let monitor = Tee { first: monitor, second: &metrics };
     monitor.emit(&layout(&format!("pendulum swing-up, {} + CEM", model_description(model)), model.is_some()));
@@ -212,14 +300,28 @@ pub fn evaluate(
         results.push(ep);
     }
     monitor.progress("episodes", episodes as u64, episodes as u64);
-    write_outputs(settings, &model_description(model), provenance, &run, &results)?;
+    write_dataset(
+        &run.file("rollouts.mcap"),
+        &episodes_dataset(settings, provenance.seed, &provenance.command_line, &results),
+    )?;
+    let summary = SwingupSummary {
+        provenance: provenance.clone(),
+        settings: settings.clone(),
+        model: model_description(model),
+        episodes: results
+            .iter()
+            .map(|e| EpisodeRecord {
+                episode: e.episode,
+                total_return: e.total_return,
+                success: e.success,
+                angles: e.rollout.states.iter().map(|s| s[0]).collect(),
+            })
+            .collect(),
+    };
+    publish(PROTOCOL, &summary, run.path(), render)?;
     // Only the run's own file is told it finished: the caller's view may have more jobs to show.
     metrics.emit(&Event::Finished { ok: true });
-    Ok(SwingupSummary {
-        returns: results.iter().map(|e| e.total_return).collect(),
-        successes: results.iter().filter(|e| e.success).count(),
-        episodes,
-    })
+    Ok(summary)
 }
 
 /// What the planner planned on, in words for reports.
@@ -227,17 +329,15 @@ pub fn model_description(model: Option<&dyn BatchDynamics>) -> String {
     model.map(|m| m.describe()).unwrap_or_else(|| "ground-truth model".into())
 }
 
-fn write_outputs(
-    settings: &SwingupSettings,
-    model: &str,
-    provenance: &Provenance,
-    run: &RunDir,
-    results: &[SwingupEpisode],
-) -> Result<()> {
+/// Writes episodes.csv, angle.png, returns.png and report.md of `summary` into `dir`.
+pub fn render(summary: &SwingupSummary, dir: &Path) -> Result<()> {
+    let settings = &summary.settings;
+    let results = &summary.episodes;
+    let file = |name: &str| dir.join(name);
     let rows: Vec<Vec<String>> = results
         .iter()
         .map(|e| {
-            let final_angle = e.rollout.states.last().map(|s| angle_normalize(s[0])).unwrap_or(f64::NAN);
+            let final_angle = e.angles.last().map(|a| angle_normalize(*a)).unwrap_or(f64::NAN);
             vec![
                 e.episode.to_string(),
                 format!("{:.6}", e.total_return),
@@ -246,37 +346,23 @@ fn write_outputs(
             ]
         })
         .collect();
-    write_csv(&run.file("episodes.csv"), &["episode", "return", "success", "final_angle"], &rows)?;
+    write_csv(&file("episodes.csv"), &["episode", "return", "success", "final_angle"], &rows)?;
     let dt = Pendulum::new(settings.variant.clone()).spec().dt;
     let series: Vec<Series> = results
         .iter()
-        .map(|e| Series {
-            name: format!("episode {}", e.episode + 1),
-            points: wrapped_angle_points(&e.rollout.states, dt),
-        })
+        .map(|e| Series { name: format!("episode {}", e.episode + 1), points: wrapped_angle_points(&e.angles, dt) })
         .collect();
-    line_plot(
-        &run.file("angle.png"),
-        "Pendulum angle during swing-up (0 = upright)",
-        "time [s]",
-        "angle [rad]",
-        &series,
-    )?;
-    let returns: Vec<f64> = results.iter().map(|e| e.total_return).collect();
-    histogram(&run.file("returns.png"), "Episode returns", "return", &returns, 10)?;
-    write_dataset(
-        &run.file("rollouts.mcap"),
-        &episodes_dataset(settings, provenance.seed, &provenance.command_line, results),
-    )?;
-    let report = report_markdown(settings, model, provenance, results);
-    write_text(&run.file("report.md"), &report)
+    line_plot(&file("angle.png"), "Pendulum angle during swing-up (0 = upright)", "time [s]", "angle [rad]", &series)?;
+    histogram(&file("returns.png"), "Episode returns", "return", &summary.returns(), 10)?;
+    let report = report_markdown(settings, &summary.model, &summary.provenance, results);
+    write_text(&file("report.md"), &report)
 }
 
 /// (time, wrapped angle) with a NaN break wherever the angle wraps around ±π.
-fn wrapped_angle_points(states: &[Vec<f64>], dt: f64) -> Vec<(f64, f64)> {
-    let mut points: Vec<(f64, f64)> = Vec::with_capacity(states.len() + 8);
-    for (t, s) in states.iter().enumerate() {
-        let point = (t as f64 * dt, angle_normalize(s[0]));
+fn wrapped_angle_points(angles: &[f64], dt: f64) -> Vec<(f64, f64)> {
+    let mut points: Vec<(f64, f64)> = Vec::with_capacity(angles.len() + 8);
+    for (t, a) in angles.iter().enumerate() {
+        let point = (t as f64 * dt, angle_normalize(*a));
         if points.last().is_some_and(|last| (last.1 - point.1).abs() > std::f64::consts::PI) {
             points.push((point.0, f64::NAN));
         }
@@ -289,7 +375,7 @@ fn report_markdown(
     settings: &SwingupSettings,
     model: &str,
     provenance: &Provenance,
-    results: &[SwingupEpisode],
+    results: &[EpisodeRecord],
 ) -> String {
     let returns: Vec<f64> = results.iter().map(|e| e.total_return).collect();
     let successes = results.iter().filter(|e| e.success).count();

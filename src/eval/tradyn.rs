@@ -9,11 +9,14 @@ use std::fmt::Write as _;
 use std::path::Path;
 use std::sync::Arc;
 
+use base64::Engine;
 use rand::Rng;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
+use super::num;
 use super::plot::{band_panels, map_paths, Band, ColorGrid, MapPanel, Series};
 use super::stats::{quantile, wilcoxon_signed_rank, Alternative};
+use super::summary::{publish, write_config};
 use crate::control::BatchDynamics;
 use crate::data::collect::exploration_actions;
 use crate::data::Rollout;
@@ -67,22 +70,82 @@ pub fn variant_name((terrain, calibrated): (bool, bool)) -> String {
     format!("{}T,{}C", if terrain { "+" } else { "−" }, if calibrated { "+" } else { "−" })
 }
 
-/// What one variant did on one task.
-#[derive(Clone, Debug)]
-struct Outcome {
-    energy: f64,
-    final_distance: f64,
-    success: bool,
-    path: Vec<(f64, f64)>,
-    /// Per prediction step: position error (m), speed error (m/s), heading error (rad).
-    prediction: Vec<[f64; 3]>,
+pub const PROTOCOL: &str = "tradyn";
+
+/// `mbrl eval tradyn`'s settings, as config.json records them (the command's flags).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TradynEvalConfig {
+    pub model_terrain: std::path::PathBuf,
+    pub model_no_terrain: std::path::PathBuf,
+    pub maps: std::path::PathBuf,
+    pub allow_incomplete: bool,
+    pub tasks: usize,
+    pub transitions: usize,
+    pub steps: usize,
+    pub horizon: usize,
+    pub candidates: usize,
+    pub elites: usize,
+    pub iters: usize,
+    pub prediction_steps: usize,
 }
 
-impl Outcome {
-    /// Mean position error over the prediction horizon.
-    fn mean_position_error(&self) -> f64 {
-        self.prediction.iter().map(|e| e[0]).sum::<f64>() / self.prediction.len().max(1) as f64
+impl TradynEvalConfig {
+    /// The protocol's settings; the command's range checks first.
+    pub fn settings(&self) -> Result<TradynEvalSettings> {
+        if !(2..=100_000).contains(&self.tasks)
+            || !(1..=10_000).contains(&self.steps)
+            || !(1..=10_000).contains(&self.prediction_steps)
+        {
+            return Err(Error::config("--tasks must be 2..=100000, --steps and --prediction-steps 1..=10000"));
+        }
+        if !(1..=1000).contains(&self.transitions) {
+            return Err(Error::config("--transitions must be 1..=1000"));
+        }
+        let mut navigation = NavigationSettings::thesis();
+        navigation.steps = self.steps;
+        navigation.horizon = self.horizon;
+        navigation.cem.candidates = self.candidates;
+        navigation.cem.elites = self.elites;
+        navigation.cem.iterations = self.iters;
+        let settings = TradynEvalSettings {
+            tasks: self.tasks,
+            calibration_transitions: self.transitions,
+            navigation,
+            prediction_steps: self.prediction_steps,
+            example_tasks: 3,
+        };
+        settings.validate()?;
+        Ok(settings)
     }
+}
+
+/// The settings as the report states them.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ReportedSettings {
+    pub calibration_transitions: usize,
+    pub candidates: usize,
+    pub elites: usize,
+    pub iterations: usize,
+    pub horizon: usize,
+    pub steps: usize,
+    pub success_distance: f64,
+    pub prediction_steps: usize,
+}
+
+/// What one variant did on one task.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Outcome {
+    #[serde(with = "num::real")]
+    pub energy: f64,
+    #[serde(with = "num::real")]
+    pub final_distance: f64,
+    pub success: bool,
+    #[serde(with = "num::points")]
+    pub path: Vec<(f64, f64)>,
+    /// Per prediction step: position error (m), speed error (m/s), heading error (rad).
+    #[serde(with = "num::triples")]
+    pub prediction: Vec<[f64; 3]>,
 }
 
 struct Task {
@@ -91,18 +154,90 @@ struct Task {
     outcomes: Vec<Outcome>,
 }
 
+/// One navigation task and what the four variants did on it.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct TaskRecord {
+    pub map: String,
+    /// x, y, heading.
+    pub start: [f64; 3],
+    pub goal: [f64; 2],
+    /// In VARIANTS order.
+    pub outcomes: [Outcome; 4],
+    /// The map's colours on a PLOT_CELLS² grid (RGB bytes, base64), for the tasks whose paths are drawn.
+    pub map_rgb: Option<String>,
+}
+
+/// A pairwise energy test (Fig. 5.7): row − column differences over tasks and the one-sided p that the row
+/// variant uses less energy.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct EnergyTest {
+    pub row: usize,
+    pub column: usize,
+    #[serde(with = "num::real")]
+    pub diff_p20: f64,
+    #[serde(with = "num::real")]
+    pub diff_median: f64,
+    #[serde(with = "num::real")]
+    pub diff_p80: f64,
+    #[serde(with = "num::real")]
+    pub p_value: f64,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct TradynEvalSummary {
+    pub provenance: Provenance,
+    pub settings: ReportedSettings,
+    /// The two checkpoints and how far each was trained.
+    pub models: String,
+    pub tasks: Vec<TaskRecord>,
     /// Per variant (VARIANTS order): median energy, median final distance (m), failures.
-    pub median_energy: Vec<f64>,
-    pub median_distance: Vec<f64>,
-    pub failures: Vec<usize>,
+    #[serde(with = "num::quad")]
+    pub median_energy: [f64; 4],
+    #[serde(with = "num::quad")]
+    pub median_distance: [f64; 4],
+    pub failures: [usize; 4],
     /// Mean position error over the prediction horizon and tasks, per variant.
-    pub mean_position_error: Vec<f64>,
-    /// One-sided p-values that the row variant uses less energy than the column variant (row ≠ col).
-    pub energy_tests: Vec<(usize, usize, f64)>,
+    #[serde(with = "num::quad")]
+    pub mean_position_error: [f64; 4],
+    /// Every ordered pair of distinct variants.
+    pub energy_tests: Vec<EnergyTest>,
     /// One-sided p-values that terrain lookup lowers the per-task mean position error: (−C, +C).
-    pub prediction_tests: [f64; 2],
-    pub tasks: usize,
+    #[serde(with = "num::opt_pair")]
+    pub prediction_tests: Option<(f64, f64)>,
+}
+
+impl std::fmt::Display for TradynEvalSummary {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        for (v, variant) in VARIANTS.iter().enumerate() {
+            writeln!(
+                f,
+                "{:<6} median energy {:.4}, median final distance {:.2} mm, failed {}/{}, mean position error {:.4} m",
+                variant_name(*variant),
+                self.median_energy[v],
+                self.median_distance[v] * 1000.0,
+                self.failures[v],
+                self.tasks.len(),
+                self.mean_position_error[v]
+            )?;
+        }
+        let (without, with) = self.prediction_tests.unwrap_or((f64::NAN, f64::NAN));
+        write!(
+            f,
+            "Wilcoxon: terrain lookup lowers the mean position error: p = {without:.3e} without calibration, {with:.3e} with it"
+        )?;
+        for t in &self.energy_tests {
+            if t.row > t.column && t.row < VARIANTS.len() {
+                write!(
+                    f,
+                    "\nWilcoxon: {} less energy than {}: p = {:.3e}",
+                    variant_name(VARIANTS[t.row]),
+                    variant_name(VARIANTS[t.column]),
+                    t.p_value
+                )?;
+            }
+        }
+        Ok(())
+    }
 }
 
 /// The two trained models the variants come from: with terrain lookup (+T) and the ablation (−T).
@@ -171,26 +306,18 @@ fn layout(title: &str) -> Event {
 pub fn evaluate(
     models: &TradynEvalModels,
     maps: Vec<TerrainMap>,
-    settings: &TradynEvalSettings,
+    config: &TradynEvalConfig,
     provenance: &Provenance,
     report_dir: &Path,
     monitor: &dyn Monitor,
 ) -> Result<TradynEvalSummary> {
-    settings.validate()?;
+    let settings = &config.settings()?;
     models.check()?;
     if maps.is_empty() {
         return Err(Error::config("eval tradyn needs at least one test map"));
     }
     let run = RunDir::create(report_dir)?;
-    run.write_config(&serde_json::json!({
-        "job": "eval tradyn",
-        "provenance": provenance,
-        "model_terrain": models.terrain.loaded.dir,
-        "model_no_terrain": models.no_terrain.loaded.dir,
-        "training": {"terrain": models.terrain.loaded.progress, "no_terrain": models.no_terrain.loaded.progress},
-        "maps": maps.iter().map(|m| serde_json::json!({"name": m.name, "crc32": m.crc32})).collect::<Vec<_>>(),
-        "settings": settings,
-    }))?;
+    write_config(config, provenance, run.path())?;
     let metrics = run.metrics()?;
     let monitor = Tee { first: monitor, second: &metrics };
     monitor.emit(&layout("eval tradyn: ±terrain lookup × ±calibration"));
@@ -210,7 +337,9 @@ pub fn evaluate(
         tasks.push(task);
     }
     monitor.progress("tasks", settings.tasks as u64, settings.tasks as u64);
-    write_report(&run, settings, &models.describe(), &tasks)
+    let summary = summarize(settings, models.describe(), provenance, tasks)?;
+    publish(PROTOCOL, &summary, run.path(), render)?;
+    Ok(summary)
 }
 
 fn run_task(
@@ -321,16 +450,107 @@ fn prediction_errors(dynamics: &TradynDynamics, truth: &Rollout) -> Vec<[f64; 3]
         .collect()
 }
 
-fn write_report(
-    run: &RunDir,
+/// The figures of Table 5.2, Fig. 5.7 and the prediction tests from what every task gave.
+fn summarize(
     settings: &TradynEvalSettings,
-    models: &str,
-    tasks: &[Task],
+    models: String,
+    provenance: &Provenance,
+    tasks: Vec<Task>,
 ) -> Result<TradynEvalSummary> {
+    let nav = &settings.navigation;
+    let tasks: Vec<TaskRecord> = tasks
+        .into_iter()
+        .enumerate()
+        .map(|(k, t)| {
+            let outcomes: [Outcome; 4] = t.outcomes.try_into().map_err(|o: Vec<Outcome>| {
+                Error::data(format!("task {k}: {} variant outcomes, expected {}", o.len(), VARIANTS.len()))
+            })?;
+            Ok(TaskRecord {
+                map: t.map.name.clone(),
+                start: t.task.start,
+                goal: t.task.goal,
+                outcomes,
+                map_rgb: (k < settings.example_tasks.max(1))
+                    .then(|| base64::engine::general_purpose::STANDARD.encode(t.map.coarse_rgb(PLOT_CELLS))),
+            })
+        })
+        .collect::<Result<_>>()?;
+    let column =
+        |v: usize, f: &dyn Fn(&Outcome) -> f64| -> Vec<f64> { tasks.iter().map(|t| f(&t.outcomes[v])).collect() };
+    let q = |values: &[f64], p: f64| quantile(values, p).unwrap_or(f64::NAN);
+    // +T against −T with the same calibration: VARIANTS[2] vs [0] and [3] vs [1].
+    let prediction_test = |with: usize, without: usize| {
+        let a = column(with, &mean_position_error);
+        let b = column(without, &mean_position_error);
+        wilcoxon_signed_rank(&a, &b, Alternative::Less).map(|w| w.p_value).unwrap_or(f64::NAN)
+    };
+    let mut summary = TradynEvalSummary {
+        provenance: provenance.clone(),
+        settings: ReportedSettings {
+            calibration_transitions: settings.calibration_transitions,
+            candidates: nav.cem.candidates,
+            elites: nav.cem.elites,
+            iterations: nav.cem.iterations,
+            horizon: nav.horizon,
+            steps: nav.steps,
+            success_distance: nav.success_distance,
+            prediction_steps: settings.prediction_steps,
+        },
+        models,
+        median_energy: [f64::NAN; 4],
+        median_distance: [f64::NAN; 4],
+        failures: [0; 4],
+        mean_position_error: [f64::NAN; 4],
+        energy_tests: Vec::new(),
+        prediction_tests: Some((prediction_test(2, 0), prediction_test(3, 1))),
+        tasks: Vec::new(),
+    };
+    for v in 0..VARIANTS.len() {
+        let position = column(v, &mean_position_error);
+        summary.median_energy[v] = q(&column(v, &|o| o.energy), 0.5);
+        summary.median_distance[v] = q(&column(v, &|o| o.final_distance * 1000.0), 0.5) / 1000.0;
+        summary.failures[v] = tasks.iter().filter(|t| !t.outcomes[v].success).count();
+        summary.mean_position_error[v] = position.iter().sum::<f64>() / position.len().max(1) as f64;
+    }
+    for r in 0..VARIANTS.len() {
+        for c in 0..VARIANTS.len() {
+            if r == c {
+                continue;
+            }
+            let (a, b) = (column(r, &|o| o.energy), column(c, &|o| o.energy));
+            let diffs: Vec<f64> = a.iter().zip(&b).map(|(x, y)| x - y).collect();
+            summary.energy_tests.push(EnergyTest {
+                row: r,
+                column: c,
+                diff_p20: q(&diffs, 0.2),
+                diff_median: q(&diffs, 0.5),
+                diff_p80: q(&diffs, 0.8),
+                p_value: wilcoxon_signed_rank(&a, &b, Alternative::Less).map(|w| w.p_value).unwrap_or(f64::NAN),
+            });
+        }
+    }
+    summary.tasks = tasks;
+    Ok(summary)
+}
+
+/// Mean position error over the prediction horizon.
+fn mean_position_error(o: &Outcome) -> f64 {
+    o.prediction.iter().map(|e| e[0]).sum::<f64>() / o.prediction.len().max(1) as f64
+}
+
+/// Writes tasks.csv, table_5_2.csv, energy_wilcoxon.csv, prediction.csv/.png, paths.png and report.md of
+/// `summary` into `dir`.
+pub fn render(summary: &TradynEvalSummary, dir: &Path) -> Result<()> {
+    let settings = &summary.settings;
+    let tasks = &summary.tasks;
     let names: Vec<String> = VARIANTS.iter().map(|v| variant_name(*v)).collect();
     let column =
         |v: usize, f: &dyn Fn(&Outcome) -> f64| -> Vec<f64> { tasks.iter().map(|t| f(&t.outcomes[v])).collect() };
     let q = |values: &[f64], p: f64| quantile(values, p).unwrap_or(f64::NAN);
+    let file = |name: &str| dir.join(name);
+    if let Some(t) = summary.energy_tests.iter().find(|t| t.row >= VARIANTS.len() || t.column >= VARIANTS.len()) {
+        return Err(Error::config(format!("energy_tests: variant index {} is not below 4", t.row.max(t.column))));
+    }
 
     // Per task and variant.
     let mut rows = Vec::new();
@@ -338,22 +558,22 @@ fn write_report(
         for (v, o) in t.outcomes.iter().enumerate() {
             rows.push(vec![
                 k.to_string(),
-                t.map.name.clone(),
-                format!("{:.4}", t.task.start[0]),
-                format!("{:.4}", t.task.start[1]),
-                format!("{:.4}", t.task.start[2]),
-                format!("{:.4}", t.task.goal[0]),
-                format!("{:.4}", t.task.goal[1]),
+                t.map.clone(),
+                format!("{:.4}", t.start[0]),
+                format!("{:.4}", t.start[1]),
+                format!("{:.4}", t.start[2]),
+                format!("{:.4}", t.goal[0]),
+                format!("{:.4}", t.goal[1]),
                 names[v].clone(),
                 format!("{:.6}", o.energy),
                 format!("{:.6}", o.final_distance),
                 o.success.to_string(),
-                format!("{:.6}", o.mean_position_error()),
+                format!("{:.6}", mean_position_error(o)),
             ]);
         }
     }
     write_csv(
-        &run.file("tasks.csv"),
+        &file("tasks.csv"),
         &[
             "task",
             "map",
@@ -372,42 +592,20 @@ fn write_report(
     )?;
 
     // Table 5.2 analogue (distances in mm) with energies.
-    let mut summary = TradynEvalSummary {
-        median_energy: Vec::new(),
-        median_distance: Vec::new(),
-        failures: Vec::new(),
-        mean_position_error: Vec::new(),
-        energy_tests: Vec::new(),
-        prediction_tests: [f64::NAN; 2],
-        tasks: tasks.len(),
-    };
-    // +T against −T with the same calibration: VARIANTS[2] vs [0] and [3] vs [1].
-    for (slot, (with, without)) in summary.prediction_tests.iter_mut().zip([(2, 0), (3, 1)]) {
-        let a = column(with, &|o| o.mean_position_error());
-        let b = column(without, &|o| o.mean_position_error());
-        *slot = wilcoxon_signed_rank(&a, &b, Alternative::Less).map(|w| w.p_value).unwrap_or(f64::NAN);
-    }
     let mut table = Vec::new();
     for (v, name) in names.iter().enumerate() {
         let distance = column(v, &|o| o.final_distance * 1000.0);
         let energy = column(v, &|o| o.energy);
-        let failures = tasks.iter().filter(|t| !t.outcomes[v].success).count();
-        let position = column(v, &|o| o.mean_position_error());
-        let mean_position = position.iter().sum::<f64>() / position.len().max(1) as f64;
-        summary.median_energy.push(q(&energy, 0.5));
-        summary.median_distance.push(q(&distance, 0.5) / 1000.0);
-        summary.failures.push(failures);
-        summary.mean_position_error.push(mean_position);
         table.push(vec![
             name.clone(),
             format!("{:.2}", q(&distance, 0.2)),
             format!("{:.2}", q(&distance, 0.5)),
             format!("{:.2}", q(&distance, 0.8)),
-            format!("{failures}/{}", tasks.len()),
+            format!("{}/{}", summary.failures[v], tasks.len()),
             format!("{:.4}", q(&energy, 0.2)),
             format!("{:.4}", q(&energy, 0.5)),
             format!("{:.4}", q(&energy, 0.8)),
-            format!("{mean_position:.4}"),
+            format!("{:.4}", summary.mean_position_error[v]),
         ]);
     }
     let table_header = [
@@ -421,31 +619,25 @@ fn write_report(
         "energy_p80",
         "mean_position_error_m",
     ];
-    write_csv(&run.file("table_5_2.csv"), &table_header, &table)?;
+    write_csv(&file("table_5_2.csv"), &table_header, &table)?;
 
     // Fig. 5.7 analogue: row − column energy differences per task, one-sided Wilcoxon (row uses less).
-    let mut pairs = Vec::new();
-    for r in 0..VARIANTS.len() {
-        for c in 0..VARIANTS.len() {
-            if r == c {
-                continue;
-            }
-            let (a, b) = (column(r, &|o| o.energy), column(c, &|o| o.energy));
-            let diffs: Vec<f64> = a.iter().zip(&b).map(|(x, y)| x - y).collect();
-            let p = wilcoxon_signed_rank(&a, &b, Alternative::Less).map(|w| w.p_value).unwrap_or(f64::NAN);
-            summary.energy_tests.push((r, c, p));
-            pairs.push(vec![
-                names[r].clone(),
-                names[c].clone(),
-                format!("{:.4}", q(&diffs, 0.2)),
-                format!("{:.4}", q(&diffs, 0.5)),
-                format!("{:.4}", q(&diffs, 0.8)),
-                format!("{p:.3e}"),
-            ]);
-        }
-    }
+    let pairs: Vec<Vec<String>> = summary
+        .energy_tests
+        .iter()
+        .map(|t| {
+            vec![
+                names[t.row].clone(),
+                names[t.column].clone(),
+                format!("{:.4}", t.diff_p20),
+                format!("{:.4}", t.diff_median),
+                format!("{:.4}", t.diff_p80),
+                format!("{:.3e}", t.p_value),
+            ]
+        })
+        .collect();
     write_csv(
-        &run.file("energy_wilcoxon.csv"),
+        &file("energy_wilcoxon.csv"),
         &["row", "column", "diff_p20", "diff_median", "diff_p80", "p_row_less"],
         &pairs,
     )?;
@@ -463,7 +655,7 @@ fn write_report(
                 let mean = errors.iter().sum::<f64>() / errors.len().max(1) as f64;
                 points.push(((step + 1) as f64, q(&errors, 0.2), mean, q(&errors, 0.8)));
                 if d == 0 {
-                    let at = |t: &Task| t.outcomes[v].prediction.get(step).copied().unwrap_or([f64::NAN; 3]);
+                    let at = |t: &TaskRecord| t.outcomes[v].prediction.get(step).copied().unwrap_or([f64::NAN; 3]);
                     let mean_of = |i: usize| tasks.iter().map(|t| at(t)[i]).sum::<f64>() / tasks.len() as f64;
                     prediction_rows.push(vec![
                         name.clone(),
@@ -479,12 +671,12 @@ fn write_report(
         panels.push((what.to_string(), bands));
     }
     write_csv(
-        &run.file("prediction.csv"),
+        &file("prediction.csv"),
         &["variant", "step", "mean_position_error_m", "mean_speed_error", "mean_heading_error_rad"],
         &prediction_rows,
     )?;
     band_panels(
-        &run.file("prediction.png"),
+        &file("prediction.png"),
         "Open-loop prediction error (mean, P20–P80 over tasks)",
         "prediction step",
         "error",
@@ -492,38 +684,50 @@ fn write_report(
     )?;
 
     // Fig. 5.6 analogue: example paths of all variants on their maps.
-    let examples: Vec<MapPanel> = tasks
-        .iter()
-        .take(settings.example_tasks.max(1))
-        .enumerate()
-        .map(|(k, t)| MapPanel {
+    let mut examples = Vec::new();
+    for (k, t) in tasks.iter().enumerate() {
+        let Some(rgb) = &t.map_rgb else { break };
+        let rgb = base64::engine::general_purpose::STANDARD
+            .decode(rgb)
+            .ok()
+            .filter(|b| b.len() == PLOT_CELLS * PLOT_CELLS * 3)
+            .ok_or_else(|| Error::config(format!("tasks[{k}].map_rgb: expected {PLOT_CELLS}² RGB pixels in base64")))?;
+        examples.push(MapPanel {
             title: format!(
                 "task {k} on {}: E {}",
-                t.map.name,
+                t.map,
                 t.outcomes.iter().map(|o| format!("{:.2}", o.energy)).collect::<Vec<_>>().join(" / ")
             ),
-            grid: ColorGrid { cells: PLOT_CELLS, rgb: t.map.coarse_rgb(PLOT_CELLS) },
+            grid: ColorGrid { cells: PLOT_CELLS, rgb },
             paths: t
                 .outcomes
                 .iter()
                 .zip(&names)
                 .map(|(o, name)| Series { name: name.clone(), points: o.path.clone() })
                 .collect(),
-            start: (t.task.start[0], t.task.start[1]),
-            goal: (t.task.goal[0], t.task.goal[1]),
-        })
-        .collect();
-    map_paths(&run.file("paths.png"), "Navigation paths (white ×: start, black ×: goal)", &examples)?;
+            start: (t.start[0], t.start[1]),
+            goal: (t.goal[0], t.goal[1]),
+        });
+    }
+    map_paths(&file("paths.png"), "Navigation paths (white ×: start, black ×: goal)", &examples)?;
 
+    let prediction_tests = summary.prediction_tests.unwrap_or((f64::NAN, f64::NAN));
     write_text(
-        &run.file("report.md"),
-        &markdown(settings, models, &names, &table, &pairs, summary.prediction_tests, tasks.len()),
-    )?;
-    Ok(summary)
+        &file("report.md"),
+        &markdown(
+            settings,
+            &summary.models,
+            &names,
+            &table,
+            &pairs,
+            [prediction_tests.0, prediction_tests.1],
+            tasks.len(),
+        ),
+    )
 }
 
 fn markdown(
-    settings: &TradynEvalSettings,
+    settings: &ReportedSettings,
     models: &str,
     names: &[String],
     table: &[Vec<String>],
@@ -531,7 +735,6 @@ fn markdown(
     prediction_tests: [f64; 2],
     tasks: usize,
 ) -> String {
-    let nav = &settings.navigation;
     let mut md = String::new();
     let _ = writeln!(md, "# TRADYN evaluation (thesis 5.5)\n");
     let _ = writeln!(md, "Models {models}.\n");
@@ -543,13 +746,13 @@ fn markdown(
          elites × {} iterations, horizon min({}, {} − t), {} steps, colored noise; the same planner seed per task for \
          every variant. Failure: final distance > {} m.\n",
         settings.calibration_transitions,
-        nav.cem.candidates,
-        nav.cem.elites,
-        nav.cem.iterations,
-        nav.horizon,
-        nav.steps,
-        nav.steps,
-        nav.success_distance
+        settings.candidates,
+        settings.elites,
+        settings.iterations,
+        settings.horizon,
+        settings.steps,
+        settings.steps,
+        settings.success_distance
     );
     let _ = writeln!(md, "## Distance to goal and failures (Table 5.2 analogue)\n");
     let _ = writeln!(

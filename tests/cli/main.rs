@@ -13,6 +13,7 @@ mod collect;
 mod context;
 mod dlgpd;
 mod embodied;
+mod eval_render;
 mod export;
 mod foxglove_schemas;
 mod kill;

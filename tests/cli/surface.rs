@@ -14,6 +14,7 @@ const SUBCOMMANDS: &[&[&str]] = &[
     &["eval", "embodied"],
     &["eval", "ball"],
     &["eval", "context"],
+    &["eval", "render"],
     &["calibrate"],
     &["solve-board"],
     &["filter"],

@@ -13,7 +13,7 @@ use crate::error::{Error, Result};
 pub const EMBODIMENT_HELP: &str = "cursor, reacher";
 
 /// The manipulators a user can name.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Embodiment {
     Cursor,

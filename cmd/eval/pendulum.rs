@@ -1,0 +1,201 @@
+//! `eval dataset`, `eval pendulum-swingup` and `eval dlgpd`.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use mbrl::eval::dlgpd::DlgpdEvalConfig;
+use mbrl::eval::swingup::{self, ModelSpec, SwingupConfig, SwingupSettings};
+use mbrl::run::dir::Provenance;
+
+use super::{print, print_inline, recorded};
+use crate::cem_args::CemArgs;
+use crate::common::{pendulum_variant, run_job, GlobalArgs};
+use crate::model_args::{accepting, report_unfinished, ModelArgs, PropagationChoice};
+
+#[derive(Args, Debug)]
+pub struct DatasetArgs {
+    /// Dataset file written by `mbrl collect` or `mbrl plan`.
+    #[arg(long, required_unless_present = "config", conflicts_with = "config")]
+    input: Option<PathBuf>,
+    /// Report directory.
+    #[arg(long, default_value = "reports/dataset")]
+    out: PathBuf,
+    /// Redo the report of the dataset a dataset report recorded (its config.json).
+    #[arg(long, value_name = "FILE")]
+    config: Option<PathBuf>,
+}
+
+pub fn dataset(global: &GlobalArgs, provenance: Provenance, a: DatasetArgs) -> anyhow::Result<()> {
+    let (input, provenance) = match (&a.config, a.input) {
+        (Some(path), _) => {
+            let (config, provenance) = recorded::<mbrl::eval::dataset_report::DatasetConfig>(global, path)?;
+            (config.input, provenance)
+        }
+        (None, input) => (input.unwrap_or_default(), provenance),
+    };
+    let s = run_job(global, "eval dataset", |_| mbrl::eval::dataset_report::report(&input, &provenance, &a.out))?;
+    print_inline(&s, &a.out);
+    Ok(())
+}
+
+#[derive(Args, Debug)]
+pub struct SwingupArgs {
+    #[command(flatten)]
+    model: Option<ModelArgs>,
+    /// Number of episodes (each with its own start state).
+    #[arg(long, default_value_t = 10)]
+    episodes: usize,
+    #[arg(long, default_value = "pendulum", help = concat!("Environment variant: ", mbrl::pendulum_envs!()))]
+    env: String,
+    /// Steps per episode.
+    #[arg(long, default_value_t = 150)]
+    steps: usize,
+    #[command(flatten)]
+    cem: CemArgs,
+    /// Report directory.
+    #[arg(long, default_value = "reports/pendulum-swingup")]
+    out: PathBuf,
+    /// Rerun the settings and seed a swing-up report recorded (its config.json); no other flag but --out.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["model", "particles", "propagation", "context", "allow_incomplete", "episodes", "env", "steps", "horizon", "candidates", "elites", "iters", "noise", "beta", "no_warm_start"])]
+    config: Option<PathBuf>,
+}
+
+impl SwingupArgs {
+    fn config(&self) -> anyhow::Result<SwingupConfig> {
+        let Some(m) = &self.model else {
+            anyhow::bail!("the following required argument was not provided: --model <MODEL> (or --config FILE)");
+        };
+        let mut settings = SwingupSettings::thesis(pendulum_variant(&self.env)?);
+        settings.steps = self.steps;
+        settings.cem = self.cem.config(&settings.cem.action_low, &settings.cem.action_high);
+        let propagation = match m.propagation {
+            PropagationChoice::Ts1 => "ts1",
+            PropagationChoice::Tsinf => "tsinf",
+            PropagationChoice::Expectation => "expectation",
+        };
+        Ok(SwingupConfig {
+            model: ModelSpec {
+                model: m.model.clone(),
+                particles: m.particles,
+                propagation: propagation.into(),
+                context: m.context.clone(),
+                allow_incomplete: m.allow_incomplete,
+            },
+            env: self.env.clone(),
+            episodes: self.episodes,
+            settings,
+        })
+    }
+}
+
+/// The command's model flags from a recorded model.
+fn model_args(spec: &ModelSpec) -> anyhow::Result<ModelArgs> {
+    let propagation = match spec.propagation.as_str() {
+        "ts1" => PropagationChoice::Ts1,
+        "tsinf" => PropagationChoice::Tsinf,
+        "expectation" => PropagationChoice::Expectation,
+        other => anyhow::bail!("model.propagation '{other}': expected ts1, tsinf or expectation"),
+    };
+    Ok(ModelArgs {
+        model: spec.model.clone(),
+        particles: spec.particles,
+        propagation,
+        context: spec.context.clone(),
+        allow_incomplete: spec.allow_incomplete,
+    })
+}
+
+pub fn swingup(global: &GlobalArgs, provenance: Provenance, a: SwingupArgs) -> anyhow::Result<()> {
+    let (config, provenance) = match &a.config {
+        Some(path) => recorded(global, path)?,
+        None => (a.config()?, provenance),
+    };
+    let model = model_args(&config.model)?.load(&mbrl::envs::parse_env(&config.env)?)?;
+    let model = model.as_deref();
+    config.validate()?;
+    mbrl::util::budget::check(
+        &format!("--episodes {} × --steps {}", config.episodes, config.settings.steps),
+        mbrl::util::budget::times(&[config.episodes, config.settings.steps], crate::plan::STEP_RECORD_BYTES),
+        "evaluate fewer or shorter episodes",
+    )?;
+    let summary = run_job(global, "eval pendulum-swingup", |monitor| {
+        swingup::evaluate(&config, model, &provenance, &a.out, monitor)
+    })?;
+    print_inline(&summary, &a.out);
+    Ok(())
+}
+
+#[derive(Args, Debug)]
+pub struct DlgpdArgs {
+    /// A DLGPD checkpoint (`mbrl train dlgpd`).
+    #[arg(long, required_unless_present = "config")]
+    model: Option<PathBuf>,
+    /// Settings to swing up (repeatable; default: the thesis' pendulum, pendulum:inverted, pendulum:light,
+    /// pendulum:heavy).
+    #[arg(long)]
+    env: Vec<String>,
+    /// Evidence sizes in rollouts of 30 frames (thesis: 10, 20, 30, 50, 70, 100, 200).
+    #[arg(long, value_delimiter = ',', default_value = "5,10,20")]
+    evidence_rollouts: Vec<usize>,
+    /// Runs per point, each with its own evidence pool and start state (thesis: 27).
+    #[arg(long, default_value_t = 2)]
+    runs: usize,
+    /// Steps per swing-up.
+    #[arg(long, default_value_t = 150)]
+    steps: usize,
+    /// CEM candidates per iteration (the authors': 1000, about 1.5 s a step on 2 cores at 10 evidence rollouts).
+    #[arg(long, default_value_t = 300)]
+    candidates: usize,
+    /// CEM elites (the authors': 100).
+    #[arg(long, default_value_t = 30)]
+    elites: usize,
+    /// At most this many CEM iterations per step (the authors': 30, stopping at first-action std ≤ 0.01).
+    #[arg(long, default_value_t = 10)]
+    iters: usize,
+    /// Skip the swing-ups: only check the conditioned models' reward predictions on held-out rollouts
+    /// (seconds instead of an hour; tells a model that cannot see the pendulum from a planner that fails).
+    #[arg(long, conflicts_with_all = ["runs", "steps", "candidates", "elites", "iters"])]
+    prediction_only: bool,
+    /// Take a run still in training (its best-validation weights so far); the report says how far it got.
+    #[arg(long)]
+    allow_incomplete: bool,
+    /// Report directory.
+    #[arg(long, default_value = "reports/dlgpd")]
+    out: PathBuf,
+    /// Rerun the settings and seed a dlgpd report recorded (its config.json); no other flag but --out.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["model", "env", "evidence_rollouts", "runs", "steps", "candidates", "elites", "iters", "prediction_only", "allow_incomplete"])]
+    config: Option<PathBuf>,
+}
+
+pub fn dlgpd(global: &GlobalArgs, provenance: Provenance, a: DlgpdArgs) -> anyhow::Result<()> {
+    let (config, provenance) = match &a.config {
+        Some(path) => recorded(global, path)?,
+        None => {
+            // The command's own error for a bad --env names the pendulum variants it knows.
+            for env in &a.env {
+                pendulum_variant(env)?;
+            }
+            let config = DlgpdEvalConfig {
+                model: a.model.clone().unwrap_or_default(),
+                envs: a.env.clone(),
+                evidence_rollouts: a.evidence_rollouts.clone(),
+                runs: a.runs,
+                steps: a.steps,
+                candidates: a.candidates,
+                elites: a.elites,
+                iters: a.iters,
+                prediction_only: a.prediction_only,
+                allow_incomplete: a.allow_incomplete,
+            };
+            (config, provenance)
+        }
+    };
+    config.settings()?;
+    let trained = mbrl::models::dlgpd::job::load(&config.model, accepting(config.allow_incomplete))?;
+    report_unfinished(&config.model, &trained.progress);
+    let summary = run_job(global, "eval dlgpd", |monitor| {
+        mbrl::eval::dlgpd::evaluate(&trained, &config, &provenance, &a.out, monitor)
+    })?;
+    print(&summary, &a.out);
+    Ok(())
+}
