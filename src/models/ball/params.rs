@@ -5,7 +5,7 @@
 //!
 //! The values are the model's own transcription of the thesis, not the simulator's: the simulator adopts the
 //! learned model as its ground truth, but may be retuned without moving the model's published defaults. A test
-//! (tests/model.rs) holds the two transcriptions equal where the simulator is meant to agree.
+//! (`models/ball/tests/model.rs`) holds the two transcriptions equal where the simulator is meant to agree.
 
 use serde::{Deserialize, Serialize};
 
