@@ -7,7 +7,7 @@ use serde_json::Value;
 
 use super::checkpoint::{CheckpointDir, FileEntry};
 use super::fit::{fit, DirCheckpointer, FitSettings, TrainingMethod, CONFIG_FILE, STATE_FILE};
-use super::method::{Method, Prepared, Request, RunRecord, Trained};
+use super::method::{Method, Prepared, Request, RunConfig, RunRecord, Trained};
 use super::run_dir::Decision;
 use super::OpenedCheckpoint;
 use crate::error::{Error, Result};
@@ -91,7 +91,7 @@ pub fn resume<M: Method>(dir: &Path, extension: Option<&Extension>, monitor: &dy
     let opened = OpenedCheckpoint::open(dir)?;
     opened.expect_method(M::NAME)?;
     let record = RunRecord::<M>::read(&opened)?;
-    let steps = M::total_steps(&record.config);
+    let steps = record.config.total_steps();
     opened.expect_total_steps(steps)?;
     if extension.is_some_and(|e| e.steps != steps) && !M::EXTENDABLE {
         return Err(Error::config(format!(
@@ -140,8 +140,8 @@ pub fn carry_out<M: Method>(
 /// uninterrupted run would. To extend, the new record is staged with the next checkpoint, so until that
 /// checkpoint the directory still holds the run as it was.
 fn run<M: Method>(dir: &Path, request: &Request<M>, start: Start, monitor: &dyn Monitor) -> Result<Trained<M>> {
-    M::validate(&request.config)?;
-    let total_steps = M::total_steps(&request.config);
+    request.config.check()?;
+    let total_steps = request.config.total_steps();
     if total_steps > MAX_TRAIN_STEPS {
         return Err(Error::config(format!(
             "{total_steps} training steps; at most {MAX_TRAIN_STEPS} (months on any machine mbrl runs on)"
@@ -157,7 +157,7 @@ fn run<M: Method>(dir: &Path, request: &Request<M>, start: Start, monitor: &dyn 
         details,
         provenance: request.provenance.clone(),
     };
-    let (validate_every, checkpoint_every) = M::schedule(&request.config);
+    let (validate_every, checkpoint_every) = request.config.schedule();
     let settings = FitSettings {
         method: M::NAME.to_string(),
         env: record.env.clone(),

@@ -25,7 +25,7 @@ pub trait Method: Sized + 'static {
     /// (`train --resume DIR --steps N`): true only where nothing in training depends on the total.
     const EXTENDABLE: bool = false;
     /// The hyperparameters: config.json's `config` table, which a TOML file may set.
-    type Config: Clone + PartialEq + Serialize + DeserializeOwned + Send + Sync;
+    type Config: RunConfig + Clone + PartialEq + Serialize + DeserializeOwned + Send + Sync;
     /// What a run takes beyond config and data that is no hyperparameter (the SEADS game, the TRADYN
     /// lookup); recovered from the record when a run is resumed.
     type Variant: Clone + Send + Sync;
@@ -33,14 +33,10 @@ pub trait Method: Sized + 'static {
     type Details: Clone + Serialize + DeserializeOwned;
     type Trainer: TrainingMethod;
 
-    fn total_steps(config: &Self::Config) -> u64;
     /// The config with another total; called only for [`Method::EXTENDABLE`] methods.
     fn with_total_steps(config: &Self::Config, _steps: u64) -> Self::Config {
         config.clone()
     }
-    /// Steps between validations and between checkpoints.
-    fn schedule(config: &Self::Config) -> (u64, u64);
-    fn validate(config: &Self::Config) -> Result<()>;
     /// Reads the data, checks it against the request and builds the trainer.
     fn prepare(request: &Request<Self>) -> Result<Prepared<Self>>;
     /// The variant a recorded run was started with.
@@ -56,6 +52,15 @@ pub trait Method: Sized + 'static {
     }
     /// Rewrites a config.json written by an older mbrl into today's layout (default: unchanged).
     fn upgrade(_record: &mut Value) {}
+}
+
+/// What the job reads of a method's config: the run's length, its schedule and its checks. Context and
+/// TRADYN share one config, so they share this too.
+pub trait RunConfig {
+    fn total_steps(&self) -> u64;
+    /// Steps between validations and between checkpoints.
+    fn schedule(&self) -> (u64, u64);
+    fn check(&self) -> Result<()>;
 }
 
 /// A new run: everything it is started from.
@@ -137,7 +142,7 @@ impl<M: Method> RunRecord<M> {
         if record.method != M::NAME {
             return Err(Error::bad_file(path, format!("method '{}', expected '{}'", record.method, M::NAME)));
         }
-        M::validate(&record.config).map_err(|e| e.at(path))?;
+        record.config.check().map_err(|e| e.at(path))?;
         M::check_record(&record).map_err(|e| e.at(path))?;
         Ok(record)
     }

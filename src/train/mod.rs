@@ -19,7 +19,7 @@ pub use fit::{
     TrainingMethod, CONFIG_FILE, MODEL_FILE, STATE_FILE,
 };
 pub use job::{continuation, loss_panel, training_view, validation_panel, Continuation, Extension, Start};
-pub use method::{Method, Prepared, Request, RunRecord, Trained};
+pub use method::{Method, Prepared, Request, RunConfig, RunRecord, Trained};
 pub use tensors::StoredTensor;
 
 use std::path::Path;

@@ -23,6 +23,7 @@ use crate::data::{read_dataset, Dataset};
 use crate::envs::EnvName;
 use crate::error::{Error, Result};
 use crate::train::tensors::to_params;
+use crate::train::RunConfig;
 use crate::train::{
     loss_panel, training_view, DataFile, FitOutcome, Method, OpenedCheckpoint, Prepared, Request, RunRecord, Trained,
     TrainingProgress, MODEL_FILE,
@@ -79,6 +80,20 @@ pub type ContextRun = RunRecord<Context>;
 /// Explore the Context's model as the training job drives it.
 pub struct Context;
 
+impl RunConfig for ContextConfig {
+    fn total_steps(&self) -> u64 {
+        self.steps
+    }
+
+    fn schedule(&self) -> (u64, u64) {
+        (self.validate_every, self.checkpoint_every)
+    }
+
+    fn check(&self) -> Result<()> {
+        self.validate()
+    }
+}
+
 impl Method for Context {
     const NAME: &'static str = METHOD;
     const TITLE: &'static str = "context-model";
@@ -86,18 +101,6 @@ impl Method for Context {
     type Variant = ();
     type Details = ContextDetails;
     type Trainer = ContextTrainer;
-
-    fn total_steps(config: &ContextConfig) -> u64 {
-        config.steps
-    }
-
-    fn schedule(config: &ContextConfig) -> (u64, u64) {
-        (config.validate_every, config.checkpoint_every)
-    }
-
-    fn validate(config: &ContextConfig) -> Result<()> {
-        config.validate()
-    }
 
     fn prepare(request: &Request<Self>) -> Result<Prepared<Self>> {
         prepare_model(request, &StateSpace::EnvState)

@@ -19,7 +19,7 @@ use crate::nn::tensor::inference_device;
 use crate::train::datasets::{env_of, load_datasets, TransitionCounts};
 use crate::train::tensors::TensorData;
 use crate::train::{
-    loss_panel, open_run, training_view, Accept, FitOutcome, Method, Prepared, Request, RunRecord, Trained,
+    loss_panel, open_run, training_view, Accept, FitOutcome, Method, Prepared, Request, RunConfig, RunRecord, Trained,
     TrainingProgress, MODEL_FILE,
 };
 use crate::util::seeding::rng_for;
@@ -64,6 +64,20 @@ fn split_rows(windows: &Windows, fraction: f64, seed: u64) -> (Vec<usize>, Vec<u
     (train, valid, counts)
 }
 
+impl RunConfig for DlgpdConfig {
+    fn total_steps(&self) -> u64 {
+        self.steps
+    }
+
+    fn schedule(&self) -> (u64, u64) {
+        (self.validate_every, self.checkpoint_every)
+    }
+
+    fn check(&self) -> Result<()> {
+        self.validate()
+    }
+}
+
 impl Method for Dlgpd {
     const NAME: &'static str = METHOD;
     const TITLE: &'static str = "DLGPD";
@@ -73,20 +87,8 @@ impl Method for Dlgpd {
     type Details = DlgpdDetails;
     type Trainer = DlgpdTrainer;
 
-    fn total_steps(config: &DlgpdConfig) -> u64 {
-        config.steps
-    }
-
     fn with_total_steps(config: &DlgpdConfig, steps: u64) -> DlgpdConfig {
         DlgpdConfig { steps, ..config.clone() }
-    }
-
-    fn schedule(config: &DlgpdConfig) -> (u64, u64) {
-        (config.validate_every, config.checkpoint_every)
-    }
-
-    fn validate(config: &DlgpdConfig) -> Result<()> {
-        config.validate()
     }
 
     fn prepare(request: &Request<Self>) -> Result<Prepared<Self>> {

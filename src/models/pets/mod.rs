@@ -22,6 +22,7 @@ use crate::error::{Error, Result};
 use crate::nn::Normalizer;
 use crate::train::datasets::{env_of, load_datasets, TransitionCounts};
 use crate::train::tensors::{to_params, TensorData};
+use crate::train::RunConfig;
 use crate::train::{
     loss_panel, open_run, training_view, validation_panel, Accept, FitOutcome, Method, OpenedCheckpoint, Prepared,
     Request, RunRecord, Trained, MODEL_FILE,
@@ -54,6 +55,20 @@ pub type PetsRun = RunRecord<Pets>;
 /// PETS as the training job drives it.
 pub struct Pets;
 
+impl RunConfig for PetsConfig {
+    fn total_steps(&self) -> u64 {
+        self.steps
+    }
+
+    fn schedule(&self) -> (u64, u64) {
+        (self.validate_every, self.checkpoint_every)
+    }
+
+    fn check(&self) -> Result<()> {
+        self.validate()
+    }
+}
+
 impl Method for Pets {
     const NAME: &'static str = METHOD;
     const TITLE: &'static str = "PETS";
@@ -63,20 +78,8 @@ impl Method for Pets {
     type Details = PetsDetails;
     type Trainer = PetsTrainer;
 
-    fn total_steps(config: &PetsConfig) -> u64 {
-        config.steps
-    }
-
     fn with_total_steps(config: &PetsConfig, steps: u64) -> PetsConfig {
         PetsConfig { steps, ..config.clone() }
-    }
-
-    fn schedule(config: &PetsConfig) -> (u64, u64) {
-        (config.validate_every, config.checkpoint_every)
-    }
-
-    fn validate(config: &PetsConfig) -> Result<()> {
-        config.validate()
     }
 
     fn prepare(request: &Request<Self>) -> Result<Prepared<Self>> {

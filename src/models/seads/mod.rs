@@ -26,7 +26,9 @@ use crate::envs::EnvName;
 use crate::error::{Error, Result};
 use crate::run::PanelSpec;
 use crate::train::run_dir::Field;
-use crate::train::{training_view, FitOutcome, Method, Prepared, Request, RunRecord, Trained, TrainingMethod};
+use crate::train::{
+    training_view, FitOutcome, Method, Prepared, Request, RunConfig, RunRecord, Trained, TrainingMethod,
+};
 
 pub const METHOD: &str = "seads";
 pub const ENV_HELP: &str = "lightsout:cursor, tileswap:cursor, lightsout:reacher, tileswap:reacher";
@@ -99,6 +101,21 @@ impl<G: BoardGame> SeadsTraining for SeadsTrainer<G> {
 /// (the game and embodiment) is required.
 pub struct Seads;
 
+impl RunConfig for SeadsConfig {
+    fn total_steps(&self) -> u64 {
+        self.max_epochs()
+    }
+
+    /// Nothing is held out: the forward model's loss on each epoch's new episodes is the check.
+    fn schedule(&self) -> (u64, u64) {
+        (u64::MAX, self.checkpoint_every)
+    }
+
+    fn check(&self) -> Result<()> {
+        self.validate()
+    }
+}
+
 impl Method for Seads {
     const NAME: &'static str = METHOD;
     const TITLE: &'static str = "SEADS";
@@ -106,19 +123,6 @@ impl Method for Seads {
     type Variant = ();
     type Details = SeadsDetails;
     type Trainer = Box<dyn SeadsTraining>;
-
-    fn total_steps(config: &SeadsConfig) -> u64 {
-        config.max_epochs()
-    }
-
-    /// Nothing is held out: the forward model's loss on each epoch's new episodes is the check.
-    fn schedule(config: &SeadsConfig) -> (u64, u64) {
-        (u64::MAX, config.checkpoint_every)
-    }
-
-    fn validate(config: &SeadsConfig) -> Result<()> {
-        config.validate()
-    }
 
     fn prepare(request: &Request<Self>) -> Result<Prepared<Self>> {
         let name = request.env.as_deref().ok_or_else(|| Error::config(format!("SEADS needs an env ({ENV_HELP})")))?;

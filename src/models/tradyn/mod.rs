@@ -47,18 +47,6 @@ impl Method for Tradyn {
     type Details = ContextDetails;
     type Trainer = ContextTrainer;
 
-    fn total_steps(config: &ContextConfig) -> u64 {
-        config.steps
-    }
-
-    fn schedule(config: &ContextConfig) -> (u64, u64) {
-        (config.validate_every, config.checkpoint_every)
-    }
-
-    fn validate(config: &ContextConfig) -> Result<()> {
-        config.validate()
-    }
-
     fn prepare(request: &Request<Self>) -> Result<Prepared<Self>> {
         context_net::prepare_model(request, &state_space(request.variant))
     }

@@ -13,7 +13,8 @@ use crate::data::ball_io::read_recordings;
 use crate::error::{Error, Result};
 use crate::models::ball::BallModelParams;
 use crate::train::{
-    loss_history, loss_panel, training_view, DataFile, FitOutcome, Method, Prepared, Request, RunRecord, Trained,
+    loss_history, loss_panel, training_view, DataFile, FitOutcome, Method, Prepared, Request, RunConfig, RunRecord,
+    Trained,
 };
 
 pub const METHOD: &str = "ball-ekf";
@@ -34,6 +35,21 @@ pub type BallRun = RunRecord<BallEkf>;
 /// The gray-box ball EKF as the training job drives it. Its seed lives in its settings, as it always has.
 pub struct BallEkf;
 
+impl RunConfig for TrainSettings {
+    fn total_steps(&self) -> u64 {
+        self.steps
+    }
+
+    /// One validation, at the end: the EKF holds nothing back, the final parameters are the model.
+    fn schedule(&self) -> (u64, u64) {
+        (self.steps, CHECKPOINT_EVERY)
+    }
+
+    fn check(&self) -> Result<()> {
+        self.validate()
+    }
+}
+
 impl Method for BallEkf {
     const NAME: &'static str = METHOD;
     const TITLE: &'static str = "ball-EKF";
@@ -41,19 +57,6 @@ impl Method for BallEkf {
     type Variant = ();
     type Details = BallDetails;
     type Trainer = BallEkfTrainer;
-
-    fn total_steps(config: &TrainSettings) -> u64 {
-        config.steps
-    }
-
-    /// One validation, at the end: the EKF holds nothing back, the final parameters are the model.
-    fn schedule(config: &TrainSettings) -> (u64, u64) {
-        (config.steps, CHECKPOINT_EVERY)
-    }
-
-    fn validate(config: &TrainSettings) -> Result<()> {
-        config.validate()
-    }
 
     fn prepare(request: &Request<Self>) -> Result<Prepared<Self>> {
         let [path] = request.data.as_slice() else {
