@@ -4,30 +4,21 @@
 use std::path::PathBuf;
 
 use anyhow::bail;
-use clap::{Args, ValueEnum};
+use clap::Args;
 use mbrl::data::write_dataset;
 use mbrl::envs::terrain::TerrainMap;
 use mbrl::envs::unicycle::UnicycleTerrain;
 use mbrl::envs::{parse_env, EnvName};
 use mbrl::models::context::calibration::{
-    calibration_dataset, layout, run_calibration, CalibrationRequest, CalibrationSettings, Strategy,
+    calibration_dataset, layout, run_calibration, CalibrationRequest, CalibrationSettings,
 };
 use mbrl::models::context::{self, fast::gaussian_entropy, LoadedModel};
 use mbrl::models::tradyn::{self, TradynModel};
 use mbrl::train::{Accept, OpenedCheckpoint};
 
 use crate::common::{check_output_file, command_line, file_stem, parse_floats, run_job, GlobalArgs};
-use crate::model_args::{accepting, report_unfinished};
-
-#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
-pub enum StrategyChoice {
-    /// Uniformly random actions (the baseline).
-    Random,
-    /// One action sequence maximizing the expected information gain, planned at the start (eq. 4.36).
-    OpenLoop,
-    /// Replan the EIG-optimal sequence after every transition, horizon min(H_max, N − n) (eq. 4.37).
-    Mpc,
-}
+use mbrl::jobs::choices::StrategyChoice;
+use mbrl::jobs::model_options::{accepting, report_unfinished};
 
 /// Calibrate a context model in an instance of its env by expected information gain.
 #[derive(Args, Debug)]
@@ -90,16 +81,6 @@ pub struct CalibrateArgs {
     allow_incomplete: bool,
 }
 
-impl StrategyChoice {
-    pub fn strategy(self) -> Strategy {
-        match self {
-            StrategyChoice::Random => Strategy::Random,
-            StrategyChoice::OpenLoop => Strategy::OpenLoop,
-            StrategyChoice::Mpc => Strategy::Mpc,
-        }
-    }
-}
-
 pub fn run(global: &GlobalArgs, args: CalibrateArgs) -> anyhow::Result<()> {
     let mut env = parse_env(&args.env)?;
     let unicycle = matches!(env, EnvName::Unicycle(_));
@@ -109,7 +90,7 @@ pub fn run(global: &GlobalArgs, args: CalibrateArgs) -> anyhow::Result<()> {
         (Some(_), false) => bail!("--map is the unicycle's terrain; '{}' has none", env.canonical()),
         (None, false) => {}
     }
-    let strategy = args.strategy.strategy();
+    let strategy = args.strategy.into();
     let transitions = args.transitions.unwrap_or(if unicycle { 10 } else { 30 });
     let settings = CalibrationSettings {
         strategy,

@@ -6,7 +6,10 @@ use std::sync::Arc;
 
 use anyhow::Context;
 use clap::Args;
+use mbrl::jobs::{Invocation, Job};
 use mbrl::run::{ChannelMonitor, ConsoleMonitor, Event, Monitor, NullMonitor};
+
+pub use mbrl::jobs::{check_output_file, file_stem, finite_f64, parse_floats, pendulum_variant};
 use mbrl::tui::{run_live, LiveOutcome};
 
 #[derive(Args, Clone, Debug)]
@@ -48,6 +51,11 @@ impl GlobalArgs {
 
     pub fn thread_count(&self) -> usize {
         rayon::current_num_threads()
+    }
+
+    /// What a library job needs to know of this command.
+    pub fn invocation(&self) -> Invocation {
+        Invocation { seed: self.seed, threads: self.thread_count(), command_line: command_line() }
     }
 }
 
@@ -96,6 +104,14 @@ pub fn command_line() -> String {
         .join(" ")
 }
 
+/// Runs a prepared job in the view the flags ask for and prints its summary.
+pub fn show<S: std::fmt::Display + Send>(global: &GlobalArgs, job: Job<'_, S>) -> anyhow::Result<()> {
+    let title = job.title.clone();
+    let summary = run_job(global, &title, |monitor| job.run(monitor))?;
+    say!("{summary}");
+    Ok(())
+}
+
 /// Runs `job` with the monitor the flags ask for. With the TUI, the job runs on a worker thread while the
 /// view owns the terminal; quitting the view cancels the job.
 pub fn run_job<T: Send>(
@@ -127,67 +143,6 @@ pub fn run_job<T: Send>(
     })
 }
 
-/// Accepts only finite numbers, so NaN or inf never reach a simulator or planner.
-pub fn finite_f64(text: &str) -> Result<f64, String> {
-    let value: f64 = text.parse().map_err(|_| format!("'{text}' is not a number"))?;
-    if value.is_finite() {
-        Ok(value)
-    } else {
-        Err(format!("'{text}' is not finite; expected a finite number"))
-    }
-}
-
-/// A filesystem-friendly form of an env name (`pendulum:heavy` → `pendulum-heavy`).
-pub fn file_stem(env: &str) -> String {
-    env.chars().map(|c| if c.is_ascii_alphanumeric() || c == '.' || c == '-' { c } else { '-' }).collect()
-}
-
-/// The successor model a board search uses. The learned SEADS model joins this list when it lands.
-#[derive(Copy, Clone, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum ModelChoice {
-    /// The game's own rules (ground truth).
-    True,
-}
-
-/// The pendulum variant an env name denotes; other envs have no continuous MPC task yet.
-pub fn pendulum_variant(name: &str) -> anyhow::Result<mbrl::envs::pendulum::PendulumVariant> {
-    match mbrl::envs::parse_env(name)? {
-        mbrl::envs::EnvName::Pendulum(v) => Ok(v),
-        mbrl::envs::EnvName::Ball => {
-            anyhow::bail!(
-                "'ball' has no control task; use `mbrl filter` / `mbrl predict`; CEM planning supports pendulum envs"
-            )
-        }
-        env @ (mbrl::envs::EnvName::Toy(_)
-        | mbrl::envs::EnvName::MountainCar
-        | mbrl::envs::EnvName::Unicycle(_)
-        | mbrl::envs::EnvName::Terrain) => {
-            anyhow::bail!("'{}' has no MPC task here yet; CEM planning supports pendulum envs", env.canonical())
-        }
-        env @ mbrl::envs::EnvName::Embodied(..) => anyhow::bail!(
-            "'{}' is a board game played by a manipulator: plan its moves with `mbrl solve-board --embodiment`; CEM \
-             planning supports pendulum envs",
-            env.canonical()
-        ),
-        mbrl::envs::EnvName::Board(g) => anyhow::bail!(
-            "'{}' is a board game: solve it with `mbrl solve-board --game {}`; CEM planning supports pendulum envs",
-            g.name(),
-            g.name()
-        ),
-    }
-}
-
-/// A comma-separated list of finite numbers (`--init-state 0.5,-1`), or an error naming the flag.
-pub fn parse_floats(flag: &str, text: &str) -> anyhow::Result<Vec<f64>> {
-    text.split(',')
-        .enumerate()
-        .map(|(i, part)| match part.trim().parse::<f64>() {
-            Ok(x) if x.is_finite() => Ok(x),
-            _ => anyhow::bail!("{flag} '{text}': value {} ('{}') is not a finite number", i + 1, part.trim()),
-        })
-        .collect()
-}
-
 /// Prints one line of results. A reader that closed stdout early (`mbrl … | head -1`) does not stop the
 /// work, whose files are still written; any other failure to write ends the command with one error line.
 pub fn say(args: std::fmt::Arguments) {
@@ -203,23 +158,4 @@ pub fn write_stdout(result: std::io::Result<()>) {
         Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {}
         Err(e) => mbrl::util::interrupt::abandon_and_exit_with(1, &format!("cannot write to stdout: {e}")),
     }
-}
-
-/// Extensions of the files mbrl reads or writes: an output named with one of them promises that format.
-const KNOWN_EXTENSIONS: [&str; 10] = ["mcap", "csv", "npz", "json", "jsonl", "png", "md", "txt", "toml", "safetensors"];
-
-/// Checks an output file before any work starts: not a directory, and not named for another format
-/// (`plan --out p.csv` would otherwise get MCAP bytes). Names without a known extension are taken as given.
-pub fn check_output_file(flag: &str, path: &std::path::Path, extension: &str) -> anyhow::Result<()> {
-    let named = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
-    if let Some(named) = named.filter(|n| KNOWN_EXTENSIONS.contains(&n.as_str()) && n != extension) {
-        let hint = if extension == "mcap" { "; `mbrl export` turns MCAP into CSV or .npz" } else { "" };
-        anyhow::bail!(
-            "{flag} {}: this writes {} and the name says .{named}; name it .{extension}{hint}",
-            path.display(),
-            extension.to_ascii_uppercase()
-        );
-    }
-    mbrl::util::atomic::Target::of(path)?;
-    Ok(())
 }

@@ -11,14 +11,10 @@ macro_rules! say {
 }
 
 mod calibrate;
-mod cem_args;
 mod collect;
 mod common;
 mod completions;
 mod eval;
-mod export;
-mod filter;
-mod model_args;
 mod plan;
 mod plan_unicycle;
 mod predict;
@@ -63,12 +59,12 @@ enum Command {
     Plan(plan::PlanArgs),
     Train(train::TrainArgs),
     Calibrate(calibrate::CalibrateArgs),
-    Filter(filter::FilterArgs),
+    Filter(mbrl::jobs::filter::FilterOptions),
     Predict(predict::PredictArgs),
     SolveBoard(solve_board::SolveBoardArgs),
     Eval(eval::EvalArgs),
     Watch(watch::WatchArgs),
-    Export(export::ExportArgs),
+    Export(mbrl::jobs::export::ExportOptions),
     Completions(completions::CompletionsArgs),
 }
 
@@ -87,12 +83,14 @@ fn main() {
         Command::Plan(args) => plan::run(&cli.global, args),
         Command::Train(args) => train::run(&cli.global, args),
         Command::Calibrate(args) => calibrate::run(&cli.global, args),
-        Command::Filter(args) => filter::run(&cli.global, args),
+        Command::Filter(args) => {
+            common::show(&cli.global, mbrl::jobs::filter::prepare(args, &cli.global.invocation())?)
+        }
         Command::Predict(args) => predict::run(&cli.global, args),
         Command::SolveBoard(args) => solve_board::run(&cli.global, args),
         Command::Eval(args) => eval::run(&cli.global, args),
         Command::Watch(args) => watch::run(&cli.global, args),
-        Command::Export(args) => export::run(args),
+        Command::Export(args) => Ok(say!("{}", mbrl::jobs::export::run(args)?)),
         Command::Completions(args) => completions::run(args),
     });
     if let Err(err) = outcome {

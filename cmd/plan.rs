@@ -9,9 +9,9 @@ use mbrl::eval::swingup::{self, SwingupEpisode, SwingupSettings};
 use mbrl::models::dlgpd;
 use mbrl::util::budget;
 
-use crate::cem_args::CemArgs;
 use crate::common::{check_output_file, command_line, file_stem, pendulum_variant, run_job, GlobalArgs};
-use crate::model_args::{report_unfinished, ModelArgs};
+use mbrl::jobs::cem_options::CemOptions;
+use mbrl::jobs::model_options::{report_unfinished, ModelOptions};
 
 /// Plan with CEM on a model and execute the plan in the simulator (MPC).
 #[derive(Args, Debug)]
@@ -43,7 +43,7 @@ pub struct PlanArgs {
     #[arg(long, help = concat!("Environment: ", mbrl::pendulum_envs!(), " or unicycle"))]
     env: String,
     #[command(flatten)]
-    model: ModelArgs,
+    model: ModelOptions,
     /// Steps to execute (pendulum 150; unicycle 50).
     #[arg(long)]
     steps: Option<usize>,
@@ -57,7 +57,7 @@ pub struct PlanArgs {
     #[arg(long)]
     goal: Option<String>,
     #[command(flatten)]
-    cem: CemArgs,
+    cem: CemOptions,
     /// DLGPD models: rollouts to condition the GPs on (a dataset written by `collect`).
     #[arg(long)]
     evidence: Option<PathBuf>,
@@ -82,16 +82,17 @@ impl PlanArgs {
     }
 }
 
-/// Generous bytes kept per executed step (state, action, reward, planner statistics).
-pub const STEP_RECORD_BYTES: usize = 512;
-
 pub fn run(global: &GlobalArgs, args: PlanArgs) -> anyhow::Result<()> {
     if args.steps == Some(0) {
         bail!("--steps must be at least 1");
     }
     let steps = args.steps.unwrap_or(if args.env == "unicycle" { 50 } else { 150 });
     // The executed rollout and per-step planner records are kept until the file is written.
-    budget::check(&format!("--steps {steps}"), budget::times(&[steps], STEP_RECORD_BYTES), "plan fewer steps")?;
+    budget::check(
+        &format!("--steps {steps}"),
+        budget::times(&[steps], mbrl::jobs::STEP_RECORD_BYTES),
+        "plan fewer steps",
+    )?;
     if args.env == "unicycle" {
         return crate::plan_unicycle::run(global, &args.model, &args.cem, steps, args.unicycle());
     }

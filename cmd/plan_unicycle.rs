@@ -15,9 +15,9 @@ use mbrl::models::tradyn::navigation::{layout, navigate, NavigationSettings, Nav
 use mbrl::models::tradyn::{self, TradynDynamics, TradynModel};
 use mbrl::train::OpenedCheckpoint;
 
-use crate::cem_args::CemArgs;
 use crate::common::{check_output_file, command_line, parse_floats, run_job, GlobalArgs};
-use crate::model_args::{report_unfinished, ModelArgs};
+use mbrl::jobs::cem_options::CemOptions;
+use mbrl::jobs::model_options::{report_unfinished, ModelOptions};
 
 /// The unicycle flags of `plan`.
 pub struct UnicycleTask {
@@ -44,7 +44,7 @@ fn task(flags: &UnicycleTask) -> anyhow::Result<NavigationTask> {
 }
 
 fn load_dynamics(
-    model: &ModelArgs,
+    model: &ModelOptions,
     map: &Arc<TerrainMap>,
     truth: Box<dyn mbrl::envs::Dynamics>,
 ) -> anyhow::Result<Box<dyn BatchDynamics>> {
@@ -76,8 +76,8 @@ fn load_dynamics(
 
 pub fn run(
     global: &GlobalArgs,
-    model: &ModelArgs,
-    cem: &CemArgs,
+    model: &ModelOptions,
+    cem: &CemOptions,
     steps: usize,
     flags: UnicycleTask,
 ) -> anyhow::Result<()> {

@@ -49,6 +49,14 @@ pub struct Error {
 
 pub type Result<T> = std::result::Result<T, Error>;
 
+/// Refuses settings that cannot work: `return Err(Error::config(format!(..)))`, the `bail!` of option checks.
+#[macro_export]
+macro_rules! refuse {
+    ($($arg:tt)*) => {
+        return Err($crate::Error::config(format!($($arg)*)))
+    };
+}
+
 impl Error {
     pub fn new(kind: ErrorKind) -> Self {
         Error { kind, context: Vec::new() }

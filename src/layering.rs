@@ -22,6 +22,7 @@ const FLOORS: &[(&str, u8)] = &[
     ("models", 9),
     ("eval", 10),
     ("tui", 10),
+    ("jobs", 11),
 ];
 
 /// Folders of `models/` that are one learning method each; shared pieces (`gp`, `context_net`) are not.
@@ -211,4 +212,19 @@ fn the_parser_sees_nested_use_trees_and_paths_in_code() {
     );
     let paths: Vec<String> = crate_paths(&code).into_iter().map(|p| p.join("::")).collect();
     assert_eq!(paths, ["VERSION", "envs::Env", "eval::swingup", "models::gp", "models::pets"]);
+}
+
+/// Flags are parsed in one room: the engine below `jobs/` takes typed settings and never names clap.
+#[test]
+fn only_jobs_know_clap() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files = Vec::new();
+    rust_files(&src, &mut files);
+    let offenders: Vec<String> = files
+        .iter()
+        .filter(|file| place(&src, file).0 != "jobs" && !file.ends_with("layering.rs"))
+        .filter(|file| code_of(&std::fs::read_to_string(file).unwrap()).contains("clap::"))
+        .map(|file| file.display().to_string())
+        .collect();
+    assert!(offenders.is_empty(), "clap used outside src/jobs/: {}", offenders.join(", "));
 }

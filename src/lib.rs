@@ -7,6 +7,7 @@ pub mod envs;
 pub mod error;
 pub mod eval;
 pub mod filtering;
+pub mod jobs;
 pub mod models;
 pub mod nn;
 pub mod planning;

@@ -11,8 +11,8 @@ use mbrl::run::dir::Provenance;
 
 use super::{print, recorded};
 use crate::common::{run_job, GlobalArgs};
-use crate::model_args::{accepting, report_unfinished};
 use crate::solve_board::{EmbodimentChoice, SplitChoice};
+use mbrl::jobs::model_options::{accepting, report_unfinished};
 
 #[derive(Args, Debug)]
 pub struct BoardsArgs {

@@ -14,7 +14,7 @@ use mbrl::run::dir::Provenance;
 
 use super::{print, recorded};
 use crate::common::{run_job, GlobalArgs};
-use crate::model_args::{accepting, report_unfinished};
+use mbrl::jobs::model_options::{accepting, report_unfinished};
 
 #[derive(Args, Debug)]
 pub struct BallArgs {
@@ -92,7 +92,7 @@ pub struct ContextArgs {
     horizon: usize,
     /// Strategies to compare (repeatable; default: all three).
     #[arg(long, value_enum)]
-    strategy: Vec<crate::calibrate::StrategyChoice>,
+    strategy: Vec<mbrl::jobs::choices::StrategyChoice>,
     /// CEM candidates per iteration (thesis 1000).
     #[arg(long, default_value_t = 1000)]
     candidates: usize,
@@ -131,7 +131,7 @@ impl ContextArgs {
         let strategies: Vec<Strategy> = if self.strategy.is_empty() {
             Strategy::ALL.to_vec()
         } else {
-            self.strategy.iter().map(|s| s.strategy()).collect()
+            self.strategy.iter().map(|&s| s.into()).collect()
         };
         let swingup = match (self.swingup, env) {
             (false, _) => None,

@@ -8,9 +8,9 @@ use mbrl::eval::swingup::{self, ModelSpec, SwingupConfig, SwingupSettings};
 use mbrl::run::dir::Provenance;
 
 use super::{print, print_inline, recorded};
-use crate::cem_args::CemArgs;
 use crate::common::{pendulum_variant, run_job, GlobalArgs};
-use crate::model_args::{accepting, report_unfinished, ModelArgs, PropagationChoice};
+use mbrl::jobs::cem_options::CemOptions;
+use mbrl::jobs::model_options::{accepting, report_unfinished, ModelOptions, PropagationChoice};
 
 #[derive(Args, Debug)]
 pub struct DatasetArgs {
@@ -41,7 +41,7 @@ pub fn dataset(global: &GlobalArgs, provenance: Provenance, a: DatasetArgs) -> a
 #[derive(Args, Debug)]
 pub struct SwingupArgs {
     #[command(flatten)]
-    model: Option<ModelArgs>,
+    model: Option<ModelOptions>,
     /// Number of episodes (each with its own start state).
     #[arg(long, default_value_t = 10)]
     episodes: usize,
@@ -51,7 +51,7 @@ pub struct SwingupArgs {
     #[arg(long, default_value_t = 150)]
     steps: usize,
     #[command(flatten)]
-    cem: CemArgs,
+    cem: CemOptions,
     /// Report directory.
     #[arg(long, default_value = "reports/pendulum-swingup")]
     out: PathBuf,
@@ -89,14 +89,14 @@ impl SwingupArgs {
 }
 
 /// The command's model flags from a recorded model.
-fn model_args(spec: &ModelSpec) -> anyhow::Result<ModelArgs> {
+fn model_args(spec: &ModelSpec) -> anyhow::Result<ModelOptions> {
     let propagation = match spec.propagation.as_str() {
         "ts1" => PropagationChoice::Ts1,
         "tsinf" => PropagationChoice::Tsinf,
         "expectation" => PropagationChoice::Expectation,
         other => anyhow::bail!("model.propagation '{other}': expected ts1, tsinf or expectation"),
     };
-    Ok(ModelArgs {
+    Ok(ModelOptions {
         model: spec.model.clone(),
         particles: spec.particles,
         propagation,
@@ -115,7 +115,7 @@ pub fn swingup(global: &GlobalArgs, provenance: Provenance, a: SwingupArgs) -> a
     config.validate()?;
     mbrl::util::budget::check(
         &format!("--episodes {} × --steps {}", config.episodes, config.settings.steps),
-        mbrl::util::budget::times(&[config.episodes, config.settings.steps], crate::plan::STEP_RECORD_BYTES),
+        mbrl::util::budget::times(&[config.episodes, config.settings.steps], mbrl::jobs::STEP_RECORD_BYTES),
         "evaluate fewer or shorter episodes",
     )?;
     let summary = run_job(global, "eval pendulum-swingup", |monitor| {

@@ -11,7 +11,7 @@ use mbrl::util::seeding::rng_for;
 
 use super::{board_of, limits_of, SearchChoice, SolveBoardArgs};
 use crate::common::{run_job, GlobalArgs};
-use crate::model_args::{accepting, report_unfinished};
+use mbrl::jobs::model_options::{accepting, report_unfinished};
 
 pub fn run_learned(global: &GlobalArgs, args: &SolveBoardArgs) -> anyhow::Result<()> {
     let dir = std::path::Path::new(&args.model);

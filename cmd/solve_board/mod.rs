@@ -2,7 +2,7 @@
 //! manipulator.
 
 use anyhow::{bail, Context};
-use clap::{Args, ValueEnum};
+use clap::Args;
 use mbrl::envs::boards::depth::{DenseIndex, DepthTable};
 use mbrl::envs::boards::sets::sample_board;
 use mbrl::envs::boards::{GameSpec, LightsOut, Split, TileSwap};
@@ -13,55 +13,7 @@ use mbrl::planning::solve_board::{execute_plan, plan_board, SearchKind};
 use mbrl::util::seeding::rng_for;
 
 use crate::common::{run_job, GlobalArgs};
-
-#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
-pub enum SplitChoice {
-    Train,
-    Test,
-}
-
-#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
-pub enum SearchChoice {
-    /// From both ends (moves undo themselves); far fewer states.
-    Bidirectional,
-    /// From the start only, as the thesis' planner.
-    Bfs,
-}
-
-#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
-pub enum EmbodimentChoice {
-    /// A point moved by steps of at most 0.2, pushing where it stands (10 steps per move).
-    Cursor,
-    /// A torque-driven two-link arm over a 0.3 m board (50 steps per move).
-    Reacher,
-}
-
-impl From<SplitChoice> for mbrl::envs::terrain::TerrainSplit {
-    fn from(choice: SplitChoice) -> Self {
-        match choice {
-            SplitChoice::Train => Self::Train,
-            SplitChoice::Test => Self::Test,
-        }
-    }
-}
-
-impl From<SplitChoice> for Split {
-    fn from(choice: SplitChoice) -> Split {
-        match choice {
-            SplitChoice::Train => Split::Train,
-            SplitChoice::Test => Split::Test,
-        }
-    }
-}
-
-impl From<EmbodimentChoice> for Embodiment {
-    fn from(choice: EmbodimentChoice) -> Embodiment {
-        match choice {
-            EmbodimentChoice::Cursor => Embodiment::Cursor,
-            EmbodimentChoice::Reacher => Embodiment::Reacher,
-        }
-    }
-}
+pub use mbrl::jobs::choices::{EmbodimentChoice, SearchChoice, SplitChoice};
 
 /// Find a shortest solution of a LightsOut or TileSwap board and optionally play it with a manipulator.
 #[derive(Args, Debug)]

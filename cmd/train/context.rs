@@ -14,7 +14,7 @@ use crate::common::GlobalArgs;
 
 /// The flags context and TRADYN share: the model and its training are the same.
 #[derive(Args, Debug)]
-pub struct ModelArgs {
+pub struct ModelOptions {
     /// Hyperparameters from a TOML file (keys of config.json's `config` table), over the preset's.
     #[arg(long)]
     config: Option<PathBuf>,
@@ -50,7 +50,7 @@ pub struct ContextArgs {
     #[arg(long)]
     env: Option<String>,
     #[command(flatten)]
-    model: ModelArgs,
+    model: ModelOptions,
     #[command(flatten)]
     run: RunArgs,
 }
@@ -77,12 +77,12 @@ pub struct TradynArgs {
     #[arg(long)]
     no_terrain: bool,
     #[command(flatten)]
-    model: ModelArgs,
+    model: ModelOptions,
     #[command(flatten)]
     run: RunArgs,
 }
 
-impl ModelArgs {
+impl ModelOptions {
     fn options(&self) -> ContextOptions {
         ContextOptions {
             preset: self.preset.map(|p| match p {

@@ -1,11 +1,13 @@
 //! `mbrl export`: any mbrl data file as a CSV table or NumPy arrays.
 
+use std::fmt;
 use std::path::PathBuf;
 
-use anyhow::bail;
 use clap::Args;
-use mbrl::data::export::{self, ExportFormat};
-use mbrl::util::atomic::Target;
+
+use crate::data::export::{self, ExportFormat, Exported};
+use crate::util::atomic::Target;
+use crate::{refuse, Result};
 
 /// Convert a dataset, board set, ball recording or filter-estimate file to CSV or NumPy `.npz`.
 #[derive(Args, Debug)]
@@ -20,7 +22,7 @@ Examples:
   mbrl export --input datasets/pendulum.mcap --out pendulum.csv
   mbrl export --input datasets/ball.mcap --format npz --out ball.npz
   python3 -c \"import numpy as np; d = np.load('pendulum.npz'); print(d['state'].shape)\"")]
-pub struct ExportArgs {
+pub struct ExportOptions {
     /// An mbrl MCAP file: a dataset (`collect`), board set, ball recording or `filter --out *.mcap` output.
     #[arg(long)]
     input: PathBuf,
@@ -32,45 +34,59 @@ pub struct ExportArgs {
     format: Option<String>,
 }
 
-pub fn run(args: ExportArgs) -> anyhow::Result<()> {
-    let format = choose_format(&args)?;
-    // A directory or unwritable place is refused before the input is read.
-    Target::of(&args.out)?;
-    let exported = export::load(&args.input)?;
-    export::write(&exported, format, &args.out)?;
-    say!(
-        "exported {} rows of {} {} to {} ({}): {}",
-        exported.rows,
-        exported.kind.describe(),
-        args.input.display(),
-        args.out.display(),
-        format.extension(),
-        exported.array_shapes(format).join(", ")
-    );
-    Ok(())
+pub struct ExportSummary {
+    exported: Exported,
+    format: ExportFormat,
+    input: PathBuf,
+    out: PathBuf,
 }
 
-fn choose_format(args: &ExportArgs) -> anyhow::Result<ExportFormat> {
-    let named = match &args.format {
+impl fmt::Display for ExportSummary {
+    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        write!(
+            f,
+            "exported {} rows of {} {} to {} ({}): {}",
+            self.exported.rows,
+            self.exported.kind.describe(),
+            self.input.display(),
+            self.out.display(),
+            self.format.extension(),
+            self.exported.array_shapes(self.format).join(", ")
+        )
+    }
+}
+
+/// Export is quick and reads one file: it runs at once, with no view.
+pub fn run(options: ExportOptions) -> Result<ExportSummary> {
+    let format = choose_format(&options)?;
+    // A directory or unwritable place is refused before the input is read.
+    Target::of(&options.out)?;
+    let exported = export::load(&options.input)?;
+    export::write(&exported, format, &options.out)?;
+    Ok(ExportSummary { exported, format, input: options.input, out: options.out })
+}
+
+fn choose_format(options: &ExportOptions) -> Result<ExportFormat> {
+    let named = match &options.format {
         Some(text) => match ExportFormat::parse(text) {
             Some(f) => Some(f),
-            None => bail!("--format '{text}' is not known; supported: {}", ExportFormat::NAMES),
+            None => refuse!("--format '{text}' is not known; supported: {}", ExportFormat::NAMES),
         },
         None => None,
     };
-    let by_extension = ExportFormat::of_path(&args.out);
+    let by_extension = ExportFormat::of_path(&options.out);
     match (named, by_extension) {
-        (Some(f), Some(e)) if f != e => bail!(
+        (Some(f), Some(e)) if f != e => refuse!(
             "--format {} disagrees with --out {} (a .{} file); give --out a .{} name",
             f.extension(),
-            args.out.display(),
+            options.out.display(),
             e.extension(),
             f.extension()
         ),
         (Some(f), _) | (None, Some(f)) => Ok(f),
-        (None, None) => bail!(
+        (None, None) => refuse!(
             "--out {}: cannot tell the format from the extension; name it .csv or .npz, or give --format ({})",
-            args.out.display(),
+            options.out.display(),
             ExportFormat::NAMES
         ),
     }

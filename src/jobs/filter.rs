@@ -1,15 +1,18 @@
 //! `mbrl filter`: run the ball EKF over recordings and write the filtered states with covariances.
 
+use std::collections::HashMap;
+use std::fmt;
 use std::path::PathBuf;
 
 use clap::Args;
-use mbrl::data::ball_estimates::{write_estimates_csv, write_estimates_mcap, BallEstimate};
-use mbrl::data::ball_io::{read_recordings, FRAME_RATE};
-use mbrl::models::ball::checkpoint::load_ball_model;
-use mbrl::models::ball::track::filter_recording;
-use mbrl::models::ball::Phase;
 
-use crate::common::{check_output_file, command_line, run_job, GlobalArgs};
+use super::{check_output_file, Invocation, Job};
+use crate::data::ball_estimates::{write_estimates_csv, write_estimates_mcap, BallEstimate};
+use crate::data::ball_io::{read_recordings, FRAME_RATE};
+use crate::models::ball::checkpoint::load_ball_model;
+use crate::models::ball::track::filter_recording;
+use crate::models::ball::Phase;
+use crate::Result;
 
 /// Filter table-tennis ball recordings with the gray-box EKF (thesis chapter 6).
 #[derive(Args, Debug)]
@@ -20,7 +23,7 @@ Examples:
 
 --model is `thesis` (learned values of eq. 6.26 / Table C.2), `initial` (Table C.1) or a directory
 written by training. CSV input: header frame (or t), x, y, z; empty x,y,z cells are lost frames.")]
-pub struct FilterArgs {
+pub struct FilterOptions {
     /// Ball model: thesis, initial, or a checkpoint directory.
     #[arg(long)]
     model: String,
@@ -35,20 +38,42 @@ pub struct FilterArgs {
     mcap: Option<PathBuf>,
 }
 
-pub fn run(global: &GlobalArgs, args: FilterArgs) -> anyhow::Result<()> {
-    let model = load_ball_model(&args.model)?;
-    check_output_file("--out", &args.out, "csv")?;
-    if let Some(path) = &args.mcap {
+/// Per trajectory its id, log-likelihood and filtered frames; then what was written where.
+pub struct FilterSummary {
+    likelihoods: Vec<(u32, f64, usize)>,
+    estimates: usize,
+    out: PathBuf,
+    mcap: Option<PathBuf>,
+}
+
+impl fmt::Display for FilterSummary {
+    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        for (id, ll, frames) in &self.likelihoods {
+            writeln!(f, "trajectory {id}: {frames} frames filtered, log-likelihood {ll:.2}")?;
+        }
+        write!(f, "wrote {} estimates to {}", self.estimates, self.out.display())?;
+        if let Some(path) = &self.mcap {
+            write!(f, "\nwrote means and covariances to {}", path.display())?;
+        }
+        Ok(())
+    }
+}
+
+pub fn prepare(options: FilterOptions, invocation: &Invocation) -> Result<Job<'static, FilterSummary>> {
+    let model = load_ball_model(&options.model)?;
+    check_output_file("--out", &options.out, "csv")?;
+    if let Some(path) = &options.mcap {
         check_output_file("--mcap", path, "mcap")?;
     }
-    let recordings = read_recordings(&args.input)?;
-    let (estimates, likelihoods) = run_job(global, "filter", |monitor| {
+    let recordings = read_recordings(&options.input)?;
+    let command_line = invocation.command_line.clone();
+    Ok(Job::new("filter", move |monitor| {
         let mut estimates = Vec::new();
         let mut likelihoods = Vec::new();
         for (k, rec) in recordings.iter().enumerate() {
             let track = filter_recording(&model.model, rec, None, &model.prior(rec))?;
             likelihoods.push((rec.id, track.log_likelihood, track.frames.len()));
-            let measured: std::collections::HashMap<u64, [f64; 3]> =
+            let measured: HashMap<u64, [f64; 3]> =
                 rec.frames.iter().zip(&rec.positions).filter_map(|(f, p)| p.map(|p| (*f, p))).collect();
             for (frame, belief) in track.frames.iter().zip(&track.beliefs) {
                 estimates.push(BallEstimate {
@@ -63,18 +88,10 @@ pub fn run(global: &GlobalArgs, args: FilterArgs) -> anyhow::Result<()> {
             }
             monitor.progress("filter recordings", k as u64 + 1, recordings.len() as u64);
         }
-        write_estimates_csv(&args.out, &estimates)?;
-        if let Some(path) = &args.mcap {
-            write_estimates_mcap(path, &args.model, &command_line(), &estimates)?;
+        write_estimates_csv(&options.out, &estimates)?;
+        if let Some(path) = &options.mcap {
+            write_estimates_mcap(path, &options.model, &command_line, &estimates)?;
         }
-        Ok((estimates, likelihoods))
-    })?;
-    for (id, ll, frames) in &likelihoods {
-        say!("trajectory {id}: {frames} frames filtered, log-likelihood {ll:.2}");
-    }
-    say!("wrote {} estimates to {}", estimates.len(), args.out.display());
-    if let Some(path) = &args.mcap {
-        say!("wrote means and covariances to {}", path.display());
-    }
-    Ok(())
+        Ok(FilterSummary { likelihoods, estimates: estimates.len(), out: options.out, mcap: options.mcap })
+    }))
 }

@@ -3,13 +3,15 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::bail;
 use clap::{Args, ValueEnum};
-use mbrl::control::BatchDynamics;
-use mbrl::envs::EnvName;
-use mbrl::models::pets::Propagation;
-use mbrl::models::{load_planning_model, RolloutOptions};
-use mbrl::train::{Accept, OpenedCheckpoint, TrainingProgress};
+
+use super::warn;
+use crate::control::BatchDynamics;
+use crate::envs::EnvName;
+use crate::models::pets::Propagation;
+use crate::models::{load_planning_model, RolloutOptions};
+use crate::train::{Accept, OpenedCheckpoint, TrainingProgress};
+use crate::{refuse, Result};
 
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
 pub enum PropagationChoice {
@@ -22,7 +24,7 @@ pub enum PropagationChoice {
 }
 
 #[derive(Args, Clone, Debug)]
-pub struct ModelArgs {
+pub struct ModelOptions {
     /// Dynamics the planner uses: `true` (the simulator's equations) or a checkpoint directory written by
     /// `mbrl train` (e.g. models/pets-pendulum).
     #[arg(long)]
@@ -42,17 +44,17 @@ pub struct ModelArgs {
     pub allow_incomplete: bool,
 }
 
-impl ModelArgs {
+impl ModelOptions {
     /// `None` for the ground truth.
-    pub fn load(&self, env: &EnvName) -> anyhow::Result<Option<Box<dyn BatchDynamics>>> {
+    pub fn load(&self, env: &EnvName) -> Result<Option<Box<dyn BatchDynamics>>> {
         if self.model == "true" {
             if self.context.is_some() {
-                bail!("--context conditions a learned context model; `--model true` plans with the simulator itself");
+                refuse!("--context conditions a learned context model; `--model true` plans with the simulator itself");
             }
             return Ok(None);
         }
         if !(1..=10_000).contains(&self.particles) {
-            bail!("--particles must be 1..=10000, got {}", self.particles);
+            refuse!("--particles must be 1..=10000, got {}", self.particles);
         }
         let propagation = match self.propagation {
             PropagationChoice::Ts1 => Propagation::Ts1,
@@ -61,7 +63,7 @@ impl ModelArgs {
         };
         let dir = PathBuf::from(&self.model);
         if !dir.exists() {
-            bail!(
+            refuse!(
                 "--model '{}': no such checkpoint directory; expected `true` or a directory written by `mbrl train`",
                 self.model
             );
@@ -97,7 +99,7 @@ pub fn accepting(allow_incomplete: bool) -> Accept {
 
 /// A one-line warning on stderr when a loaded model's training is unfinished (only `--allow-incomplete` lets
 /// such a model load).
-pub fn warn_if_unfinished(model: &Path) -> anyhow::Result<()> {
+pub fn warn_if_unfinished(model: &Path) -> Result<()> {
     report_unfinished(model, &OpenedCheckpoint::open(model)?.progress());
     Ok(())
 }
@@ -105,6 +107,6 @@ pub fn warn_if_unfinished(model: &Path) -> anyhow::Result<()> {
 /// As [`warn_if_unfinished`], for a caller that holds the loaded model's progress.
 pub fn report_unfinished(model: &Path, progress: &TrainingProgress) {
     if !progress.complete {
-        eprintln!("warning: {}: {}", model.display(), progress.describe());
+        warn(&format!("{}: {}", model.display(), progress.describe()));
     }
 }

@@ -1,9 +1,8 @@
 //! CEM flags shared by `plan` and `eval pendulum-swingup`.
 
+use super::finite_f64;
+use crate::planning::{CemConfig, NoiseKind};
 use clap::{Args, ValueEnum};
-use mbrl::planning::{CemConfig, NoiseKind};
-
-use crate::common::finite_f64;
 
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
 pub enum NoiseChoice {
@@ -16,7 +15,7 @@ pub enum NoiseChoice {
 /// Defaults are the task's planner: pendulum swing-up 20 / 1000 / 100 / 10, white, warm start; unicycle
 /// navigation (TRADYN) 30 / 1000 / 50 / 20, colored β 0.5, initial std 0.5, no warm start.
 #[derive(Args, Clone, Debug)]
-pub struct CemArgs {
+pub struct CemOptions {
     /// Planning horizon in steps (pendulum 20; unicycle 30, shrinking to the steps left).
     #[arg(long)]
     pub horizon: Option<usize>,
@@ -40,7 +39,7 @@ pub struct CemArgs {
     pub no_warm_start: bool,
 }
 
-impl CemArgs {
+impl CemOptions {
     /// The pendulum planner (Algorithm 1 defaults) over these flags.
     pub fn config(&self, action_low: &[f64], action_high: &[f64]) -> CemConfig {
         self.over(CemConfig::for_box(action_low, action_high))

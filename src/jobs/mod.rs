@@ -1,0 +1,18 @@
+//! What each subcommand does, below the shell. A job module holds the subcommand's options (declared with
+//! clap, so each flag's help is written where the flag is), the checks and defaults that turn them into work,
+//! and the typed summary the binary prints. `cmd/` parses the command line, picks the view (live TUI,
+//! progress lines or quiet) and prints; everything a command decides lives here, where scripts of the library
+//! and tests get the same behaviour as the command line.
+//!
+//! The one room that knows clap: the engine below never parses flags.
+
+pub mod cem_options;
+pub mod choices;
+mod common;
+pub mod export;
+pub mod filter;
+pub mod model_options;
+
+pub use common::{
+    check_output_file, file_stem, finite_f64, parse_floats, pendulum_variant, warn, Invocation, Job, STEP_RECORD_BYTES,
+};
