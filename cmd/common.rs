@@ -10,7 +10,7 @@ use mbrl::jobs::{Invocation, Job};
 use mbrl::run::{ChannelMonitor, ConsoleMonitor, Event, Monitor, NullMonitor};
 
 pub use mbrl::jobs::{check_output_file, file_stem, finite_f64, parse_floats, pendulum_variant};
-use mbrl::tui::{run_live, LiveOutcome};
+use mbrl::tui::{run_live, LiveOptions, LiveOutcome, DEFAULT_GRACE};
 
 #[derive(Args, Clone, Debug)]
 pub struct GlobalArgs {
@@ -20,9 +20,13 @@ pub struct GlobalArgs {
     /// Worker threads (0 = one per core).
     #[arg(long, global = true, default_value_t = 0)]
     pub threads: usize,
-    /// Show the live terminal view (default when stdout is a terminal).
+    /// Show the live terminal view (default when stdout is a terminal and MBRL_TUI is not `never`). It
+    /// opens once the work has run a second and closes by itself when the work ends.
     #[arg(long, global = true, overrides_with = "no_tui")]
     pub tui: bool,
+    /// Keep the live view open when the work ends, until q is pressed (also MBRL_TUI=hold).
+    #[arg(long, global = true)]
+    pub hold: bool,
     /// Print plain progress lines on stderr instead of the live view.
     #[arg(long, global = true, overrides_with = "tui")]
     pub no_tui: bool,
@@ -41,12 +45,41 @@ fn memory_gib(text: &str) -> Result<f64, String> {
     }
 }
 
+/// `MBRL_TUI` in the environment: the live view's default for every command, outside the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum TuiSetting {
+    /// On a terminal, as without the variable.
+    Auto,
+    /// Progress lines on stderr; `--tui` on a command line still asks for the view.
+    Never,
+    /// As `--hold` on every command.
+    Hold,
+}
+
+fn tui_setting() -> anyhow::Result<TuiSetting> {
+    match std::env::var("MBRL_TUI") {
+        Err(std::env::VarError::NotPresent) => Ok(TuiSetting::Auto),
+        Ok(value) => match value.as_str() {
+            "" | "auto" => Ok(TuiSetting::Auto),
+            "never" => Ok(TuiSetting::Never),
+            "hold" => Ok(TuiSetting::Hold),
+            other => anyhow::bail!("MBRL_TUI='{other}': expected never, auto or hold"),
+        },
+        Err(std::env::VarError::NotUnicode(_)) => anyhow::bail!("MBRL_TUI is not UTF-8: expected never, auto or hold"),
+    }
+}
+
 impl GlobalArgs {
     pub fn use_tui(&self) -> bool {
         if self.quiet || self.no_tui {
             return false;
         }
-        self.tui || std::io::stdout().is_terminal()
+        self.tui || (tui_setting().ok() != Some(TuiSetting::Never) && std::io::stdout().is_terminal())
+    }
+
+    /// How the live view opens and closes: after a grace second, closing by itself unless held.
+    pub fn live_options(&self) -> LiveOptions {
+        LiveOptions { hold: self.hold || tui_setting().ok() == Some(TuiSetting::Hold), grace: DEFAULT_GRACE }
     }
 
     pub fn thread_count(&self) -> usize {
@@ -70,6 +103,7 @@ fn has_terminal() -> bool {
 const MAX_THREADS: usize = 1024;
 
 pub fn init_threads(global: &GlobalArgs) -> anyhow::Result<()> {
+    tui_setting()?;
     if global.threads > MAX_THREADS {
         anyhow::bail!("--threads {}: at most {MAX_THREADS} worker threads (0 = one per core)", global.threads);
     }
@@ -135,7 +169,7 @@ pub fn run_job<T: Send>(
             monitor.emit(&Event::Finished { ok: result.is_ok() });
             result
         });
-        let outcome = run_live(receiver, cancel.clone(), title).context("terminal view failed");
+        let outcome = run_live(receiver, cancel.clone(), title, global.live_options()).context("terminal view failed");
         let result = worker.join().map_err(|_| anyhow::anyhow!("the job panicked"))?;
         match outcome? {
             LiveOutcome::QuitByUser | LiveOutcome::Finished => Ok(result?),

@@ -9,9 +9,10 @@ use std::time::Duration;
 use anyhow::Context;
 use clap::Args;
 use mbrl::run::dir::METRICS_FILE;
+use mbrl::run::lock::{RunLock, LOCK_FILE};
 use mbrl::run::follow::{latest_progress_only, MetricsFollower};
 use mbrl::run::Event;
-use mbrl::tui::run_live;
+use mbrl::tui::{run_live, LiveOptions};
 
 use crate::common::GlobalArgs;
 
@@ -30,7 +31,7 @@ pub fn run(global: &GlobalArgs, args: WatchArgs) -> anyhow::Result<()> {
     let path = if args.run_dir.is_dir() { args.run_dir.join(METRICS_FILE) } else { args.run_dir.clone() };
     let mut follower = MetricsFollower::open(&path)?;
     if !global.use_tui() {
-        return print_summary(&follower.poll()?);
+        return print_summary(&follower.poll()?, &unfinished_status(&path));
     }
     let (sender, receiver) = std::sync::mpsc::channel();
     let cancel = Arc::new(AtomicBool::new(false));
@@ -54,21 +55,36 @@ pub fn run(global: &GlobalArgs, args: WatchArgs) -> anyhow::Result<()> {
             }
             Ok(())
         });
-        run_live(receiver, cancel.clone(), &title).context("terminal view failed")?;
+        // Watching is for reading: the view stays until q, even after the run ends.
+        let options = LiveOptions { hold: true, grace: Duration::ZERO };
+        run_live(receiver, cancel.clone(), &title, options).context("terminal view failed")?;
         cancel.store(true, Ordering::Relaxed);
         reader.join().map_err(|_| anyhow::anyhow!("the metrics reader panicked"))??;
         Ok(())
     })
 }
 
+/// What a stream without its end means: a training run's lock tells running from stopped; other runs (eval
+/// reports) keep no lock, so for them it cannot be told.
+fn unfinished_status(metrics: &std::path::Path) -> String {
+    let dir = metrics.parent().unwrap_or(std::path::Path::new("."));
+    if RunLock::is_held(dir) {
+        "running".to_string()
+    } else if dir.join(LOCK_FILE).is_file() {
+        format!("stopped; continue with `mbrl train --resume {}`", dir.display())
+    } else {
+        "running (or stopped without finishing)".to_string()
+    }
+}
+
 /// Last value of each scalar, the latest progress, messages, the latest text of each text panel and
 /// whether the run finished.
-fn print_summary(events: &[Event]) -> anyhow::Result<()> {
+fn print_summary(events: &[Event], unfinished: &str) -> anyhow::Result<()> {
     let mut last: BTreeMap<&str, (u64, f64, usize)> = BTreeMap::new();
     let mut progress: Vec<(&str, u64, u64)> = Vec::new();
     // Printed once at the end, not as they come: a board redrawn every step would flood the summary.
     let mut texts: Vec<(&str, &str)> = Vec::new();
-    let mut status = "running (or stopped without finishing)";
+    let mut status = unfinished;
     for event in events {
         match event {
             Event::Layout { title, .. } => say!("{title}"),

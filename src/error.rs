@@ -32,6 +32,8 @@ pub enum ErrorKind {
     Diverged { step: Option<u64>, loss: Option<f64>, message: String },
     /// The user asked the job to stop.
     Cancelled,
+    /// The user stopped a training run, which kept its checkpoint at `step` of `total` and can go on.
+    Stopped { step: u64, total: u64 },
 }
 
 /// Where an error happened, outermost first: the files and fields it was read from.
@@ -67,7 +69,7 @@ impl Error {
     }
 
     pub fn is_cancelled(&self) -> bool {
-        matches!(self.kind, ErrorKind::Cancelled)
+        matches!(self.kind, ErrorKind::Cancelled | ErrorKind::Stopped { .. })
     }
 
     /// The innermost file the error names, if any.
@@ -108,6 +110,10 @@ impl Error {
 
     pub fn cancelled() -> Self {
         Error::new(ErrorKind::Cancelled)
+    }
+
+    pub fn stopped(step: u64, total: u64) -> Self {
+        Error::new(ErrorKind::Stopped { step, total })
     }
 
     pub fn diverged(message: impl Into<String>) -> Self {
@@ -158,6 +164,10 @@ impl fmt::Display for Error {
             }
             ErrorKind::Budget { message, .. } | ErrorKind::Diverged { message, .. } => f.write_str(message),
             ErrorKind::Cancelled => f.write_str("cancelled by the user"),
+            ErrorKind::Stopped { step, total } => {
+                let dir = self.path().map(|p| p.display().to_string()).unwrap_or_else(|| "DIR".into());
+                write!(f, "stopped at step {step} of {total}; continue with `mbrl train --resume {dir}`")
+            }
         }
     }
 }

@@ -10,8 +10,9 @@ use super::fit::{fit, DirCheckpointer, FitSettings, TrainingMethod, CONFIG_FILE,
 use super::method::{Method, Prepared, Request, RunConfig, RunRecord, Trained};
 use super::run_dir::Decision;
 use super::OpenedCheckpoint;
-use crate::error::{Error, Result};
+use crate::error::{Error, ErrorKind, Result};
 use crate::run::dir::{Provenance, METRICS_FILE};
+use crate::run::lock::RunLock;
 use crate::run::{Event, JsonlMonitor, Monitor, Tee};
 
 /// A billion optimizer steps: beyond any training budget, so a larger count is a typo or a corrupt config.
@@ -88,6 +89,10 @@ pub fn start<M: Method>(out: &Path, request: &Request<M>, monitor: &dyn Monitor)
 /// Continues the run in `dir` from its last checkpoint with the config, data and seed it was started with;
 /// with `extension`, on to a larger total (only for [`Method::EXTENDABLE`] methods).
 pub fn resume<M: Method>(dir: &Path, extension: Option<&Extension>, monitor: &dyn Monitor) -> Result<Trained<M>> {
+    // A run still going is named as such before its half-written state is judged.
+    if dir.is_dir() {
+        RunLock::ensure_free(dir)?;
+    }
     let opened = OpenedCheckpoint::open(dir)?;
     opened.expect_method(M::NAME)?;
     let record = RunRecord::<M>::read(&opened)?;
@@ -170,6 +175,12 @@ fn run<M: Method>(dir: &Path, request: &Request<M>, start: Start, monitor: &dyn 
     for event in &view {
         monitor.emit(event);
     }
+    // Taken once the data is ready and before the first write: a run that fails to prepare leaves nothing.
+    let _lock = RunLock::acquire(dir)?;
+    let stopped_dir = dir.to_path_buf();
+    let _note = crate::util::interrupt::explain_interruption(move || {
+        Some(name_the_stop(Error::cancelled(), &stopped_dir)).filter(|e| e.path().is_some()).map(|e| e.to_string())
+    });
     if start == Start::Fresh {
         let ckpt = CheckpointDir::start(dir)?;
         let entry = ckpt.write_file(CONFIG_FILE, &config_bytes)?;
@@ -180,7 +191,7 @@ fn run<M: Method>(dir: &Path, request: &Request<M>, start: Start, monitor: &dyn 
         }
         let tee = Tee { first: monitor, second: &metrics };
         let mut checkpoints = DirCheckpointer { dir: &ckpt, config_entry: &entry, metrics: &metrics };
-        let outcome = fit(&mut trainer, &settings, &mut checkpoints, None, &tee)?;
+        let outcome = fit(&mut trainer, &settings, &mut checkpoints, None, &tee).map_err(|e| name_the_stop(e, dir))?;
         metrics.emit(&Event::Finished { ok: true });
         return Ok(Trained { record, outcome, trainer });
     }
@@ -213,9 +224,24 @@ fn run<M: Method>(dir: &Path, request: &Request<M>, start: Start, monitor: &dyn 
     monitor.message(&format!("resuming at step {} of {}", point.step, settings.total_steps));
     let tee = Tee { first: monitor, second: &metrics };
     let mut checkpoints = DirCheckpointer { dir: &opened.dir, config_entry: &entry, metrics: &metrics };
-    let outcome = fit(&mut trainer, &settings, &mut checkpoints, Some(point), &tee)?;
+    let outcome =
+        fit(&mut trainer, &settings, &mut checkpoints, Some(point), &tee).map_err(|e| name_the_stop(e, dir))?;
     metrics.emit(&Event::Finished { ok: true });
     Ok(Trained { record, outcome, trainer })
+}
+
+/// A run the user stopped says where it stands and how to go on, from the checkpoint it keeps; one stopped
+/// before its first checkpoint has nothing to go on from and stays a plain cancellation.
+fn name_the_stop(err: Error, dir: &Path) -> Error {
+    if !matches!(err.kind(), ErrorKind::Cancelled) {
+        return err;
+    }
+    match OpenedCheckpoint::open(dir) {
+        Ok(opened) if !opened.manifest.complete => {
+            Error::stopped(opened.manifest.step, opened.manifest.total_steps).at(dir)
+        }
+        _ => err,
+    }
 }
 
 /// A plain resume needs an unfinished checkpoint of exactly this config; returns the config's manifest entry.

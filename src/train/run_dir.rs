@@ -9,6 +9,7 @@ use super::job::MAX_TRAIN_STEPS;
 use super::method::{Method, Request};
 use super::{Extension, OpenedCheckpoint, CONFIG_FILE};
 use crate::error::{Error, Result};
+use crate::run::lock::RunLock;
 
 /// How a `train` command goes on in its output directory.
 #[derive(Clone, Debug)]
@@ -39,6 +40,9 @@ impl Field {
 /// stopped run goes on when `request` is what started it, and only then. A directory whose checkpoint cannot be
 /// read holds no run and is replaced, as a finished one is.
 pub fn decide<M: Method>(out: &Path, request: &Request<M>, resume_if_stopped: bool) -> Result<Decision> {
+    if out.is_dir() {
+        RunLock::ensure_free(out)?;
+    }
     let Ok(opened) = OpenedCheckpoint::open(out) else {
         return Ok(Decision::Fresh);
     };

@@ -14,4 +14,4 @@ pub mod terminal;
 mod text_panel;
 
 pub use app::App;
-pub use terminal::{run_live, LiveOutcome};
+pub use terminal::{run_live, LiveOptions, LiveOutcome, DEFAULT_GRACE};

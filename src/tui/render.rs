@@ -237,10 +237,28 @@ fn paint_background(frame: &mut Frame, area: Rect, background: &crate::run::Back
 }
 
 /// The text verbatim. No wrapping: a wrapped row would break a board's grid, so long lines are cut at
-/// the border instead, and lines beyond the panel's height are left out.
+/// the last whole item that fits instead, and lines beyond the panel's height are left out.
 fn render_text_panel(panel: &TextPanel, frame: &mut Frame, area: Rect) {
     let block = Block::bordered().title(format!(" {} ", panel.name));
-    frame.render_widget(Paragraph::new(panel.text.as_str()).block(block), area);
+    let width = usize::from(block.inner(area).width);
+    let lines: Vec<Line> = panel.text.lines().map(|line| Line::from(fit_whole_items(line, width))).collect();
+    frame.render_widget(Paragraph::new(lines).block(block), area);
+}
+
+/// `line` cut to `width` characters at a space, so a value shows whole or not at all (a step range of
+/// 1500-3000 never reads as 1500-300); the cut is marked with an ellipsis.
+fn fit_whole_items(line: &str, width: usize) -> String {
+    if line.chars().count() <= width {
+        return line.to_string();
+    }
+    if width == 0 {
+        return String::new();
+    }
+    let room = width - 1;
+    let head: String = line.chars().take(room).collect();
+    let cut_at_space = line.chars().nth(room).is_some_and(char::is_whitespace);
+    let kept = if cut_at_space { head.as_str() } else { head.rfind(char::is_whitespace).map_or("", |at| &head[..at]) };
+    format!("{}…", kept.trim_end())
 }
 
 fn messages_height(app: &App) -> u16 {
@@ -348,6 +366,20 @@ mod tests {
 
         app.ingest(&Event::Finished { ok: false });
         assert!(draw(&app, 100, 20).contains("failed — press q to quit"));
+    }
+
+    #[test]
+    fn long_text_lines_lose_whole_items_never_digits() {
+        assert_eq!(fit_whole_items("kl ramp  steps 1500-3000", 22), "kl ramp  steps…");
+        assert_eq!(fit_whole_items("kl ramp  steps 1500-3000", 24), "kl ramp  steps 1500-3000");
+        assert_eq!(fit_whole_items("kl ramp  steps 1500-3000", 15), "kl ramp  steps…");
+        assert_eq!(fit_whole_items("kl ramp  steps 1500-3000", 14), "kl ramp…");
+        assert_eq!(fit_whole_items("1500-3000", 5), "…");
+        assert_eq!(fit_whole_items("1500-3000", 0), "");
+        let mut app = App::new("train context");
+        app.ingest(&Event::text("settings", "lr           0.001\nkl schedule  steps 1500-3000, then 1"));
+        let screen = draw(&app, 30, 24);
+        assert!(screen.contains("kl schedule  steps…") && !screen.contains("1500"), "{screen}");
     }
 
     #[test]

@@ -4,7 +4,7 @@
 use std::io::{self, Stdout};
 use std::panic;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::mpsc::{Receiver, TryRecvError};
+use std::sync::mpsc::{Receiver, RecvTimeoutError, TryRecvError};
 use std::sync::{Arc, Once};
 use std::time::{Duration, Instant};
 
@@ -20,7 +20,7 @@ use crate::run::Event;
 /// How the live view ended.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LiveOutcome {
-    /// The job finished (or hung up) and the user then closed the view.
+    /// The job finished (or hung up): the view closed by itself, or the user closed a held view.
     Finished,
     /// The user quit while the job was running; `cancel` has been set.
     QuitByUser,
@@ -41,12 +41,35 @@ static PANIC_HOOK: Once = Once::new();
 
 type LiveTerminal = Terminal<CrosstermBackend<Stdout>>;
 
-/// Shows the job's events live until the user quits. Quitting before the job finished sets `cancel`.
-/// An `Err` means the terminal failed; the terminal is restored but `cancel` is left to the caller.
-pub fn run_live(events: Receiver<Event>, cancel: Arc<AtomicBool>, title: &str) -> io::Result<LiveOutcome> {
-    let mut screen = Screen::take()?;
+/// When the live view opens and closes.
+#[derive(Clone, Copy, Debug)]
+pub struct LiveOptions {
+    /// Keep the view on screen after the job ends, until the user presses q, for reading its final state.
+    /// Without it the view closes by itself, so `mbrl a && mbrl b` runs unattended.
+    pub hold: bool,
+    /// Open the view only if the job is still running after this long, so a quick command never flashes
+    /// a screen; what arrived meanwhile is shown once it opens.
+    pub grace: Duration,
+}
+
+/// How long a job may run before the live view opens: below about a second a full-screen flash is noise.
+pub const DEFAULT_GRACE: Duration = Duration::from_secs(1);
+
+/// Shows the job's events live until it ends (or, with `hold`, until the user quits). Quitting before the
+/// job finished sets `cancel`. An `Err` means the terminal failed; the terminal is restored but `cancel` is
+/// left to the caller.
+pub fn run_live(
+    events: Receiver<Event>,
+    cancel: Arc<AtomicBool>,
+    title: &str,
+    options: LiveOptions,
+) -> io::Result<LiveOutcome> {
     let mut app = App::new(title);
-    let outcome = event_loop(&mut screen.terminal, &mut app, &events)?;
+    if !options.hold && ends_within(&events, &mut app, options.grace) {
+        return Ok(LiveOutcome::Finished);
+    }
+    let mut screen = Screen::take()?;
+    let outcome = event_loop(&mut screen.terminal, &mut app, &events, options.hold)?;
     if outcome == LiveOutcome::QuitByUser {
         cancel.store(true, Ordering::Relaxed);
     }
@@ -114,7 +137,32 @@ fn install_panic_hook() {
     });
 }
 
-fn event_loop(terminal: &mut LiveTerminal, app: &mut App, events: &Receiver<Event>) -> io::Result<LiveOutcome> {
+/// Ingests events for up to `grace`; true when the job ended within it.
+fn ends_within(events: &Receiver<Event>, app: &mut App, grace: Duration) -> bool {
+    let deadline = Instant::now() + grace;
+    loop {
+        match events.recv_timeout(deadline.saturating_duration_since(Instant::now())) {
+            Ok(event) => {
+                app.ingest(&event);
+                if app.is_finished() {
+                    return true;
+                }
+            }
+            Err(RecvTimeoutError::Timeout) => return false,
+            Err(RecvTimeoutError::Disconnected) => {
+                app.mark_ended();
+                return true;
+            }
+        }
+    }
+}
+
+fn event_loop(
+    terminal: &mut LiveTerminal,
+    app: &mut App,
+    events: &Receiver<Event>,
+    hold: bool,
+) -> io::Result<LiveOutcome> {
     let mut connected = true;
     loop {
         if !TERMINAL_TAKEN.load(Ordering::SeqCst) {
@@ -122,6 +170,9 @@ fn event_loop(terminal: &mut LiveTerminal, app: &mut App, events: &Receiver<Even
         }
         if connected {
             connected = drain(events, app, DRAIN_BUDGET);
+        }
+        if app.is_finished() && !hold {
+            return Ok(LiveOutcome::Finished);
         }
         terminal.draw(|frame| render(app, frame))?;
         if wait_for_quit(app, FRAME_INTERVAL)? {
@@ -185,6 +236,26 @@ mod tests {
         assert!(drain(&rx, &mut app, GENEROUS));
         assert_eq!(app.metric_names(), vec!["loss", "reward"]);
         assert!(!app.is_finished());
+    }
+
+    #[test]
+    fn a_job_that_ends_within_the_grace_never_opens_the_view() {
+        let (tx, rx) = mpsc::channel();
+        tx.send(Event::message("quick")).expect("send");
+        tx.send(Event::Finished { ok: true }).expect("send");
+        let mut app = App::new("t");
+        assert!(ends_within(&rx, &mut app, GENEROUS));
+        assert!(app.is_finished());
+    }
+
+    #[test]
+    fn a_job_still_running_after_the_grace_opens_the_view_with_what_it_sent() {
+        let (tx, rx) = mpsc::channel();
+        tx.send(Event::scalar("loss", 0, 1.0)).expect("send");
+        let mut app = App::new("t");
+        assert!(!ends_within(&rx, &mut app, Duration::from_millis(20)));
+        assert_eq!(app.metric_names(), vec!["loss"]);
+        drop(tx);
     }
 
     #[test]

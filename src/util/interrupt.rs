@@ -16,6 +16,12 @@ pub const INTERRUPTED_EXIT: i32 = 130;
 static PARTIALS: Mutex<BTreeSet<PathBuf>> = Mutex::new(BTreeSet::new());
 static HOOKS: Mutex<Vec<fn()>> = Mutex::new(Vec::new());
 
+/// What the work in progress has to say when it is interrupted (a training run: where it stopped and how to
+/// go on), by registration id.
+type Note = Box<dyn Fn() -> Option<String> + Send>;
+static NOTES: Mutex<Vec<(u64, Note)>> = Mutex::new(Vec::new());
+static NEXT_NOTE: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
 /// A poisoned lock only means another thread panicked mid-update of a plain set; the set is still usable.
 fn lock<T>(m: &'static Mutex<T>) -> MutexGuard<'static, T> {
     m.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
@@ -33,7 +39,30 @@ pub fn install() -> std::io::Result<()> {
 }
 
 fn abandon_and_exit() -> ! {
-    abandon_and_exit_with(INTERRUPTED_EXIT, "interrupted; temporary files removed, finished outputs kept")
+    let notes: Vec<String> = lock(&NOTES).iter().filter_map(|(_, note)| note()).collect();
+    let message = match notes.is_empty() {
+        true => "interrupted; temporary files removed, finished outputs kept".to_string(),
+        false => format!("interrupted; {}", notes.join("; ")),
+    };
+    abandon_and_exit_with(INTERRUPTED_EXIT, &message)
+}
+
+/// Has `note` asked, on interruption, for a line that replaces the plain "interrupted" (a training run names
+/// the step its checkpoint holds and the command that continues it), until the guard drops.
+pub fn explain_interruption(note: impl Fn() -> Option<String> + Send + 'static) -> NoteGuard {
+    let id = NEXT_NOTE.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    lock(&NOTES).push((id, Box::new(note)));
+    NoteGuard { id }
+}
+
+pub struct NoteGuard {
+    id: u64,
+}
+
+impl Drop for NoteGuard {
+    fn drop(&mut self) {
+        lock(&NOTES).retain(|(id, _)| *id != self.id);
+    }
 }
 
 /// Ends the process now, the way an interruption does, with `status` and `error: {message}` on stderr.

@@ -79,13 +79,14 @@ impl mbrl::run::Monitor for StopAfter {
     }
 }
 
-/// Every file of a run directory but the loss table and plot, which only the command line draws.
+/// Every file of a run directory but the loss table and plot, which only the command line draws, and the
+/// lock file, which names the process that last wrote there.
 #[allow(dead_code)]
 pub fn dir_bytes(dir: &Path) -> Vec<(String, Vec<u8>)> {
     let mut names: Vec<_> = std::fs::read_dir(dir)
         .unwrap()
         .map(|e| e.unwrap().file_name().into_string().unwrap())
-        .filter(|n| n != "loss.png" && n != "losses.csv")
+        .filter(|n| n != "loss.png" && n != "losses.csv" && n != ".mbrl-lock")
         .collect();
     names.sort();
     names.into_iter().map(|n| (n.clone(), std::fs::read(dir.join(&n)).unwrap())).collect()

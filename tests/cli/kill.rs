@@ -228,3 +228,41 @@ fn interrupted_and_killed_commands_leave_whole_outputs() {
     }
     println!("{}", outcomes.join("\n"));
 }
+
+/// A run directory being trained into is locked: a second `train` or a `--resume` there is refused naming the
+/// process, and once that process is stopped its interruption says how to go on and the run resumes.
+#[test]
+fn a_run_directory_in_use_refuses_a_second_writer_naming_its_pid() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("tiny.toml"), TINY_PETS).unwrap();
+    let collect = ["collect", "--env", "pendulum", "--rollouts", "20", "--steps", "30", "-q", "--out", "train.mcap"];
+    let out = mbrl(d).args(collect).output().unwrap();
+    assert!(out.status.success(), "{}", stderr_of(&out));
+    let mut long_run = args(Job::Train);
+    let steps = long_run.iter().position(|a| *a == "600").unwrap();
+    long_run[steps] = "1000000";
+    let mut child = spawn(d, &long_run);
+    let first_checkpoint = d.join("models/p/checkpoint.json");
+    let start = Instant::now();
+    while !first_checkpoint.exists() {
+        assert!(start.elapsed() < Duration::from_secs(60), "the first run never checkpointed");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let pid = format!("in use by pid {}", child.id());
+    for second in [&long_run[..], &["train", "--resume", "models/p"]] {
+        let out = mbrl(d).args(second).args(["--no-tui", "-q"]).output().unwrap();
+        assert!(!out.status.success());
+        assert!(stderr_of(&out).contains(&pid), "{second:?}: {}", stderr_of(&out));
+    }
+    Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap();
+    let status = wait(&mut child);
+    assert_eq!(status.code(), Some(130));
+    let mut stderr = String::new();
+    std::io::Read::read_to_string(child.stderr.as_mut().unwrap(), &mut stderr).unwrap();
+    assert!(stderr.contains("of 1000000; continue with `mbrl train --resume models/p`"), "{stderr}");
+    let out = mbrl(d).args(&long_run).args(["--no-tui", "-q"]).output().unwrap();
+    assert!(stderr_of(&out).contains("holds a pets run stopped at step"), "{}", stderr_of(&out));
+    let out = mbrl(d).args(["watch", "models/p", "--no-tui"]).output().unwrap();
+    assert!(stdout_of(&out).contains("status: stopped; continue with `mbrl train --resume models/p`"), "{}", stdout_of(&out));
+}
