@@ -57,7 +57,7 @@ pub struct Cli {
 enum Command {
     Collect(collect::CollectArgs),
     Plan(plan::PlanArgs),
-    Train(train::TrainArgs),
+    Train(mbrl::jobs::train::TrainOptions),
     Calibrate(calibrate::CalibrateArgs),
     Filter(mbrl::jobs::filter::FilterOptions),
     Predict(predict::PredictArgs),
@@ -81,7 +81,12 @@ fn main() {
     let outcome = common::init_threads(&cli.global).and_then(|()| match cli.command {
         Command::Collect(args) => collect::run(&cli.global, args),
         Command::Plan(args) => plan::run(&cli.global, args),
-        Command::Train(args) => train::run(&cli.global, args),
+        Command::Train(args) => match mbrl::jobs::train::prepare(args, &cli.global.invocation())? {
+            Some(job) => common::show(&cli.global, job),
+            None => exit_on_usage_error(
+                Cli::command().error(clap::error::ErrorKind::MissingSubcommand, mbrl::jobs::train::MISSING_METHOD),
+            ),
+        },
         Command::Calibrate(args) => calibrate::run(&cli.global, args),
         Command::Filter(args) => {
             common::show(&cli.global, mbrl::jobs::filter::prepare(args, &cli.global.invocation())?)

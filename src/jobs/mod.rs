@@ -12,6 +12,7 @@ mod common;
 pub mod export;
 pub mod filter;
 pub mod model_options;
+pub mod train;
 
 pub use common::{
     check_output_file, file_stem, finite_f64, parse_floats, pendulum_variant, warn, Invocation, Job, STEP_RECORD_BYTES,

@@ -3,14 +3,15 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use mbrl::models::dlgpd::config::Preset as DlgpdPreset;
-use mbrl::models::dlgpd::job::Dlgpd;
-use mbrl::models::dlgpd::options::{default_out_dir, DlgpdOptions};
-use mbrl::train::Request;
 
-use super::shared::{check_steps, provenance, train, RunArgs};
+use super::shared::{check_steps, train, RunOptions, TrainSummary};
 use super::ScalePreset;
-use crate::common::GlobalArgs;
+use crate::jobs::{Invocation, Job};
+use crate::models::dlgpd::config::Preset as DlgpdPreset;
+use crate::models::dlgpd::job::Dlgpd;
+use crate::models::dlgpd::options::{self as dlgpd_options, default_out_dir};
+use crate::train::Request;
+use crate::Result;
 
 #[derive(Args, Debug)]
 #[command(
@@ -24,7 +25,7 @@ Examples:
   mbrl train dlgpd --data datasets/pendulum-frames.mcap --preset medium --out models/dlgpd-medium
   mbrl train --resume models/dlgpd-medium --steps 30000"
 )]
-pub struct DlgpdArgs {
+pub struct DlgpdOptions {
     /// Pendulum rollouts (.mcap), merged (repeatable): with frames (`collect --images`) for the medium and
     /// paper presets, any for the small one.
     #[arg(long, required = true)]
@@ -45,33 +46,33 @@ pub struct DlgpdArgs {
     #[arg(long)]
     batch: Option<usize>,
     /// Adam learning rate (default 1e-3).
-    #[arg(long, value_parser = crate::common::finite_f64)]
+    #[arg(long, value_parser = crate::jobs::finite_f64)]
     lr: Option<f64>,
     #[command(flatten)]
-    run: RunArgs,
+    run: RunOptions,
 }
 
-pub fn run(global: &GlobalArgs, args: DlgpdArgs) -> anyhow::Result<()> {
-    check_steps(args.steps)?;
-    let options = DlgpdOptions {
-        preset: args.preset.map(|p| match p {
+pub fn prepare(options: DlgpdOptions, invocation: &Invocation) -> Result<Job<'static, TrainSummary>> {
+    check_steps(options.steps)?;
+    let settings = dlgpd_options::DlgpdOptions {
+        preset: options.preset.map(|p| match p {
             ScalePreset::Small => DlgpdPreset::Small,
             ScalePreset::Medium => DlgpdPreset::Medium,
             ScalePreset::Paper => DlgpdPreset::Paper,
         }),
-        config_file: args.config.clone(),
-        steps: args.steps,
-        batch_size: args.batch,
-        learning_rate: args.lr,
+        config_file: options.config,
+        steps: options.steps,
+        batch_size: options.batch,
+        learning_rate: options.lr,
     };
     let request = Request::<Dlgpd> {
-        env: args.env.clone(),
-        data: args.data.clone(),
-        seed: global.seed,
-        config: options.config()?,
+        env: options.env,
+        data: options.data,
+        seed: invocation.seed,
+        config: settings.config()?,
         variant: (),
-        provenance: provenance(global),
+        provenance: invocation.provenance(),
     };
-    let out = args.run.out.clone().unwrap_or_else(default_out_dir);
-    train(global, &out, &request, args.run.resume_if_stopped)
+    let out = options.run.out.unwrap_or_else(default_out_dir);
+    train(out, request, options.run.resume_if_stopped)
 }

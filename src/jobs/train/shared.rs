@@ -1,21 +1,25 @@
 //! The flags every method's training takes, and the one way a `train <method>` command runs.
 
-use std::path::{Path, PathBuf};
+use std::fmt::Display;
+use std::path::PathBuf;
 
-use anyhow::bail;
 use clap::Args;
-use mbrl::eval::training::write_loss_report;
-use mbrl::models::registry::{self, ModelMethod};
-use mbrl::run::dir::Provenance;
-use mbrl::train::run_dir::{decide, Decision};
-use mbrl::train::Request;
 
-use crate::common::{command_line, run_job, GlobalArgs};
+use crate::eval::training::write_loss_report;
+use crate::jobs::Job;
+use crate::models::registry::{self, ModelMethod};
+use crate::train::run_dir::{decide, Decision};
+use crate::train::Request;
+use crate::{refuse, Result};
+
+/// What a training run reports: the method's own summary (a resumed run's method is known only from its
+/// checkpoint, so the type is erased for all of them).
+pub type TrainSummary = Box<dyn Display + Send>;
 
 /// Flattened into each method's flags; `--seed`, `--threads` and the display flags are global.
 #[derive(Args, Debug)]
 #[command(next_help_heading = "Run options")]
-pub struct RunArgs {
+pub struct RunOptions {
     /// Checkpoint directory (default: models/ and a name from the method and env). A stopped run there is
     /// never replaced: a new run refuses it.
     #[arg(long, value_name = "DIR")]
@@ -28,34 +32,29 @@ pub struct RunArgs {
 }
 
 /// A zero total passes clap's u64 parser, and would make a run that writes no model.
-pub fn check_steps(steps: Option<u64>) -> anyhow::Result<()> {
+pub fn check_steps(steps: Option<u64>) -> Result<()> {
     if steps == Some(0) {
-        bail!("--steps must be at least 1");
+        refuse!("--steps must be at least 1");
     }
     Ok(())
 }
 
-/// This command's provenance.
-pub fn provenance(global: &GlobalArgs) -> Provenance {
-    Provenance::new(command_line(), global.seed, global.thread_count())
-}
-
 /// Trains `request` into `out`, or resumes the stopped run there when asked and it is this command's, then
-/// leaves the loss plot beside the checkpoint and prints the method's summary.
+/// leaves the loss plot beside the checkpoint. Whether `out` may be used is decided before the job is made.
 pub fn train<M: ModelMethod>(
-    global: &GlobalArgs,
-    out: &Path,
-    request: &Request<M>,
+    out: PathBuf,
+    request: Request<M>,
     resume_if_stopped: bool,
-) -> anyhow::Result<()> {
-    let decision = decide(out, request, resume_if_stopped)?;
+) -> Result<Job<'static, TrainSummary>> {
+    let decision = decide(&out, &request, resume_if_stopped)?;
     let title = match decision {
         Decision::Fresh => format!("train {}", M::NAME),
         Decision::Resume(_) => format!("train {} (resumed)", M::NAME),
     };
-    let summary = run_job(global, &title, |monitor| registry::train(out, request, &decision, monitor))?;
-    let (plot_title, y_label) = M::LOSS_PLOT;
-    write_loss_report(out, plot_title, y_label)?;
-    say!("{summary}");
-    Ok(())
+    Ok(Job::new(title, move |monitor| {
+        let summary = registry::train(&out, &request, &decision, monitor)?;
+        let (plot_title, y_label) = M::LOSS_PLOT;
+        write_loss_report(&out, plot_title, y_label)?;
+        Ok(Box::new(summary) as TrainSummary)
+    }))
 }

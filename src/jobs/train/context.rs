@@ -3,18 +3,19 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use mbrl::models::context::options::ContextOptions;
-use mbrl::models::context::{self, Context};
-use mbrl::models::tradyn::{self, Tradyn};
-use mbrl::train::Request;
 
-use super::shared::{check_steps, provenance, train, RunArgs};
+use super::shared::{check_steps, train, RunOptions, TrainSummary};
 use super::ScalePreset;
-use crate::common::GlobalArgs;
+use crate::jobs::{Invocation, Job};
+use crate::models::context::options::ContextOptions as ContextSettings;
+use crate::models::context::{self, Context};
+use crate::models::tradyn::{self, Tradyn};
+use crate::train::Request;
+use crate::Result;
 
 /// The flags context and TRADYN share: the model and its training are the same.
 #[derive(Args, Debug)]
-pub struct ModelOptions {
+pub struct ContextModelOptions {
     /// Hyperparameters from a TOML file (keys of config.json's `config` table), over the preset's.
     #[arg(long)]
     config: Option<PathBuf>,
@@ -28,7 +29,7 @@ pub struct ModelOptions {
     #[arg(long)]
     batch: Option<usize>,
     /// Adam learning rate (default: the preset's).
-    #[arg(long, value_parser = crate::common::finite_f64)]
+    #[arg(long, value_parser = crate::jobs::finite_f64)]
     lr: Option<f64>,
 }
 
@@ -42,7 +43,7 @@ Examples:
   mbrl train context --data datasets/toy-inner.mcap --preset small --out models/context-toy-inner
   mbrl calibrate --model models/context-toy-inner --env toy:inner --instance-seed 3"
 )]
-pub struct ContextArgs {
+pub struct ContextOptions {
     /// An instance-pair dataset (.mcap) from `mbrl collect --instances N`.
     #[arg(long)]
     data: PathBuf,
@@ -50,9 +51,9 @@ pub struct ContextArgs {
     #[arg(long)]
     env: Option<String>,
     #[command(flatten)]
-    model: ModelOptions,
+    model: ContextModelOptions,
     #[command(flatten)]
-    run: RunArgs,
+    run: RunOptions,
 }
 
 #[derive(Args, Debug)]
@@ -66,7 +67,7 @@ Examples:
   mbrl train tradyn --data datasets/unicycle-train.mcap --preset small --out models/tradyn-terrain
   mbrl train tradyn --no-terrain --data datasets/unicycle-train.mcap --preset small --out models/tradyn-no-terrain"
 )]
-pub struct TradynArgs {
+pub struct TradynOptions {
     /// A unicycle instance-pair dataset (.mcap): `collect --env unicycle --maps DIR --split train --instances N`.
     #[arg(long)]
     data: PathBuf,
@@ -77,14 +78,14 @@ pub struct TradynArgs {
     #[arg(long)]
     no_terrain: bool,
     #[command(flatten)]
-    model: ModelOptions,
+    model: ContextModelOptions,
     #[command(flatten)]
-    run: RunArgs,
+    run: RunOptions,
 }
 
-impl ModelOptions {
-    fn options(&self) -> ContextOptions {
-        ContextOptions {
+impl ContextModelOptions {
+    fn settings(&self) -> ContextSettings {
+        ContextSettings {
             preset: self.preset.map(|p| match p {
                 ScalePreset::Small => context::Preset::Small,
                 ScalePreset::Medium => context::Preset::Medium,
@@ -98,46 +99,46 @@ impl ModelOptions {
     }
 }
 
-pub fn run_context(global: &GlobalArgs, args: ContextArgs) -> anyhow::Result<()> {
-    check_steps(args.model.steps)?;
-    let data = &args.data;
-    let planned = args.model.options().plan(
+pub fn prepare_context(options: ContextOptions, invocation: &Invocation) -> Result<Job<'static, TrainSummary>> {
+    check_steps(options.model.steps)?;
+    let data = &options.data;
+    let planned = options.model.settings().plan(
         data,
-        args.env.as_deref(),
-        || Ok(mbrl::data::read_dataset(data)?.meta.env),
-        args.run.out.clone(),
+        options.env.as_deref(),
+        || Ok(crate::data::read_dataset(data)?.meta.env),
+        options.run.out.clone(),
     )?;
     let request = Request::<Context> {
-        env: args.env.clone(),
-        data: vec![data.clone()],
-        seed: global.seed,
+        env: options.env,
+        data: vec![options.data],
+        seed: invocation.seed,
         config: planned.config,
         variant: (),
-        provenance: provenance(global),
+        provenance: invocation.provenance(),
     };
-    train(global, &planned.out, &request, args.run.resume_if_stopped)
+    train(planned.out, request, options.run.resume_if_stopped)
 }
 
-pub fn run_tradyn(global: &GlobalArgs, args: TradynArgs) -> anyhow::Result<()> {
-    check_steps(args.model.steps)?;
-    let data = &args.data;
-    let data_env = mbrl::data::read_dataset(data)?.meta.env;
-    let terrain = !args.no_terrain;
+pub fn prepare_tradyn(options: TradynOptions, invocation: &Invocation) -> Result<Job<'static, TrainSummary>> {
+    check_steps(options.model.steps)?;
+    let data = &options.data;
+    let data_env = crate::data::read_dataset(data)?.meta.env;
+    let terrain = !options.no_terrain;
     let planned = tradyn::options::plan(
-        &args.model.options(),
+        &options.model.settings(),
         data,
         &data_env,
-        args.env.as_deref(),
+        options.env.as_deref(),
         terrain,
-        args.run.out.clone(),
+        options.run.out.clone(),
     )?;
     let request = Request::<Tradyn> {
         env: None,
-        data: vec![data.clone()],
-        seed: global.seed,
+        data: vec![options.data],
+        seed: invocation.seed,
         config: planned.config,
         variant: terrain,
-        provenance: provenance(global),
+        provenance: invocation.provenance(),
     };
-    train(global, &planned.out, &request, args.run.resume_if_stopped)
+    train(planned.out, request, options.run.resume_if_stopped)
 }

@@ -3,12 +3,13 @@
 use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
-use mbrl::models::pets::options::PetsOptions;
-use mbrl::models::pets::{Pets, Preset, RewardSource};
-use mbrl::train::Request;
 
-use super::shared::{check_steps, provenance, train, RunArgs};
-use crate::common::GlobalArgs;
+use super::shared::{check_steps, train, RunOptions, TrainSummary};
+use crate::jobs::{Invocation, Job};
+use crate::models::pets::options as pets_options;
+use crate::models::pets::{Pets, Preset, RewardSource};
+use crate::train::Request;
+use crate::Result;
 
 #[derive(Args, Debug)]
 #[command(
@@ -21,7 +22,7 @@ Examples:
   mbrl train pets --data a.mcap --data b.mcap --preset medium --config pets.toml --out models/pets-big
   mbrl train --resume models/pets-big --steps 8000"
 )]
-pub struct PetsArgs {
+pub struct PetsOptions {
     /// Rollout datasets (.mcap) of one env, merged (repeatable).
     #[arg(long, required = true)]
     data: Vec<PathBuf>,
@@ -44,13 +45,13 @@ pub struct PetsArgs {
     #[arg(long)]
     batch: Option<usize>,
     /// Adam learning rate (default 1e-3).
-    #[arg(long, value_parser = crate::common::finite_f64)]
+    #[arg(long, value_parser = crate::jobs::finite_f64)]
     lr: Option<f64>,
     /// Where the model's reward comes from (default: known where the env has a closed form).
     #[arg(long, value_enum)]
     reward: Option<RewardChoice>,
     #[command(flatten)]
-    run: RunArgs,
+    run: RunOptions,
 }
 
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
@@ -69,9 +70,9 @@ pub enum RewardChoice {
     Learned,
 }
 
-impl PetsArgs {
-    fn options(&self) -> PetsOptions {
-        PetsOptions {
+impl PetsOptions {
+    fn settings(&self) -> pets_options::PetsOptions {
+        pets_options::PetsOptions {
             preset: self.preset.map(|p| match p {
                 PetsPreset::Small => Preset::Small,
                 PetsPreset::Medium => Preset::Medium,
@@ -89,21 +90,21 @@ impl PetsArgs {
     }
 }
 
-pub fn run(global: &GlobalArgs, args: PetsArgs) -> anyhow::Result<()> {
-    check_steps(args.steps)?;
-    let first = &args.data[0];
-    let planned = args.options().plan(
-        args.env.as_deref(),
-        || Ok(mbrl::data::read_dataset(first)?.meta.env),
-        args.run.out.clone(),
+pub fn prepare(options: PetsOptions, invocation: &Invocation) -> Result<Job<'static, TrainSummary>> {
+    check_steps(options.steps)?;
+    let first = &options.data[0];
+    let planned = options.settings().plan(
+        options.env.as_deref(),
+        || Ok(crate::data::read_dataset(first)?.meta.env),
+        options.run.out.clone(),
     )?;
     let request = Request::<Pets> {
-        env: args.env.clone(),
-        data: args.data.clone(),
-        seed: global.seed,
+        env: options.env,
+        data: options.data,
+        seed: invocation.seed,
         config: planned.config,
         variant: (),
-        provenance: provenance(global),
+        provenance: invocation.provenance(),
     };
-    train(global, &planned.out, &request, args.run.resume_if_stopped)
+    train(planned.out, request, options.run.resume_if_stopped)
 }

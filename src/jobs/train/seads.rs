@@ -2,15 +2,15 @@
 
 use std::path::PathBuf;
 
-use anyhow::Context;
 use clap::Args;
-use mbrl::models::seads::options::{default_out_for, SeadsOptions};
-use mbrl::models::seads::{self, EmbodiedGame, Seads};
-use mbrl::train::Request;
 
-use super::shared::{provenance, train, RunArgs};
+use super::shared::{train, RunOptions, TrainSummary};
 use super::ScalePreset;
-use crate::common::GlobalArgs;
+use crate::jobs::{Invocation, Job};
+use crate::models::seads::options::{self as seads_options, default_out_for};
+use crate::models::seads::{self, EmbodiedGame, Seads};
+use crate::train::Request;
+use crate::{refuse, Result};
 
 #[derive(Args, Debug)]
 #[command(
@@ -24,7 +24,7 @@ Examples:
 
 Learning rates and batch sizes are keys of the --config file."
 )]
-pub struct SeadsArgs {
+pub struct SeadsOptions {
     /// The embodied board game: lightsout:cursor, tileswap:cursor, lightsout:reacher or tileswap:reacher.
     #[arg(long)]
     env: Option<String>,
@@ -50,34 +50,35 @@ pub struct SeadsArgs {
     #[arg(long)]
     no_novelty: bool,
     #[command(flatten)]
-    run: RunArgs,
+    run: RunOptions,
 }
 
-pub fn run(global: &GlobalArgs, args: SeadsArgs) -> anyhow::Result<()> {
-    let env_name = args.env.as_deref().context(format!("seads needs --env ({})", seads::ENV_HELP))?;
+pub fn prepare(options: SeadsOptions, invocation: &Invocation) -> Result<Job<'static, TrainSummary>> {
+    let Some(env_name) = options.env.as_deref() else {
+        refuse!("seads needs --env ({})", seads::ENV_HELP);
+    };
     let env = EmbodiedGame::parse(env_name)?;
-    let options = SeadsOptions {
-        preset: args.preset.map(|p| match p {
+    let settings = seads_options::SeadsOptions {
+        preset: options.preset.map(|p| match p {
             ScalePreset::Small => seads::Preset::Small,
             ScalePreset::Medium => seads::Preset::Medium,
             ScalePreset::Paper => seads::Preset::Paper,
         }),
-        config_file: args.config.clone(),
-        skills: args.skills,
-        env_steps: args.env_steps,
-        no_relabel: args.no_relabel,
-        no_second_best: args.no_second_best,
-        no_novelty: args.no_novelty,
+        config_file: options.config,
+        skills: options.skills,
+        env_steps: options.env_steps,
+        no_relabel: options.no_relabel,
+        no_second_best: options.no_second_best,
+        no_novelty: options.no_novelty,
     };
-    let config = options.config(&env)?;
     let request = Request::<Seads> {
         env: Some(env.name()),
         data: Vec::new(),
-        seed: global.seed,
-        config,
+        seed: invocation.seed,
+        config: settings.config(&env)?,
         variant: (),
-        provenance: provenance(global),
+        provenance: invocation.provenance(),
     };
-    let out = args.run.out.clone().unwrap_or_else(|| default_out_for(&env));
-    train(global, &out, &request, args.run.resume_if_stopped)
+    let out = options.run.out.unwrap_or_else(|| default_out_for(&env));
+    train(out, request, options.run.resume_if_stopped)
 }

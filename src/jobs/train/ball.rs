@@ -3,12 +3,13 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use mbrl::models::ball::learn::job::BallEkf;
-use mbrl::models::ball::learn::options::{default_out_dir, BallOptions};
-use mbrl::train::Request;
 
-use super::shared::{check_steps, provenance, train, RunArgs};
-use crate::common::GlobalArgs;
+use super::shared::{check_steps, train, RunOptions, TrainSummary};
+use crate::jobs::{Invocation, Job};
+use crate::models::ball::learn::job::BallEkf;
+use crate::models::ball::learn::options::{self as ball_options, default_out_dir};
+use crate::train::Request;
+use crate::Result;
 
 #[derive(Args, Debug)]
 #[command(
@@ -20,7 +21,7 @@ Examples:
   mbrl train ball-ekf --data datasets/ball-train.mcap --out models/ball-ekf --steps 2000
   mbrl train ball-ekf --data datasets/ball-train.mcap --out models/ball-ekf-launch --steps 2000 --launcher-prior"
 )]
-pub struct BallArgs {
+pub struct BallOptions {
     /// A ball dataset (.mcap) or a .csv recording.
     #[arg(long)]
     data: PathBuf,
@@ -34,32 +35,32 @@ pub struct BallArgs {
     #[arg(long)]
     chunk: Option<usize>,
     /// Adam learning rate (thesis: 5e-3).
-    #[arg(long, value_parser = crate::common::finite_f64)]
+    #[arg(long, value_parser = crate::jobs::finite_f64)]
     lr: Option<f64>,
     /// Learn the spin prior from launcher settings (thesis C.1.3); recordings need side information.
     #[arg(long)]
     launcher_prior: bool,
     #[command(flatten)]
-    run: RunArgs,
+    run: RunOptions,
 }
 
-pub fn run(global: &GlobalArgs, args: BallArgs) -> anyhow::Result<()> {
-    check_steps(args.steps)?;
-    let options = BallOptions {
-        steps: args.steps,
-        batch_size: args.batch,
-        chunk_len: args.chunk,
-        learning_rate: args.lr,
-        launcher_prior: args.launcher_prior,
+pub fn prepare(options: BallOptions, invocation: &Invocation) -> Result<Job<'static, TrainSummary>> {
+    check_steps(options.steps)?;
+    let settings = ball_options::BallOptions {
+        steps: options.steps,
+        batch_size: options.batch,
+        chunk_len: options.chunk,
+        learning_rate: options.lr,
+        launcher_prior: options.launcher_prior,
     };
     let request = Request::<BallEkf> {
         env: None,
-        data: vec![args.data.clone()],
-        seed: global.seed,
-        config: options.settings(global.seed),
+        data: vec![options.data],
+        seed: invocation.seed,
+        config: settings.settings(invocation.seed),
         variant: (),
-        provenance: provenance(global),
+        provenance: invocation.provenance(),
     };
-    let out = args.run.out.clone().unwrap_or_else(default_out_dir);
-    train(global, &out, &request, args.run.resume_if_stopped)
+    let out = options.run.out.unwrap_or_else(default_out_dir);
+    train(out, request, options.run.resume_if_stopped)
 }
