@@ -95,7 +95,7 @@ fn main() {
         Command::SolveBoard(args) => solve_board::run(&cli.global, args),
         Command::Eval(args) => eval::run(&cli.global, args),
         Command::Watch(args) => watch::run(&cli.global, args),
-        Command::Export(args) => Ok(say!("{}", mbrl::jobs::export::run(args)?)),
+        Command::Export(args) => mbrl::jobs::export::run(args).map(|summary| say!("{summary}")).map_err(Into::into),
         Command::Completions(args) => completions::run(args),
     });
     if let Err(err) = outcome {

@@ -28,8 +28,10 @@ impl Invocation {
 /// doing work is refused before one is made, so a bad flag never opens the live view.
 pub struct Job<'a, S> {
     pub title: String,
-    work: Box<dyn FnOnce(&dyn Monitor) -> Result<S> + Send + 'a>,
+    work: Work<'a, S>,
 }
+
+type Work<'a, S> = Box<dyn FnOnce(&dyn Monitor) -> Result<S> + Send + 'a>;
 
 impl<'a, S> Job<'a, S> {
     pub fn new(title: impl Into<String>, work: impl FnOnce(&dyn Monitor) -> Result<S> + Send + 'a) -> Self {
