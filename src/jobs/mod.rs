@@ -8,10 +8,12 @@
 
 pub mod cem_options;
 pub mod choices;
+pub mod collect;
 mod common;
 pub mod export;
 pub mod filter;
 pub mod model_options;
+pub mod predict;
 
 pub use common::{
     check_output_file, file_stem, finite_f64, parse_floats, pendulum_variant, warn, Invocation, Job, STEP_RECORD_BYTES,
