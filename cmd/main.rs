@@ -11,13 +11,11 @@ macro_rules! say {
 }
 
 mod calibrate;
-mod collect;
 mod common;
 mod completions;
 mod eval;
 mod plan;
 mod plan_unicycle;
-mod predict;
 mod solve_board;
 mod train;
 mod watch;
@@ -55,12 +53,12 @@ pub struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    Collect(collect::CollectArgs),
+    Collect(mbrl::jobs::collect::CollectOptions),
     Plan(plan::PlanArgs),
     Train(mbrl::jobs::train::TrainOptions),
     Calibrate(calibrate::CalibrateArgs),
     Filter(mbrl::jobs::filter::FilterOptions),
-    Predict(predict::PredictArgs),
+    Predict(mbrl::jobs::predict::PredictOptions),
     SolveBoard(solve_board::SolveBoardArgs),
     Eval(eval::EvalArgs),
     Watch(watch::WatchArgs),
@@ -79,7 +77,13 @@ fn main() {
         .and_then(|matches| Cli::from_arg_matches(&matches))
         .unwrap_or_else(|err| exit_on_usage_error(err));
     let outcome = common::init_threads(&cli.global).and_then(|()| match cli.command {
-        Command::Collect(args) => collect::run(&cli.global, args),
+        Command::Collect(args) => match mbrl::jobs::collect::prepare(args, &cli.global.invocation())? {
+            mbrl::jobs::collect::Collection::Now(job) => {
+                say!("{}", job.run(&mbrl::run::NullMonitor)?);
+                Ok(())
+            }
+            mbrl::jobs::collect::Collection::Viewed(job) => common::show(&cli.global, job),
+        },
         Command::Plan(args) => plan::run(&cli.global, args),
         Command::Train(args) => match mbrl::jobs::train::prepare(args, &cli.global.invocation())? {
             Some(job) => common::show(&cli.global, job),
@@ -91,7 +95,7 @@ fn main() {
         Command::Filter(args) => {
             common::show(&cli.global, mbrl::jobs::filter::prepare(args, &cli.global.invocation())?)
         }
-        Command::Predict(args) => predict::run(&cli.global, args),
+        Command::Predict(args) => common::show(&cli.global, mbrl::jobs::predict::prepare(args)?),
         Command::SolveBoard(args) => solve_board::run(&cli.global, args),
         Command::Eval(args) => eval::run(&cli.global, args),
         Command::Watch(args) => watch::run(&cli.global, args),

@@ -8,10 +8,12 @@
 
 pub mod cem_options;
 pub mod choices;
+pub mod collect;
 mod common;
 pub mod export;
 pub mod filter;
 pub mod model_options;
+pub mod predict;
 pub mod train;
 
 pub use common::{

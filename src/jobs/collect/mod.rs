@@ -1,15 +1,27 @@
 //! `mbrl collect`: roll out a behaviour policy in a simulator and save the dataset as MCAP.
+//!
+//! One file per source: random rollouts and instance pairs, replayed actions, embodied board episodes,
+//! terrain maps, board sets and ball shots.
 
 use std::path::PathBuf;
 
-use anyhow::bail;
 use clap::{Args, ValueEnum};
-use mbrl::data::collect::{collect_instance_pairs, collect_random, CollectSettings, InstancePairSettings};
-use mbrl::data::collect_frames::{add_pendulum_frames, check_frames_size};
-use mbrl::data::write_dataset;
-use mbrl::envs::{parse_env, EnvName};
 
-use crate::common::{check_output_file, command_line, file_stem, run_job, GlobalArgs};
+use super::choices::SplitChoice;
+use super::{Invocation, Job};
+use crate::data::collect_frames::check_frames_size;
+use crate::envs::{parse_env, EnvName};
+use crate::{refuse, Result};
+
+mod ball;
+mod boards;
+mod embodied;
+mod random;
+mod replay;
+mod summary;
+mod terrain;
+
+pub use summary::CollectSummary;
 
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
 pub enum Policy {
@@ -58,8 +70,8 @@ episode from a uniformly scrambled board and a reset manipulator. --actions: one
 --board (default: the solved board) and --init-state (cursor: x,y in [0,1]; reacher: shoulder,wrist
 angles in rad (|wrist| <= 160 deg) and their velocities; default: a reset drawn from --seed).
 Ball shots: launcher settings drawn as in thesis 6.5.1, 180 Hz camera with ~1 mm noise and dropouts.")]
-pub struct CollectArgs {
-    #[arg(long, help = concat!("Environment: ", mbrl::known_envs!()))]
+pub struct CollectOptions {
+    #[arg(long, help = concat!("Environment: ", crate::known_envs!()))]
     env: String,
     /// Number of rollouts, each in its own instance of a parametrized env.
     #[arg(long, default_value_t = 100)]
@@ -116,7 +128,7 @@ pub struct CollectArgs {
     max_depth: Option<u8>,
     /// Only boards of this split (--boards), or the maps of this split of a map set (--maps DIR).
     #[arg(long, value_enum)]
-    split: Option<crate::solve_board::SplitChoice>,
+    split: Option<SplitChoice>,
     /// For --env terrain: how many maps to make. For --env unicycle: a map set directory (with terrain.json)
     /// whose --split maps the instances are drawn on.
     #[arg(long, value_name = "N|DIR", conflicts_with = "map")]
@@ -126,107 +138,63 @@ pub struct CollectArgs {
     map: Option<PathBuf>,
 }
 
-mod sources;
+/// What `collect` hands the binary. A replay of a CSV is quick and runs at once with no view, as it always
+/// has (a live view would only flash); every other source is long work shown in the view the flags pick.
+pub enum Collection {
+    Now(Job<'static, CollectSummary>),
+    Viewed(Job<'static, CollectSummary>),
+}
 
-use sources::{
-    collect_ball_shots, collect_boards, collect_embodied_episodes, collect_terrain, replay_actions, unicycle_terrain,
-};
-
-pub fn run(global: &GlobalArgs, args: CollectArgs) -> anyhow::Result<()> {
-    let mut env = parse_env(&args.env)?;
+pub fn prepare(options: CollectOptions, invocation: &Invocation) -> Result<Collection> {
+    let mut env = parse_env(&options.env)?;
     if env == EnvName::Terrain {
-        return collect_terrain(global, &args);
+        return terrain::prepare_maps(options, invocation).map(Collection::Viewed);
     }
     if let EnvName::Unicycle(_) = env {
-        env = env.with_terrain(unicycle_terrain(args.map.as_deref(), args.maps.as_deref(), args.split)?)?;
-    } else if args.map.is_some() || args.maps.is_some() {
-        bail!("--map and --maps are for --env unicycle (maps) and --env terrain (--maps N), not '{}'", env.canonical());
+        env = env.with_terrain(terrain::unicycle_terrain(
+            options.map.as_deref(),
+            options.maps.as_deref(),
+            options.split,
+        )?)?;
+    } else if options.map.is_some() || options.maps.is_some() {
+        refuse!(
+            "--map and --maps are for --env unicycle (maps) and --env terrain (--maps N), not '{}'",
+            env.canonical()
+        );
     }
-    if args.split.is_some() && !args.boards && args.maps.is_none() {
-        bail!("--split needs --boards (board sets) or --maps DIR (a terrain map set)");
+    if options.split.is_some() && !options.boards && options.maps.is_none() {
+        refuse!("--split needs --boards (board sets) or --maps DIR (a terrain map set)");
     }
-    if args.images {
+    if options.images {
         check_frames_size(&env, 0.0)?;
     }
     if env == EnvName::Ball {
-        let Some(trajectories) = args.trajectories else {
-            bail!("'ball' is recorded as camera trajectories: give --trajectories N");
+        let Some(trajectories) = options.trajectories else {
+            refuse!("'ball' is recorded as camera trajectories: give --trajectories N");
         };
-        return collect_ball_shots(global, trajectories, &args);
+        return ball::prepare(trajectories, options, invocation).map(Collection::Viewed);
     }
-    if args.trajectories.is_some() {
-        bail!("--trajectories is for --env ball, not '{}'", env.canonical());
+    if options.trajectories.is_some() {
+        refuse!("--trajectories is for --env ball, not '{}'", env.canonical());
     }
     if let EnvName::Embodied(game, embodiment) = env {
-        return collect_embodied_episodes(global, game, embodiment, &args);
+        return embodied::prepare(game, embodiment, options, invocation);
     }
-    if args.episodes.is_some() || args.board.is_some() {
-        let flag = if args.episodes.is_some() { "--episodes" } else { "--board" };
-        bail!("{flag} is for board games played by a manipulator (e.g. lightsout:cursor), not '{}'", env.canonical());
+    if options.episodes.is_some() || options.board.is_some() {
+        let flag = if options.episodes.is_some() { "--episodes" } else { "--board" };
+        refuse!("{flag} is for board games played by a manipulator (e.g. lightsout:cursor), not '{}'", env.canonical());
     }
     if let EnvName::Board(game) = env {
-        if !args.boards {
-            bail!("'{}' is a board game: collect its board sets with --boards --max-depth D", game.name());
+        if !options.boards {
+            refuse!("'{}' is a board game: collect its board sets with --boards --max-depth D", game.name());
         }
-        return collect_boards(global, game, &args);
+        return boards::prepare(game, options, invocation).map(Collection::Viewed);
     }
-    if args.boards {
-        bail!("--boards is for board games (lightsout, tileswap), not '{}'", env.canonical());
+    if options.boards {
+        refuse!("--boards is for board games (lightsout, tileswap), not '{}'", env.canonical());
     }
-    if let Some(actions) = &args.actions {
-        return replay_actions(global, env, actions, &args);
+    if let Some(actions) = options.actions.clone() {
+        return replay::prepare(env, &actions, options, invocation).map(Collection::Now);
     }
-    let mode = if args.instances.is_some() { "pairs" } else { "random" };
-    let out = args
-        .out
-        .clone()
-        .unwrap_or_else(|| PathBuf::from(format!("datasets/{}-{mode}.mcap", file_stem(&env.canonical()))));
-    check_output_file("--out", &out, "mcap")?;
-    if args.images {
-        let rollouts = args.instances.map_or(args.rollouts, |n| 2 * n);
-        check_frames_size(&env, rollouts as f64 * (args.steps as f64 + 1.0))?;
-    }
-    let dataset = run_job(global, "collect", |monitor| {
-        let mut data = match (args.instances, args.policy) {
-            (Some(instances), Policy::Random) => {
-                let settings = InstancePairSettings {
-                    env,
-                    instances,
-                    steps: args.steps,
-                    seed: global.seed,
-                    command_line: command_line(),
-                };
-                collect_instance_pairs(&settings, monitor)?
-            }
-            (None, Policy::Random) => {
-                let settings = CollectSettings {
-                    env,
-                    rollouts: args.rollouts,
-                    steps: args.steps,
-                    seed: global.seed,
-                    command_line: command_line(),
-                };
-                collect_random(&settings, monitor)?
-            }
-        };
-        if args.images {
-            add_pendulum_frames(&mut data, monitor)?;
-        }
-        write_dataset(&out, &data)?;
-        Ok(data)
-    })?;
-    let rollouts = dataset.meta.instances.len();
-    let grouping = match args.instances {
-        Some(n) => format!("{rollouts} rollouts ({n} instance pairs)"),
-        None => format!("{rollouts} rollouts"),
-    };
-    let frames =
-        if dataset.frames.is_empty() { String::new() } else { format!(" with {} frames", dataset.frames.len()) };
-    say!(
-        "wrote {} transitions in {grouping} of {}{frames} to {}",
-        dataset.steps.len(),
-        dataset.meta.env,
-        out.display()
-    );
-    Ok(())
+    random::prepare(env, options, invocation).map(Collection::Viewed)
 }
