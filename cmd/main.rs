@@ -14,7 +14,6 @@ mod calibrate;
 mod collect;
 mod common;
 mod completions;
-mod eval;
 mod plan;
 mod plan_unicycle;
 mod predict;
@@ -62,7 +61,7 @@ enum Command {
     Filter(mbrl::jobs::filter::FilterOptions),
     Predict(predict::PredictArgs),
     SolveBoard(solve_board::SolveBoardArgs),
-    Eval(eval::EvalArgs),
+    Eval(mbrl::jobs::eval::EvalOptions),
     Watch(watch::WatchArgs),
     Export(mbrl::jobs::export::ExportOptions),
     Completions(completions::CompletionsArgs),
@@ -88,7 +87,13 @@ fn main() {
         }
         Command::Predict(args) => predict::run(&cli.global, args),
         Command::SolveBoard(args) => solve_board::run(&cli.global, args),
-        Command::Eval(args) => eval::run(&cli.global, args),
+        Command::Eval(args) => match mbrl::jobs::eval::prepare(args, &cli.global.invocation())? {
+            mbrl::jobs::eval::Eval::Run(job) => common::show(&cli.global, job),
+            mbrl::jobs::eval::Eval::Rendered(summary) => {
+                say!("{summary}");
+                Ok(())
+            }
+        },
         Command::Watch(args) => watch::run(&cli.global, args),
         Command::Export(args) => Ok(say!("{}", mbrl::jobs::export::run(args)?)),
         Command::Completions(args) => completions::run(args),

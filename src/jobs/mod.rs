@@ -9,6 +9,7 @@
 pub mod cem_options;
 pub mod choices;
 mod common;
+pub mod eval;
 pub mod export;
 pub mod filter;
 pub mod model_options;
