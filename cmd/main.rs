@@ -13,7 +13,6 @@ macro_rules! say {
 mod calibrate;
 mod common;
 mod completions;
-mod eval;
 mod plan;
 mod plan_unicycle;
 mod solve_board;
@@ -60,7 +59,7 @@ enum Command {
     Filter(mbrl::jobs::filter::FilterOptions),
     Predict(mbrl::jobs::predict::PredictOptions),
     SolveBoard(solve_board::SolveBoardArgs),
-    Eval(eval::EvalArgs),
+    Eval(mbrl::jobs::eval::EvalOptions),
     Watch(watch::WatchArgs),
     Export(mbrl::jobs::export::ExportOptions),
     Completions(completions::CompletionsArgs),
@@ -97,7 +96,13 @@ fn main() {
         }
         Command::Predict(args) => common::show(&cli.global, mbrl::jobs::predict::prepare(args)?),
         Command::SolveBoard(args) => solve_board::run(&cli.global, args),
-        Command::Eval(args) => eval::run(&cli.global, args),
+        Command::Eval(args) => match mbrl::jobs::eval::prepare(args, &cli.global.invocation())? {
+            mbrl::jobs::eval::Eval::Run(job) => common::show(&cli.global, job),
+            mbrl::jobs::eval::Eval::Rendered(summary) => {
+                say!("{summary}");
+                Ok(())
+            }
+        },
         Command::Watch(args) => watch::run(&cli.global, args),
         Command::Export(args) => mbrl::jobs::export::run(args).map(|summary| say!("{summary}")).map_err(Into::into),
         Command::Completions(args) => completions::run(args),

@@ -10,6 +10,7 @@ pub mod cem_options;
 pub mod choices;
 pub mod collect;
 mod common;
+pub mod eval;
 pub mod export;
 pub mod filter;
 pub mod model_options;

@@ -3,19 +3,20 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use mbrl::eval::boards::{self, EmbodiedConfig, EmbodiedSettings};
-use mbrl::eval::seads::{
+
+use super::{recorded, report_job, EvalSummary};
+use crate::eval::boards::{self, EmbodiedConfig, EmbodiedSettings};
+use crate::eval::seads::{
     compare_runs, run_name, seads_report, variant_label, ComparedRun, SeadsEvalConfig, SeadsEvalSettings,
 };
-use mbrl::run::dir::Provenance;
-
-use super::{print, recorded};
-use crate::common::{run_job, GlobalArgs};
-use crate::solve_board::{EmbodimentChoice, SplitChoice};
-use mbrl::jobs::model_options::{accepting, report_unfinished};
+use crate::eval::summary::Summary;
+use crate::jobs::choices::{EmbodimentChoice, SplitChoice};
+use crate::jobs::model_options::{accepting, report_unfinished};
+use crate::jobs::{Invocation, Job};
+use crate::Result;
 
 #[derive(Args, Debug)]
-pub struct BoardsArgs {
+pub struct BoardsOptions {
     /// Report directory.
     #[arg(long, default_value = "reports/boards")]
     out: PathBuf,
@@ -24,18 +25,18 @@ pub struct BoardsArgs {
     config: Option<PathBuf>,
 }
 
-pub fn boards(global: &GlobalArgs, provenance: Provenance, a: BoardsArgs) -> anyhow::Result<()> {
-    let provenance = match &a.config {
-        Some(path) => recorded::<boards::BoardsConfig>(global, path)?.1,
-        None => provenance,
+pub fn boards(options: BoardsOptions, invocation: &Invocation) -> Result<Job<'static, EvalSummary>> {
+    let provenance = match &options.config {
+        Some(path) => recorded::<boards::BoardsConfig>(invocation, path)?.1,
+        None => invocation.provenance(),
     };
-    let summary = run_job(global, "eval boards", |monitor| boards::depth_report(&provenance, &a.out, monitor))?;
-    print(&summary, &a.out);
-    Ok(())
+    Ok(report_job("eval boards", options.out, move |monitor, out| {
+        Ok(Summary::Boards(boards::depth_report(&provenance, out, monitor)?))
+    }))
 }
 
 #[derive(Args, Debug)]
-pub struct EmbodiedArgs {
+pub struct EmbodiedOptions {
     /// Game: lightsout (5x5) or tileswap.
     #[arg(long, required_unless_present = "config")]
     game: Option<String>,
@@ -59,30 +60,30 @@ pub struct EmbodiedArgs {
     config: Option<PathBuf>,
 }
 
-pub fn embodied(global: &GlobalArgs, provenance: Provenance, a: EmbodiedArgs) -> anyhow::Result<()> {
-    let (config, provenance) = match &a.config {
-        Some(path) => recorded(global, path)?,
+pub fn embodied(options: EmbodiedOptions, invocation: &Invocation) -> Result<Job<'static, EvalSummary>> {
+    let (config, provenance) = match &options.config {
+        Some(path) => recorded(invocation, path)?,
         None => (
             EmbodiedConfig {
-                game: a.game.clone().unwrap_or_default(),
+                game: options.game.clone().unwrap_or_default(),
                 settings: EmbodiedSettings {
-                    embodiment: a.embodiment.unwrap_or(EmbodimentChoice::Cursor).into(),
-                    max_depth: a.max_depth,
-                    boards_per_depth: a.boards,
-                    split: a.split.into(),
+                    embodiment: options.embodiment.unwrap_or(EmbodimentChoice::Cursor).into(),
+                    max_depth: options.max_depth,
+                    boards_per_depth: options.boards,
+                    split: options.split.into(),
                 },
             },
-            provenance,
+            invocation.provenance(),
         ),
     };
     config.validate()?;
-    let summary = run_job(global, "eval embodied", |monitor| boards::embodied(&config, &provenance, &a.out, monitor))?;
-    print(&summary, &a.out);
-    Ok(())
+    Ok(report_job("eval embodied", options.out, move |monitor, out| {
+        Ok(Summary::Embodied(boards::embodied(&config, &provenance, out, monitor)?))
+    }))
 }
 
 #[derive(Args, Debug)]
-pub struct SeadsArgs {
+pub struct SeadsOptions {
     /// A SEADS checkpoint directory (`mbrl train seads`); repeat it to compare runs (seeds of the full
     /// method and of ablations: one-sided Mann-Whitney U tests of each ablation against `full`).
     #[arg(long, required_unless_present = "config")]
@@ -117,53 +118,53 @@ pub struct SeadsArgs {
     config: Option<PathBuf>,
 }
 
-pub fn seads(global: &GlobalArgs, provenance: Provenance, a: SeadsArgs) -> anyhow::Result<()> {
-    let (config, provenance) = match &a.config {
-        Some(path) => recorded(global, path)?,
+/// One report per checkpoint; with several, each goes in a subdirectory named for its run and the top
+/// directory holds their comparison.
+pub fn seads(options: SeadsOptions, invocation: &Invocation) -> Result<Job<'static, EvalSummary>> {
+    let (config, provenance) = match &options.config {
+        Some(path) => recorded(invocation, path)?,
         None => (
             SeadsEvalConfig {
-                models: a.model.clone(),
-                allow_incomplete: a.allow_incomplete,
+                models: options.model.clone(),
+                allow_incomplete: options.allow_incomplete,
                 settings: SeadsEvalSettings {
-                    max_depth: a.max_depth,
-                    boards_per_depth: a.boards,
-                    coverage_boards: a.coverage_boards,
-                    max_replans: a.max_replans,
-                    split: a.split.into(),
-                    max_search_nodes: a.max_nodes,
+                    max_depth: options.max_depth,
+                    boards_per_depth: options.boards,
+                    coverage_boards: options.coverage_boards,
+                    max_replans: options.max_replans,
+                    split: options.split.into(),
+                    max_search_nodes: options.max_nodes,
                 },
             },
-            provenance,
+            invocation.provenance(),
         ),
     };
     config.validate()?;
-    let out = a.out.clone().unwrap_or_else(|| config.default_out());
+    let out = options.out.clone().unwrap_or_else(|| config.default_out());
     let loaded: Vec<_> = config
         .models
         .iter()
-        .map(|m| mbrl::models::seads::planner::load(m, accepting(config.allow_incomplete)))
-        .collect::<Result<_, _>>()?;
+        .map(|m| crate::models::seads::planner::load(m, accepting(config.allow_incomplete)))
+        .collect::<Result<_>>()?;
     for model in &loaded {
         report_unfinished(&model.dir, &model.progress);
     }
-    let compared = config.models.len() > 1;
-    let mut runs = Vec::new();
-    for (dir, model) in config.models.iter().zip(&loaded) {
-        let report_dir = if compared { out.join(run_name(dir)) } else { out.clone() };
-        let own = SeadsEvalConfig { models: vec![dir.to_path_buf()], ..config.clone() };
-        let s = run_job(global, "eval seads", |monitor| seads_report(model, &own, &provenance, &report_dir, monitor))?;
-        say!("{s}");
-        runs.push(ComparedRun {
-            name: run_name(dir),
-            variant: variant_label(&model.run.config),
-            seed: model.run.seed,
-            summary: s,
-        });
-    }
-    if compared {
-        print(&compare_runs(&runs, &config, &provenance, &out)?, &out);
-    } else {
-        say!("report: {}", out.join("report.md").display());
-    }
-    Ok(())
+    Ok(Job::new("eval seads", move |monitor| {
+        if let [model] = &loaded[..] {
+            let summary = Summary::Seads(seads_report(model, &config, &provenance, &out, monitor)?);
+            return Ok(EvalSummary { compared: Vec::new(), summary, out });
+        }
+        let mut runs = Vec::new();
+        for (dir, model) in config.models.iter().zip(&loaded) {
+            let own = SeadsEvalConfig { models: vec![dir.to_path_buf()], ..config.clone() };
+            runs.push(ComparedRun {
+                name: run_name(dir),
+                variant: variant_label(&model.run.config),
+                seed: model.run.seed,
+                summary: seads_report(model, &own, &provenance, &out.join(run_name(dir)), monitor)?,
+            });
+        }
+        let summary = Summary::SeadsCompare(compare_runs(&runs, &config, &provenance, &out)?);
+        Ok(EvalSummary { compared: runs.into_iter().map(|r| r.summary).collect(), summary, out })
+    }))
 }

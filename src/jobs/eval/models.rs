@@ -3,21 +3,23 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use mbrl::envs::EnvName;
-use mbrl::eval::ball::{self, BallConfig, BallEvalSettings};
-use mbrl::eval::context::{ContextEvalConfig, ContextEvalSettings};
-use mbrl::eval::swingup::SwingupSettings;
-use mbrl::eval::tradyn::{TradynEvalConfig, TradynEvalModels};
-use mbrl::models::ball::checkpoint::{load_ball_model, report_name};
-use mbrl::models::context::calibration::{CalibrationSettings, Strategy};
-use mbrl::run::dir::Provenance;
 
-use super::{print, recorded};
-use crate::common::{run_job, GlobalArgs};
-use mbrl::jobs::model_options::{accepting, report_unfinished};
+use super::{recorded, report_job, EvalSummary};
+use crate::envs::EnvName;
+use crate::eval::ball::{self, BallConfig, BallEvalSettings};
+use crate::eval::context::{ContextEvalConfig, ContextEvalSettings};
+use crate::eval::summary::Summary;
+use crate::eval::swingup::SwingupSettings;
+use crate::eval::tradyn::{TradynEvalConfig, TradynEvalModels};
+use crate::jobs::choices::StrategyChoice;
+use crate::jobs::model_options::{accepting, report_unfinished};
+use crate::jobs::{Invocation, Job};
+use crate::models::ball::checkpoint::{load_ball_model, report_name};
+use crate::models::context::calibration::{CalibrationSettings, Strategy};
+use crate::{refuse, Result};
 
 #[derive(Args, Debug)]
-pub struct BallArgs {
+pub struct BallOptions {
     /// EKF models to compare (repeatable): thesis, initial, or checkpoint directories.
     #[arg(long, default_values_t = ["thesis".to_string(), "initial".to_string()])]
     model: Vec<String>,
@@ -41,34 +43,32 @@ pub struct BallArgs {
     config: Option<PathBuf>,
 }
 
-pub fn ball(global: &GlobalArgs, provenance: Provenance, a: BallArgs) -> anyhow::Result<()> {
-    let (config, provenance) = match &a.config {
-        Some(path) => recorded(global, path)?,
+pub fn ball(options: BallOptions, invocation: &Invocation) -> Result<Job<'static, EvalSummary>> {
+    let (config, provenance) = match &options.config {
+        Some(path) => recorded(invocation, path)?,
         None => (
             BallConfig {
-                models: a.model.clone(),
+                models: options.model.clone(),
                 settings: BallEvalSettings {
-                    train_shots: a.train_shots,
-                    augment_rotations: a.augment_rotations,
-                    test_shots_default: a.test_shots,
-                    test_shots_unseen: a.unseen_shots,
+                    train_shots: options.train_shots,
+                    augment_rotations: options.augment_rotations,
+                    test_shots_default: options.test_shots,
+                    test_shots_unseen: options.unseen_shots,
                     ..BallEvalSettings::default()
                 },
             },
-            provenance,
+            invocation.provenance(),
         ),
     };
-    let models =
-        config.models.iter().map(|m| Ok((report_name(m), load_ball_model(m)?))).collect::<anyhow::Result<Vec<_>>>()?;
+    let models = config.models.iter().map(|m| Ok((report_name(m), load_ball_model(m)?))).collect::<Result<Vec<_>>>()?;
     config.validate()?;
-    let summary =
-        run_job(global, "eval ball", |monitor| ball::evaluate(&config, models, &provenance, &a.out, monitor))?;
-    print(&summary, &a.out);
-    Ok(())
+    Ok(report_job("eval ball", options.out, move |monitor, out| {
+        Ok(Summary::Ball(ball::evaluate(&config, models, &provenance, out, monitor)?))
+    }))
 }
 
 #[derive(Args, Debug)]
-pub struct ContextArgs {
+pub struct ContextOptions {
     /// A context-model checkpoint (`mbrl train context`).
     #[arg(long, required_unless_present = "config")]
     model: Option<PathBuf>,
@@ -92,7 +92,7 @@ pub struct ContextArgs {
     horizon: usize,
     /// Strategies to compare (repeatable; default: all three).
     #[arg(long, value_enum)]
-    strategy: Vec<mbrl::jobs::choices::StrategyChoice>,
+    strategy: Vec<StrategyChoice>,
     /// CEM candidates per iteration (thesis 1000).
     #[arg(long, default_value_t = 1000)]
     candidates: usize,
@@ -126,8 +126,8 @@ pub struct ContextArgs {
     config: Option<PathBuf>,
 }
 
-impl ContextArgs {
-    fn config(&self, env: &EnvName) -> anyhow::Result<ContextEvalConfig> {
+impl ContextOptions {
+    fn config(&self, env: &EnvName) -> Result<ContextEvalConfig> {
         let strategies: Vec<Strategy> = if self.strategy.is_empty() {
             Strategy::ALL.to_vec()
         } else {
@@ -142,10 +142,9 @@ impl ContextArgs {
                 swingup.cem.elites = (self.swingup_candidates / 10).max(2);
                 Some(swingup)
             }
-            (true, other) => anyhow::bail!(
-                "--swingup needs a pendulum env (pendulum:quadrant in the thesis), not '{}'",
-                other.canonical()
-            ),
+            (true, other) => {
+                refuse!("--swingup needs a pendulum env (pendulum:quadrant in the thesis), not '{}'", other.canonical())
+            }
         };
         Ok(ContextEvalConfig {
             model: self.model.clone().unwrap_or_default(),
@@ -171,27 +170,28 @@ impl ContextArgs {
     }
 }
 
-pub fn context(global: &GlobalArgs, provenance: Provenance, a: ContextArgs) -> anyhow::Result<()> {
-    let (config, provenance) = match &a.config {
-        Some(path) => recorded(global, path)?,
-        None => (a.config(&mbrl::envs::parse_env(a.env.as_deref().unwrap_or_default())?)?, provenance),
+pub fn context(options: ContextOptions, invocation: &Invocation) -> Result<Job<'static, EvalSummary>> {
+    let (config, provenance) = match &options.config {
+        Some(path) => recorded(invocation, path)?,
+        None => (
+            options.config(&crate::envs::parse_env(options.env.as_deref().unwrap_or_default())?)?,
+            invocation.provenance(),
+        ),
     };
-    let env = mbrl::envs::parse_env(&config.env)?;
+    let env = crate::envs::parse_env(&config.env)?;
     if !config.model.is_dir() {
-        anyhow::bail!("--model {}: no such checkpoint directory", config.model.display());
+        refuse!("--model {}: no such checkpoint directory", config.model.display());
     }
     config.validate(&env)?;
-    let model = mbrl::models::context::load(&config.model, &env, accepting(config.allow_incomplete))?;
+    let model = crate::models::context::load(&config.model, &env, accepting(config.allow_incomplete))?;
     report_unfinished(&config.model, &model.progress);
-    let summary = run_job(global, "eval context", |monitor| {
-        mbrl::eval::context::evaluate(&model, &env, &config, &provenance, &a.out, monitor)
-    })?;
-    print(&summary, &a.out);
-    Ok(())
+    Ok(report_job("eval context", options.out, move |monitor, out| {
+        Ok(Summary::Context(crate::eval::context::evaluate(&model, &env, &config, &provenance, out, monitor)?))
+    }))
 }
 
 #[derive(Args, Debug)]
-pub struct TradynArgs {
+pub struct TradynOptions {
     /// The TRADYN model with terrain lookup (`mbrl train tradyn`): the +T variants.
     #[arg(long, required_unless_present = "config")]
     model_terrain: Option<PathBuf>,
@@ -236,32 +236,32 @@ pub struct TradynArgs {
     config: Option<PathBuf>,
 }
 
-pub fn tradyn(global: &GlobalArgs, provenance: Provenance, a: TradynArgs) -> anyhow::Result<()> {
-    use mbrl::models::tradyn::TradynModel;
-    let (config, provenance) = match &a.config {
-        Some(path) => recorded(global, path)?,
+pub fn tradyn(options: TradynOptions, invocation: &Invocation) -> Result<Job<'static, EvalSummary>> {
+    use crate::models::tradyn::TradynModel;
+    let (config, provenance) = match &options.config {
+        Some(path) => recorded(invocation, path)?,
         None => (
             TradynEvalConfig {
-                model_terrain: a.model_terrain.clone().unwrap_or_default(),
-                model_no_terrain: a.model_no_terrain.clone().unwrap_or_default(),
-                maps: a.maps.clone().unwrap_or_default(),
-                allow_incomplete: a.allow_incomplete,
-                tasks: a.tasks,
-                transitions: a.transitions,
-                steps: a.steps,
-                horizon: a.horizon,
-                candidates: a.candidates,
-                elites: a.elites,
-                iters: a.iters,
-                prediction_steps: a.prediction_steps,
+                model_terrain: options.model_terrain.clone().unwrap_or_default(),
+                model_no_terrain: options.model_no_terrain.clone().unwrap_or_default(),
+                maps: options.maps.clone().unwrap_or_default(),
+                allow_incomplete: options.allow_incomplete,
+                tasks: options.tasks,
+                transitions: options.transitions,
+                steps: options.steps,
+                horizon: options.horizon,
+                candidates: options.candidates,
+                elites: options.elites,
+                iters: options.iters,
+                prediction_steps: options.prediction_steps,
             },
-            provenance,
+            invocation.provenance(),
         ),
     };
     config.settings()?;
     for (flag, dir) in [("--model-terrain", &config.model_terrain), ("--model-no-terrain", &config.model_no_terrain)] {
         if !dir.is_dir() {
-            anyhow::bail!("{flag} {}: no such checkpoint directory", dir.display());
+            refuse!("{flag} {}: no such checkpoint directory", dir.display());
         }
     }
     let accept = accepting(config.allow_incomplete);
@@ -273,10 +273,9 @@ pub fn tradyn(global: &GlobalArgs, provenance: Provenance, a: TradynArgs) -> any
         report_unfinished(&model.loaded.dir, &model.loaded.progress);
     }
     models.check()?;
-    let maps = mbrl::data::terrain_set::read_terrain_set(&config.maps, Some(mbrl::envs::terrain::TerrainSplit::Test))?;
-    let summary = run_job(global, "eval tradyn", |monitor| {
-        mbrl::eval::tradyn::evaluate(&models, maps, &config, &provenance, &a.out, monitor)
-    })?;
-    print(&summary, &a.out);
-    Ok(())
+    let maps =
+        crate::data::terrain_set::read_terrain_set(&config.maps, Some(crate::envs::terrain::TerrainSplit::Test))?;
+    Ok(report_job("eval tradyn", options.out, move |monitor, out| {
+        Ok(Summary::Tradyn(crate::eval::tradyn::evaluate(&models, maps, &config, &provenance, out, monitor)?))
+    }))
 }

@@ -3,17 +3,18 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use mbrl::eval::dlgpd::DlgpdEvalConfig;
-use mbrl::eval::swingup::{self, ModelSpec, SwingupConfig, SwingupSettings};
-use mbrl::run::dir::Provenance;
 
-use super::{print, print_inline, recorded};
-use crate::common::{pendulum_variant, run_job, GlobalArgs};
-use mbrl::jobs::cem_options::CemOptions;
-use mbrl::jobs::model_options::{accepting, report_unfinished, ModelOptions, PropagationChoice};
+use super::{recorded, report_job, EvalSummary};
+use crate::eval::dlgpd::DlgpdEvalConfig;
+use crate::eval::summary::Summary;
+use crate::eval::swingup::{self, ModelSpec, SwingupConfig, SwingupSettings};
+use crate::jobs::cem_options::CemOptions;
+use crate::jobs::model_options::{accepting, report_unfinished, ModelOptions, PropagationChoice};
+use crate::jobs::{pendulum_variant, Invocation, Job, STEP_RECORD_BYTES};
+use crate::{refuse, Result};
 
 #[derive(Args, Debug)]
-pub struct DatasetArgs {
+pub struct DatasetOptions {
     /// Dataset file written by `mbrl collect` or `mbrl plan`.
     #[arg(long, required_unless_present = "config", conflicts_with = "config")]
     input: Option<PathBuf>,
@@ -25,27 +26,27 @@ pub struct DatasetArgs {
     config: Option<PathBuf>,
 }
 
-pub fn dataset(global: &GlobalArgs, provenance: Provenance, a: DatasetArgs) -> anyhow::Result<()> {
-    let (input, provenance) = match (&a.config, a.input) {
+pub fn dataset(options: DatasetOptions, invocation: &Invocation) -> Result<Job<'static, EvalSummary>> {
+    let (input, provenance) = match (&options.config, options.input) {
         (Some(path), _) => {
-            let (config, provenance) = recorded::<mbrl::eval::dataset_report::DatasetConfig>(global, path)?;
+            let (config, provenance) = recorded::<crate::eval::dataset_report::DatasetConfig>(invocation, path)?;
             (config.input, provenance)
         }
-        (None, input) => (input.unwrap_or_default(), provenance),
+        (None, input) => (input.unwrap_or_default(), invocation.provenance()),
     };
-    let s = run_job(global, "eval dataset", |_| mbrl::eval::dataset_report::report(&input, &provenance, &a.out))?;
-    print_inline(&s, &a.out);
-    Ok(())
+    Ok(report_job("eval dataset", options.out, move |_, out| {
+        Ok(Summary::Dataset(crate::eval::dataset_report::report(&input, &provenance, out)?))
+    }))
 }
 
 #[derive(Args, Debug)]
-pub struct SwingupArgs {
+pub struct SwingupOptions {
     #[command(flatten)]
     model: Option<ModelOptions>,
     /// Number of episodes (each with its own start state).
     #[arg(long, default_value_t = 10)]
     episodes: usize,
-    #[arg(long, default_value = "pendulum", help = concat!("Environment variant: ", mbrl::pendulum_envs!()))]
+    #[arg(long, default_value = "pendulum", help = concat!("Environment variant: ", crate::pendulum_envs!()))]
     env: String,
     /// Steps per episode.
     #[arg(long, default_value_t = 150)]
@@ -60,10 +61,10 @@ pub struct SwingupArgs {
     config: Option<PathBuf>,
 }
 
-impl SwingupArgs {
-    fn config(&self) -> anyhow::Result<SwingupConfig> {
+impl SwingupOptions {
+    fn config(&self) -> Result<SwingupConfig> {
         let Some(m) = &self.model else {
-            anyhow::bail!("the following required argument was not provided: --model <MODEL> (or --config FILE)");
+            refuse!("the following required argument was not provided: --model <MODEL> (or --config FILE)");
         };
         let mut settings = SwingupSettings::thesis(pendulum_variant(&self.env)?);
         settings.steps = self.steps;
@@ -89,12 +90,12 @@ impl SwingupArgs {
 }
 
 /// The command's model flags from a recorded model.
-fn model_args(spec: &ModelSpec) -> anyhow::Result<ModelOptions> {
+fn model_options(spec: &ModelSpec) -> Result<ModelOptions> {
     let propagation = match spec.propagation.as_str() {
         "ts1" => PropagationChoice::Ts1,
         "tsinf" => PropagationChoice::Tsinf,
         "expectation" => PropagationChoice::Expectation,
-        other => anyhow::bail!("model.propagation '{other}': expected ts1, tsinf or expectation"),
+        other => refuse!("model.propagation '{other}': expected ts1, tsinf or expectation"),
     };
     Ok(ModelOptions {
         model: spec.model.clone(),
@@ -105,28 +106,25 @@ fn model_args(spec: &ModelSpec) -> anyhow::Result<ModelOptions> {
     })
 }
 
-pub fn swingup(global: &GlobalArgs, provenance: Provenance, a: SwingupArgs) -> anyhow::Result<()> {
-    let (config, provenance) = match &a.config {
-        Some(path) => recorded(global, path)?,
-        None => (a.config()?, provenance),
+pub fn swingup(options: SwingupOptions, invocation: &Invocation) -> Result<Job<'static, EvalSummary>> {
+    let (config, provenance) = match &options.config {
+        Some(path) => recorded(invocation, path)?,
+        None => (options.config()?, invocation.provenance()),
     };
-    let model = model_args(&config.model)?.load(&mbrl::envs::parse_env(&config.env)?)?;
-    let model = model.as_deref();
+    let model = model_options(&config.model)?.load(&crate::envs::parse_env(&config.env)?)?;
     config.validate()?;
-    mbrl::util::budget::check(
+    crate::util::budget::check(
         &format!("--episodes {} × --steps {}", config.episodes, config.settings.steps),
-        mbrl::util::budget::times(&[config.episodes, config.settings.steps], mbrl::jobs::STEP_RECORD_BYTES),
+        crate::util::budget::times(&[config.episodes, config.settings.steps], STEP_RECORD_BYTES),
         "evaluate fewer or shorter episodes",
     )?;
-    let summary = run_job(global, "eval pendulum-swingup", |monitor| {
-        swingup::evaluate(&config, model, &provenance, &a.out, monitor)
-    })?;
-    print_inline(&summary, &a.out);
-    Ok(())
+    Ok(report_job("eval pendulum-swingup", options.out, move |monitor, out| {
+        Ok(Summary::PendulumSwingup(swingup::evaluate(&config, model.as_deref(), &provenance, out, monitor)?))
+    }))
 }
 
 #[derive(Args, Debug)]
-pub struct DlgpdArgs {
+pub struct DlgpdOptions {
     /// A DLGPD checkpoint (`mbrl train dlgpd`).
     #[arg(long, required_unless_present = "config")]
     model: Option<PathBuf>,
@@ -167,35 +165,33 @@ pub struct DlgpdArgs {
     config: Option<PathBuf>,
 }
 
-pub fn dlgpd(global: &GlobalArgs, provenance: Provenance, a: DlgpdArgs) -> anyhow::Result<()> {
-    let (config, provenance) = match &a.config {
-        Some(path) => recorded(global, path)?,
+pub fn dlgpd(options: DlgpdOptions, invocation: &Invocation) -> Result<Job<'static, EvalSummary>> {
+    let (config, provenance) = match &options.config {
+        Some(path) => recorded(invocation, path)?,
         None => {
             // The command's own error for a bad --env names the pendulum variants it knows.
-            for env in &a.env {
+            for env in &options.env {
                 pendulum_variant(env)?;
             }
             let config = DlgpdEvalConfig {
-                model: a.model.clone().unwrap_or_default(),
-                envs: a.env.clone(),
-                evidence_rollouts: a.evidence_rollouts.clone(),
-                runs: a.runs,
-                steps: a.steps,
-                candidates: a.candidates,
-                elites: a.elites,
-                iters: a.iters,
-                prediction_only: a.prediction_only,
-                allow_incomplete: a.allow_incomplete,
+                model: options.model.clone().unwrap_or_default(),
+                envs: options.env.clone(),
+                evidence_rollouts: options.evidence_rollouts.clone(),
+                runs: options.runs,
+                steps: options.steps,
+                candidates: options.candidates,
+                elites: options.elites,
+                iters: options.iters,
+                prediction_only: options.prediction_only,
+                allow_incomplete: options.allow_incomplete,
             };
-            (config, provenance)
+            (config, invocation.provenance())
         }
     };
     config.settings()?;
-    let trained = mbrl::models::dlgpd::job::load(&config.model, accepting(config.allow_incomplete))?;
+    let trained = crate::models::dlgpd::job::load(&config.model, accepting(config.allow_incomplete))?;
     report_unfinished(&config.model, &trained.progress);
-    let summary = run_job(global, "eval dlgpd", |monitor| {
-        mbrl::eval::dlgpd::evaluate(&trained, &config, &provenance, &a.out, monitor)
-    })?;
-    print(&summary, &a.out);
-    Ok(())
+    Ok(report_job("eval dlgpd", options.out, move |monitor, out| {
+        Ok(Summary::Dlgpd(crate::eval::dlgpd::evaluate(&trained, &config, &provenance, out, monitor)?))
+    }))
 }
