@@ -30,6 +30,10 @@ pub struct GlobalArgs {
     /// Print plain progress lines on stderr instead of the live view.
     #[arg(long, global = true, overrides_with = "tui")]
     pub no_tui: bool,
+    /// Replace an output named with --out (or another output flag) that exists; without it such a command is
+    /// refused. Default output names never replace anything: a free numbered name is used.
+    #[arg(long, global = true)]
+    pub force: bool,
     /// Print only results and errors.
     #[arg(short, long, global = true)]
     pub quiet: bool,
@@ -88,7 +92,7 @@ impl GlobalArgs {
 
     /// What a library job needs to know of this command.
     pub fn invocation(&self) -> Invocation {
-        Invocation { seed: self.seed, threads: self.thread_count(), command_line: command_line() }
+        Invocation { seed: self.seed, threads: self.thread_count(), command_line: command_line(), force: self.force }
     }
 }
 

@@ -94,7 +94,7 @@ fn main() {
         Command::Filter(args) => {
             common::show(&cli.global, mbrl::jobs::filter::prepare(args, &cli.global.invocation())?)
         }
-        Command::Predict(args) => common::show(&cli.global, mbrl::jobs::predict::prepare(args)?),
+        Command::Predict(args) => common::show(&cli.global, mbrl::jobs::predict::prepare(args, &cli.global.invocation())?),
         Command::SolveBoard(args) => solve_board::run(&cli.global, args),
         Command::Eval(args) => match mbrl::jobs::eval::prepare(args, &cli.global.invocation())? {
             mbrl::jobs::eval::Eval::Run(job) => common::show(&cli.global, job),
@@ -104,7 +104,7 @@ fn main() {
             }
         },
         Command::Watch(args) => watch::run(&cli.global, args),
-        Command::Export(args) => mbrl::jobs::export::run(args).map(|summary| say!("{summary}")).map_err(Into::into),
+        Command::Export(args) => mbrl::jobs::export::run(args, &cli.global.invocation()).map(|summary| say!("{summary}")).map_err(Into::into),
         Command::Completions(args) => completions::run(args),
     });
     if let Err(err) = outcome {

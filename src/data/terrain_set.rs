@@ -47,12 +47,25 @@ fn split_of(index: usize, count: usize) -> TerrainSplit {
 /// Generates `count` maps under `seed` into the new directory `dir`. The set is written into a hidden sibling
 /// directory and renamed into place when whole, so `dir` never holds part of a set.
 pub fn write_terrain_set(dir: &Path, count: usize, seed: u64, command_line: &str, monitor: &dyn Monitor) -> Result<()> {
+    write_terrain_set_over(dir, count, seed, command_line, false, monitor)
+}
+
+/// As [`write_terrain_set`]; with `replace`, a directory that holds a map set (its `terrain.json`) is replaced
+/// by the new set once that is complete. Any other non-empty directory is refused either way.
+pub fn write_terrain_set_over(
+    dir: &Path,
+    count: usize,
+    seed: u64,
+    command_line: &str,
+    replace: bool,
+    monitor: &dyn Monitor,
+) -> Result<()> {
     if count == 0 || count > MAX_MAPS {
         return Err(Error::config(format!("--maps must be 1..={MAX_MAPS}, got {count}")));
     }
     match std::fs::read_dir(dir) {
         Ok(mut entries) => {
-            if entries.next().is_some() {
+            if entries.next().is_some() && !(replace && dir.join(MANIFEST).is_file()) {
                 return Err(Error::bad_file(dir, "exists and is not empty; give a new directory for the map set"));
             }
         }
@@ -65,7 +78,9 @@ pub fn write_terrain_set(dir: &Path, count: usize, seed: u64, command_line: &str
     let stage = staging_dir(dir)?;
     let result = fill(&stage, count, seed, command_line, monitor).and_then(|()| {
         if dir.exists() {
-            std::fs::remove_dir(dir).map_err(|e| Error::io(dir, e))?;
+            let old_set = replace && dir.join(MANIFEST).is_file();
+            let removed = if old_set { std::fs::remove_dir_all(dir) } else { std::fs::remove_dir(dir) };
+            removed.map_err(|e| Error::io(dir, e))?;
         }
         std::fs::rename(&stage, dir).map_err(|e| Error::io(dir, e))
     });

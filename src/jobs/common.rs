@@ -1,7 +1,7 @@
 //! What every job shares: the invocation it runs under, the work it hands to a view, and the checks every
 //! subcommand applies to its flags.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use crate::envs::pendulum::PendulumVariant;
 use crate::envs::{parse_env, EnvName};
@@ -16,6 +16,8 @@ pub struct Invocation {
     pub seed: u64,
     pub threads: usize,
     pub command_line: String,
+    /// `--force`: an explicitly named output that exists may be replaced.
+    pub force: bool,
 }
 
 impl Invocation {
@@ -102,6 +104,78 @@ pub fn parse_floats(flag: &str, text: &str) -> Result<Vec<f64>> {
             _ => refuse!("{flag} '{text}': value {} ('{}') is not a finite number", i + 1, part.trim()),
         })
         .collect()
+}
+
+/// The one rule for where a command writes a file. A name the user gave (`given`) that exists is replaced only
+/// with `--force`; a default name never replaces anything: when it is taken, the first free `name-2.ext`,
+/// `name-3.ext`, … is used instead (the summary prints the name written). Either way a name that was free is
+/// claimed, so a second command writing it meanwhile makes this one fail instead of silently replacing it.
+pub fn output_file(
+    flag: &str,
+    given: Option<&Path>,
+    default: impl FnOnce() -> PathBuf,
+    extension: &str,
+    invocation: &Invocation,
+) -> Result<PathBuf> {
+    let path = match given {
+        Some(path) => {
+            check_output_file(flag, path, extension)?;
+            if path.is_file() && !invocation.force {
+                refuse!("{flag} {} exists; add --force to replace it, or give another name", path.display());
+            }
+            path.to_path_buf()
+        }
+        None => {
+            let path = free_name(&default())?;
+            check_output_file(flag, &path, extension)?;
+            path
+        }
+    };
+    if !path.exists() {
+        crate::util::atomic::claim_fresh(&path);
+    }
+    Ok(path)
+}
+
+/// As [`output_file`] for an output directory (a report, a map set): one that exists is replaced only with
+/// `--force` when named, never when it is the default.
+pub fn output_dir(flag: &str, given: Option<&Path>, default: impl FnOnce() -> PathBuf, invocation: &Invocation) -> Result<PathBuf> {
+    match given {
+        Some(path) => {
+            if path.exists() && !path.is_dir() {
+                refuse!("{flag} {}: exists and is not a directory", path.display());
+            }
+            if is_nonempty_dir(path) && !invocation.force {
+                refuse!("{flag} {} exists; add --force to replace what is in it, or give another name", path.display());
+            }
+            Ok(path.to_path_buf())
+        }
+        None => free_name(&default()),
+    }
+}
+
+fn is_nonempty_dir(path: &Path) -> bool {
+    std::fs::read_dir(path).is_ok_and(|mut entries| entries.next().is_some())
+}
+
+/// Most numbered names tried for a default output before giving up (a directory full of old results).
+const MAX_NUMBERED_NAMES: u32 = 10_000;
+
+/// `path` if nothing is there, else the first free `stem-N.ext` (N from 2).
+fn free_name(path: &Path) -> Result<PathBuf> {
+    let taken = |p: &Path| std::fs::symlink_metadata(p).is_ok() && !(p.is_dir() && !is_nonempty_dir(p));
+    if !taken(path) {
+        return Ok(path.to_path_buf());
+    }
+    let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    let extension = path.extension().map(|e| format!(".{}", e.to_string_lossy())).unwrap_or_default();
+    for n in 2..=MAX_NUMBERED_NAMES {
+        let candidate = path.with_file_name(format!("{stem}-{n}{extension}"));
+        if !taken(&candidate) {
+            return Ok(candidate);
+        }
+    }
+    refuse!("{}: {MAX_NUMBERED_NAMES} numbered outputs of this name exist; give --out", path.display())
 }
 
 /// Extensions of the files mbrl reads or writes: an output named with one of them promises that format.

@@ -5,8 +5,8 @@ use std::path::PathBuf;
 
 use clap::Args;
 
+use super::{output_file, Invocation};
 use crate::data::export::{self, ExportFormat, Exported};
-use crate::util::atomic::Target;
 use crate::{refuse, Result};
 
 /// Convert a dataset, board set, ball recording or filter-estimate file to CSV or NumPy `.npz`.
@@ -57,10 +57,10 @@ impl fmt::Display for ExportSummary {
 }
 
 /// Export is quick and reads one file: it runs at once, with no view.
-pub fn run(options: ExportOptions) -> Result<ExportSummary> {
+pub fn run(options: ExportOptions, invocation: &Invocation) -> Result<ExportSummary> {
     let format = choose_format(&options)?;
-    // A directory or unwritable place is refused before the input is read.
-    Target::of(&options.out)?;
+    // A directory, an existing file without --force or an unwritable place is refused before the input is read.
+    output_file("--out", Some(&options.out), PathBuf::new, format.extension(), invocation)?;
     let exported = export::load(&options.input)?;
     export::write(&exported, format, &options.out)?;
     Ok(ExportSummary { exported, format, input: options.input, out: options.out })

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use super::{check_output_file, Invocation, Job};
+use super::{output_file, Invocation, Job};
 use crate::data::ball_estimates::{write_estimates_csv, write_estimates_mcap, BallEstimate};
 use crate::data::ball_io::{read_recordings, FRAME_RATE};
 use crate::models::ball::checkpoint::load_ball_model;
@@ -30,9 +30,10 @@ pub struct FilterOptions {
     /// Recordings: a .mcap ball dataset or a .csv recording.
     #[arg(long)]
     input: PathBuf,
-    /// CSV output: per frame the measurement, the state mean and its standard deviations.
-    #[arg(long, default_value = "filtered.csv")]
-    out: PathBuf,
+    /// CSV output: per frame the measurement, the state mean and its standard deviations (default:
+    /// filtered.csv; when that exists, the first free filtered-2.csv, …).
+    #[arg(long)]
+    out: Option<PathBuf>,
     /// Also write the means with full covariances as MCAP.
     #[arg(long)]
     mcap: Option<PathBuf>,
@@ -61,10 +62,11 @@ impl fmt::Display for FilterSummary {
 
 pub fn prepare(options: FilterOptions, invocation: &Invocation) -> Result<Job<'static, FilterSummary>> {
     let model = load_ball_model(&options.model)?;
-    check_output_file("--out", &options.out, "csv")?;
-    if let Some(path) = &options.mcap {
-        check_output_file("--mcap", path, "mcap")?;
-    }
+    let out = output_file("--out", options.out.as_deref(), || PathBuf::from("filtered.csv"), "csv", invocation)?;
+    let mcap = match &options.mcap {
+        Some(path) => Some(output_file("--mcap", Some(path), PathBuf::new, "mcap", invocation)?),
+        None => None,
+    };
     let recordings = read_recordings(&options.input)?;
     let command_line = invocation.command_line.clone();
     Ok(Job::new("filter", move |monitor| {
@@ -88,10 +90,10 @@ pub fn prepare(options: FilterOptions, invocation: &Invocation) -> Result<Job<'s
             }
             monitor.progress("filter recordings", k as u64 + 1, recordings.len() as u64);
         }
-        write_estimates_csv(&options.out, &estimates)?;
-        if let Some(path) = &options.mcap {
+        write_estimates_csv(&out, &estimates)?;
+        if let Some(path) = &mcap {
             write_estimates_mcap(path, &options.model, &command_line, &estimates)?;
         }
-        Ok(FilterSummary { likelihoods, estimates: estimates.len(), out: options.out, mcap: options.mcap })
+        Ok(FilterSummary { likelihoods, estimates: estimates.len(), out, mcap })
     }))
 }

@@ -18,5 +18,6 @@ pub mod predict;
 pub mod train;
 
 pub use common::{
+    output_dir, output_file,
     check_output_file, file_stem, finite_f64, parse_floats, pendulum_variant, warn, Invocation, Job, STEP_RECORD_BYTES,
 };

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use super::{check_output_file, finite_f64, Job};
+use super::{finite_f64, output_file, Invocation, Job};
 use crate::data::ball_io::{read_recordings, FRAME_RATE};
 use crate::models::ball::checkpoint::load_ball_model;
 use crate::models::ball::track::{
@@ -41,9 +41,9 @@ pub struct PredictOptions {
     /// Report the crossing of the plane y = this value [m].
     #[arg(long, value_parser = finite_f64)]
     plane_y: Option<f64>,
-    /// CSV of predicted points.
-    #[arg(long, default_value = "predicted.csv")]
-    out: PathBuf,
+    /// CSV of predicted points (default: predicted.csv; when that exists, the first free predicted-2.csv, …).
+    #[arg(long)]
+    out: Option<PathBuf>,
 }
 
 /// One trajectory's prediction: where it started, its error, its landing and its plane crossing.
@@ -99,8 +99,8 @@ fn horizon_frames(text: &str) -> Result<u64> {
     }
 }
 
-pub fn prepare(options: PredictOptions) -> Result<Job<'static, PredictSummary>> {
-    check_output_file("--out", &options.out, "csv")?;
+pub fn prepare(options: PredictOptions, invocation: &Invocation) -> Result<Job<'static, PredictSummary>> {
+    let out = output_file("--out", options.out.as_deref(), || PathBuf::from("predicted.csv"), "csv", invocation)?;
     let model = load_ball_model(&options.model)?;
     let steps = horizon_frames(&options.horizon)?;
     let recordings = read_recordings(&options.input)?;
@@ -149,7 +149,7 @@ pub fn prepare(options: PredictOptions) -> Result<Job<'static, PredictSummary>> 
             monitor.progress("predict recordings", k as u64 + 1, recordings.len() as u64);
         }
         let header = ["trajectory", "frame", "t", "x", "y", "z", "std_x", "std_y", "std_z", "after_impact"];
-        write_csv(&options.out, &header, &rows)?;
-        Ok(PredictSummary { trajectories, horizon: options.horizon, plane_y: options.plane_y, out: options.out })
+        write_csv(&out, &header, &rows)?;
+        Ok(PredictSummary { trajectories, horizon: options.horizon, plane_y: options.plane_y, out })
     }))
 }

@@ -37,9 +37,10 @@ impl Field {
 
 /// What to do in `out` for a run asking for `request`. Without `resume_if_stopped` a stopped run is refused (a
 /// new run starts by clearing the directory, so it would throw away every hour that run trained); with it, the
-/// stopped run goes on when `request` is what started it, and only then. A directory whose checkpoint cannot be
-/// read holds no run and is replaced, as a finished one is.
-pub fn decide<M: Method>(out: &Path, request: &Request<M>, resume_if_stopped: bool) -> Result<Decision> {
+/// stopped run goes on when `request` is what started it, and only then; with `force` alone, it is started
+/// over. A directory whose checkpoint cannot be read holds no run and is replaced, as a finished one is (the
+/// command line's rule for named outputs, `--force`, is applied before this).
+pub fn decide<M: Method>(out: &Path, request: &Request<M>, resume_if_stopped: bool, force: bool) -> Result<Decision> {
     if out.is_dir() {
         RunLock::ensure_free(out)?;
     }
@@ -52,12 +53,15 @@ pub fn decide<M: Method>(out: &Path, request: &Request<M>, resume_if_stopped: bo
     }
     let stopped =
         format!("holds a {} run stopped at step {} of {}", manifest.method, manifest.step, manifest.total_steps);
+    if force && !resume_if_stopped {
+        return Ok(Decision::Fresh);
+    }
     if !resume_if_stopped {
         return Err(Error::bad_file(
             out,
             format!(
-                "{stopped}; continue it with `mbrl train --resume {}` (or add --resume-if-stopped), or remove the \
-                 directory to start over",
+                "{stopped}; continue it with `mbrl train --resume {}` (or add --resume-if-stopped), or add --force \
+                 to start over",
                 out.display()
             ),
         ));

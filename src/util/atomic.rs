@@ -1,10 +1,37 @@
 //! Outputs appear whole or not at all: write into a temporary file beside the target, then rename.
 
+use std::collections::BTreeSet;
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
 use super::interrupt::{create_partial, PartialGuard};
 use crate::error::{Error, Result};
+
+/// Outputs this process must not replace: names a command chose because nothing was there. Their final
+/// rename refuses to replace what appeared meanwhile, so of two commands writing one name at once the second
+/// fails instead of both reporting success while one result silently wins.
+static FRESH_ONLY: Mutex<BTreeSet<PathBuf>> = Mutex::new(BTreeSet::new());
+
+fn fresh_only() -> std::sync::MutexGuard<'static, BTreeSet<PathBuf>> {
+    FRESH_ONLY.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+fn absolute(path: &Path) -> PathBuf {
+    std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf())
+}
+
+fn written_meanwhile(path: &Path) -> Error {
+    Error::bad_file(
+        path,
+        "was written by another command while this one ran; rerun with another name, or with --force to replace it",
+    )
+}
+
+/// Marks `path` as an output that must not exist when this process writes it.
+pub fn claim_fresh(path: &Path) {
+    fresh_only().insert(absolute(path));
+}
 
 /// Writes `path` through `fill`. On any error the temporary file is removed and `path` is untouched.
 pub fn write_atomic<F>(path: &Path, fill: F) -> Result<()>
@@ -43,6 +70,10 @@ pub enum Target {
 
 impl Target {
     pub fn of(path: &Path) -> Result<Target> {
+        let claimed = fresh_only().contains(&absolute(path));
+        if claimed && std::fs::symlink_metadata(path).is_ok() {
+            return Err(written_meanwhile(path));
+        }
         match std::fs::metadata(path) {
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(Target::Replace(path.to_path_buf())),
             Err(e) => Err(Error::io(path, e)),
@@ -72,6 +103,12 @@ impl Target {
 
     pub fn finish(self, mut tmp: PartialFile) -> Result<()> {
         match self {
+            Target::Replace(path) if fresh_only().contains(&absolute(&path)) => {
+                tmp.persist_fresh(&path)?;
+                // Ours from now on: a job that rewrites its own output replaces it.
+                fresh_only().remove(&absolute(&path));
+                Ok(())
+            }
             Target::Replace(path) => tmp.persist(&path),
             Target::WriteInto(path) => {
                 use std::io::Seek;
@@ -106,6 +143,16 @@ impl PartialFile {
         let PartialFile { file, _registered } = self;
         file.persist(path).map_err(|e| Error::io(path, e.error))?;
         Ok(())
+    }
+
+    /// As [`persist`](Self::persist), failing when `path` exists by now.
+    fn persist_fresh(self, path: &Path) -> Result<()> {
+        let PartialFile { file, _registered } = self;
+        match file.persist_noclobber(path) {
+            Ok(_) => Ok(()),
+            Err(e) if e.error.kind() == std::io::ErrorKind::AlreadyExists => Err(written_meanwhile(path)),
+            Err(e) => Err(Error::io(path, e.error)),
+        }
     }
 }
 
@@ -165,6 +212,18 @@ mod tests {
         std::fs::write(&target, "old").unwrap();
         write_atomic(&target, |w| w.write_all(b"new").map_err(|e| Error::io(&target, e))).unwrap();
         assert_eq!(std::fs::read_to_string(&target).unwrap(), "new");
+    }
+
+    #[test]
+    fn a_claimed_output_that_appears_meanwhile_is_not_replaced() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("claimed.txt");
+        claim_fresh(&target);
+        std::fs::write(&target, "the other command's").unwrap();
+        let err = write_text(&target, "ours").unwrap_err().to_string();
+        assert!(err.contains("written by another command"), "{err}");
+        assert_eq!(std::fs::read_to_string(&target).unwrap(), "the other command's");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "no temporary file left");
     }
 
     #[cfg(unix)]

@@ -6,7 +6,7 @@ use super::{CollectOptions, CollectSummary};
 use crate::data::ball_io::write_ball_dataset;
 use crate::data::collect_ball::{collect_ball, BallCollectSettings};
 use crate::envs::ball::Orientation;
-use crate::jobs::{check_output_file, Invocation, Job};
+use crate::jobs::{output_file, Invocation, Job};
 use crate::Result;
 
 pub(super) fn prepare(
@@ -15,8 +15,8 @@ pub(super) fn prepare(
     invocation: &Invocation,
 ) -> Result<Job<'static, CollectSummary>> {
     let orientation = Orientation::parse(&options.orientation)?;
-    let out = options.out.unwrap_or_else(|| PathBuf::from(format!("datasets/ball-{}.mcap", orientation.name())));
-    check_output_file("--out", &out, "mcap")?;
+    let default = || PathBuf::from(format!("datasets/ball-{}.mcap", orientation.name()));
+    let out = output_file("--out", options.out.as_deref(), default, "mcap", invocation)?;
     let settings = BallCollectSettings {
         trajectories,
         orientation,

@@ -7,7 +7,7 @@ use crate::data::boardset::{write_board_set, BoardSet};
 use crate::envs::boards::depth::{DenseIndex, DepthTable};
 use crate::envs::boards::sets::{board_set, BoardRecord};
 use crate::envs::boards::{BoardGame, GameSpec, LightsOut, Split, TileSwap};
-use crate::jobs::{check_output_file, file_stem, Invocation, Job};
+use crate::jobs::{output_file, file_stem, Invocation, Job};
 use crate::run::Monitor;
 use crate::{refuse, Result};
 
@@ -17,10 +17,8 @@ pub(super) fn prepare(
     invocation: &Invocation,
 ) -> Result<Job<'static, CollectSummary>> {
     let max_depth = options.max_depth.unwrap_or(0);
-    let out = options
-        .out
-        .unwrap_or_else(|| PathBuf::from(format!("datasets/{}-boards-d{max_depth}.mcap", file_stem(&game.name()))));
-    check_output_file("--out", &out, "mcap")?;
+    let default = || PathBuf::from(format!("datasets/{}-boards-d{max_depth}.mcap", file_stem(&game.name())));
+    let out = output_file("--out", options.out.as_deref(), default, "mcap", invocation)?;
     // Refused before the depth table (seconds of work) is built; the upper bound needs the table.
     let full_name = match game {
         GameSpec::LightsOut(n) => LightsOut::new(n)?.name(),

@@ -12,7 +12,7 @@ use crate::data::write_dataset;
 use crate::envs::boards::GameSpec;
 use crate::envs::embodiments::Embodiment;
 use crate::envs::EnvName;
-use crate::jobs::{check_output_file, file_stem, Invocation, Job};
+use crate::jobs::{output_file, file_stem, Invocation, Job};
 use crate::{refuse, Result};
 
 pub(super) fn prepare(
@@ -26,9 +26,8 @@ pub(super) fn prepare(
         refuse!("--boards is for board games alone; for board sets use --env {}", game.name());
     }
     let mode = if options.actions.is_some() { "replay" } else { "random" };
-    let out =
-        options.out.clone().unwrap_or_else(|| PathBuf::from(format!("datasets/{}-{mode}.mcap", file_stem(&name))));
-    check_output_file("--out", &out, "mcap")?;
+    let default = || PathBuf::from(format!("datasets/{}-{mode}.mcap", file_stem(&name)));
+    let out = output_file("--out", options.out.as_deref(), default, "mcap", invocation)?;
     let (seed, command_line) = (invocation.seed, invocation.command_line.clone());
     match (&options.actions, options.episodes) {
         (Some(actions), _) => {

@@ -7,7 +7,7 @@ use crate::data::collect::{collect_instance_pairs, collect_random, CollectSettin
 use crate::data::collect_frames::{add_pendulum_frames, check_frames_size};
 use crate::data::write_dataset;
 use crate::envs::EnvName;
-use crate::jobs::{check_output_file, file_stem, Invocation, Job};
+use crate::jobs::{output_file, file_stem, Invocation, Job};
 use crate::Result;
 
 pub(super) fn prepare(
@@ -16,11 +16,8 @@ pub(super) fn prepare(
     invocation: &Invocation,
 ) -> Result<Job<'static, CollectSummary>> {
     let mode = if options.instances.is_some() { "pairs" } else { "random" };
-    let out = options
-        .out
-        .clone()
-        .unwrap_or_else(|| PathBuf::from(format!("datasets/{}-{mode}.mcap", file_stem(&env.canonical()))));
-    check_output_file("--out", &out, "mcap")?;
+    let default = || PathBuf::from(format!("datasets/{}-{mode}.mcap", file_stem(&env.canonical())));
+    let out = output_file("--out", options.out.as_deref(), default, "mcap", invocation)?;
     if options.images {
         let rollouts = options.instances.map_or(options.rollouts, |n| 2 * n);
         check_frames_size(&env, rollouts as f64 * (options.steps as f64 + 1.0))?;

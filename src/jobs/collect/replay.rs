@@ -8,7 +8,7 @@ use crate::data::collect::{parse_state, replay, ReplaySettings};
 use crate::data::collect_frames::{add_pendulum_frames, check_frames_size};
 use crate::data::write_dataset;
 use crate::envs::EnvName;
-use crate::jobs::{check_output_file, file_stem, Invocation, Job};
+use crate::jobs::{output_file, file_stem, Invocation, Job};
 use crate::Result;
 
 pub(super) fn prepare(
@@ -20,9 +20,8 @@ pub(super) fn prepare(
     let spec = env.build()?.spec();
     let init_state = options.init_state.as_deref().map(|text| parse_state(text, &spec)).transpose()?;
     let actions = read_actions(actions, spec.action_dim())?;
-    let out =
-        options.out.unwrap_or_else(|| PathBuf::from(format!("datasets/{}-replay.mcap", file_stem(&env.canonical()))));
-    check_output_file("--out", &out, "mcap")?;
+    let default = || PathBuf::from(format!("datasets/{}-replay.mcap", file_stem(&env.canonical())));
+    let out = output_file("--out", options.out.as_deref(), default, "mcap", invocation)?;
     let settings = ReplaySettings {
         env,
         actions,

@@ -3,11 +3,11 @@
 use std::path::{Path, PathBuf};
 
 use super::{CollectOptions, CollectSummary};
-use crate::data::terrain_set::{read_terrain_set, write_terrain_set};
+use crate::data::terrain_set::{read_terrain_set, write_terrain_set_over};
 use crate::envs::terrain::{TerrainMap, TerrainSplit};
 use crate::envs::unicycle::UnicycleTerrain;
 use crate::jobs::choices::SplitChoice;
-use crate::jobs::{Invocation, Job};
+use crate::jobs::{output_dir, Invocation, Job};
 use crate::{refuse, Error, Result};
 
 /// The maps `--map` / `--maps DIR --split S` name, loaded once for every instance.
@@ -48,10 +48,10 @@ pub(super) fn prepare_maps(options: CollectOptions, invocation: &Invocation) -> 
     {
         refuse!("--env terrain takes only --maps N, --out DIR and --seed");
     }
-    let out = options.out.unwrap_or_else(|| PathBuf::from("datasets/terrain"));
-    let (seed, command_line) = (invocation.seed, invocation.command_line.clone());
+    let out = output_dir("--out", options.out.as_deref(), || PathBuf::from("datasets/terrain"), invocation)?;
+    let (seed, command_line, force) = (invocation.seed, invocation.command_line.clone(), invocation.force);
     Ok(Job::new("collect terrain", move |monitor| {
-        write_terrain_set(&out, count, seed, &command_line, monitor)?;
+        write_terrain_set_over(&out, count, seed, &command_line, force, monitor)?;
         Ok(CollectSummary::Terrain { maps: count, out })
     }))
 }

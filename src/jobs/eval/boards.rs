@@ -12,14 +12,14 @@ use crate::eval::seads::{
 use crate::eval::summary::Summary;
 use crate::jobs::choices::{EmbodimentChoice, SplitChoice};
 use crate::jobs::model_options::{accepting, report_unfinished};
-use crate::jobs::{Invocation, Job};
+use crate::jobs::{output_dir, Invocation, Job};
 use crate::Result;
 
 #[derive(Args, Debug)]
 pub struct BoardsOptions {
-    /// Report directory.
-    #[arg(long, default_value = "reports/boards")]
-    out: PathBuf,
+    /// Report directory (default: reports/boards; when that exists, the first free reports/boards-2, -3, …).
+    #[arg(long)]
+    out: Option<PathBuf>,
     /// Rerun with the seed a boards report recorded (its config.json).
     #[arg(long, value_name = "FILE")]
     config: Option<PathBuf>,
@@ -30,7 +30,7 @@ pub fn boards(options: BoardsOptions, invocation: &Invocation) -> Result<Job<'st
         Some(path) => recorded::<boards::BoardsConfig>(invocation, path)?.1,
         None => invocation.provenance(),
     };
-    Ok(report_job("eval boards", options.out, move |monitor, out| {
+    Ok(report_job("eval boards", output_dir("--out", options.out.as_deref(), || PathBuf::from("reports/boards"), invocation)?, move |monitor, out| {
         Ok(Summary::Boards(boards::depth_report(&provenance, out, monitor)?))
     }))
 }
@@ -52,9 +52,9 @@ pub struct EmbodiedOptions {
     /// Split the boards come from.
     #[arg(long, value_enum, default_value_t = SplitChoice::Test)]
     split: SplitChoice,
-    /// Report directory.
-    #[arg(long, default_value = "reports/embodied")]
-    out: PathBuf,
+    /// Report directory (default: reports/embodied; when that exists, the first free reports/embodied-2, -3, …).
+    #[arg(long)]
+    out: Option<PathBuf>,
     /// Rerun the settings and seed an embodied report recorded (its config.json); no other flag but --out.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["game", "embodiment", "max_depth", "boards", "split"])]
     config: Option<PathBuf>,
@@ -77,7 +77,7 @@ pub fn embodied(options: EmbodiedOptions, invocation: &Invocation) -> Result<Job
         ),
     };
     config.validate()?;
-    Ok(report_job("eval embodied", options.out, move |monitor, out| {
+    Ok(report_job("eval embodied", output_dir("--out", options.out.as_deref(), || PathBuf::from("reports/embodied"), invocation)?, move |monitor, out| {
         Ok(Summary::Embodied(boards::embodied(&config, &provenance, out, monitor)?))
     }))
 }
@@ -140,7 +140,7 @@ pub fn seads(options: SeadsOptions, invocation: &Invocation) -> Result<Job<'stat
         ),
     };
     config.validate()?;
-    let out = options.out.clone().unwrap_or_else(|| config.default_out());
+    let out = output_dir("--out", options.out.as_deref(), || config.default_out(), invocation)?;
     let loaded: Vec<_> = config
         .models
         .iter()

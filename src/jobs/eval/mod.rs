@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 
 use clap::{Args, Subcommand};
 
-use super::{Invocation, Job};
+use super::{output_dir, Invocation, Job};
 use crate::eval::seads::SeadsEvalSummary;
 use crate::eval::summary::{read_config, ProtocolConfig, Summary};
 use crate::run::dir::Provenance;
@@ -102,9 +102,9 @@ enum Protocol {
 
 #[derive(Args, Debug)]
 struct QuickOptions {
-    /// Report directory.
-    #[arg(long, default_value = "reports/quick")]
-    out: PathBuf,
+    /// Report directory (default: reports/quick; when that exists, the first free reports/quick-2, -3, …).
+    #[arg(long)]
+    out: Option<PathBuf>,
     /// Rerun with the seed a quick report recorded (its config.json).
     #[arg(long, value_name = "FILE")]
     config: Option<PathBuf>,
@@ -155,7 +155,7 @@ pub fn prepare(options: EvalOptions, invocation: &Invocation) -> Result<Eval> {
                 Some(path) => recorded::<crate::eval::quick::QuickConfig>(invocation, path)?.1,
                 None => invocation.provenance(),
             };
-            report_job("eval quick", options.out, move |monitor, out| {
+            report_job("eval quick", output_dir("--out", options.out.as_deref(), || PathBuf::from("reports/quick"), invocation)?, move |monitor, out| {
                 Ok(Summary::Quick(crate::eval::quick::run_quick(&provenance, out, monitor)?))
             })
         }

@@ -13,7 +13,7 @@ use crate::eval::swingup::SwingupSettings;
 use crate::eval::tradyn::{TradynEvalConfig, TradynEvalModels};
 use crate::jobs::choices::StrategyChoice;
 use crate::jobs::model_options::{accepting, report_unfinished};
-use crate::jobs::{Invocation, Job};
+use crate::jobs::{output_dir, Invocation, Job};
 use crate::models::ball::checkpoint::{load_ball_model, report_name};
 use crate::models::context::calibration::{CalibrationSettings, Strategy};
 use crate::{refuse, Result};
@@ -35,9 +35,9 @@ pub struct BallOptions {
     /// Test shots per unseen pose (5 poses).
     #[arg(long, default_value_t = 30)]
     unseen_shots: usize,
-    /// Report directory.
-    #[arg(long, default_value = "reports/ball")]
-    out: PathBuf,
+    /// Report directory (default: reports/ball; when that exists, the first free reports/ball-2, -3, …).
+    #[arg(long)]
+    out: Option<PathBuf>,
     /// Rerun the settings and seed a ball report recorded (its config.json); no other flag but --out.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["model", "train_shots", "augment_rotations", "test_shots", "unseen_shots"])]
     config: Option<PathBuf>,
@@ -62,7 +62,7 @@ pub fn ball(options: BallOptions, invocation: &Invocation) -> Result<Job<'static
     };
     let models = config.models.iter().map(|m| Ok((report_name(m), load_ball_model(m)?))).collect::<Result<Vec<_>>>()?;
     config.validate()?;
-    Ok(report_job("eval ball", options.out, move |monitor, out| {
+    Ok(report_job("eval ball", output_dir("--out", options.out.as_deref(), || PathBuf::from("reports/ball"), invocation)?, move |monitor, out| {
         Ok(Summary::Ball(ball::evaluate(&config, models, &provenance, out, monitor)?))
     }))
 }
@@ -118,9 +118,9 @@ pub struct ContextOptions {
     /// Take a run still in training (its best-validation weights so far); the report says how far it got.
     #[arg(long)]
     allow_incomplete: bool,
-    /// Report directory.
-    #[arg(long, default_value = "reports/context")]
-    out: PathBuf,
+    /// Report directory (default: reports/context; when that exists, the first free reports/context-2, -3, …).
+    #[arg(long)]
+    out: Option<PathBuf>,
     /// Rerun the settings and seed a context report recorded (its config.json); no other flag but --out.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["model", "env", "contexts", "validation_rollouts", "validation_steps", "transitions", "horizon", "strategy", "candidates", "elites", "iters", "beta_samples", "swingup", "swingup_steps", "swingup_candidates", "allow_incomplete"])]
     config: Option<PathBuf>,
@@ -185,7 +185,7 @@ pub fn context(options: ContextOptions, invocation: &Invocation) -> Result<Job<'
     config.validate(&env)?;
     let model = crate::models::context::load(&config.model, &env, accepting(config.allow_incomplete))?;
     report_unfinished(&config.model, &model.progress);
-    Ok(report_job("eval context", options.out, move |monitor, out| {
+    Ok(report_job("eval context", output_dir("--out", options.out.as_deref(), || PathBuf::from("reports/context"), invocation)?, move |monitor, out| {
         Ok(Summary::Context(crate::eval::context::evaluate(&model, &env, &config, &provenance, out, monitor)?))
     }))
 }
@@ -225,9 +225,9 @@ pub struct TradynOptions {
     /// Length of the random rollout per task whose open-loop prediction is scored (thesis 50).
     #[arg(long, default_value_t = 50)]
     prediction_steps: usize,
-    /// Report directory.
-    #[arg(long, default_value = "reports/tradyn")]
-    out: PathBuf,
+    /// Report directory (default: reports/tradyn; when that exists, the first free reports/tradyn-2, -3, …).
+    #[arg(long)]
+    out: Option<PathBuf>,
     /// Take runs still in training (their best-validation weights so far); the report says how far each got.
     #[arg(long)]
     allow_incomplete: bool,
@@ -275,7 +275,7 @@ pub fn tradyn(options: TradynOptions, invocation: &Invocation) -> Result<Job<'st
     models.check()?;
     let maps =
         crate::data::terrain_set::read_terrain_set(&config.maps, Some(crate::envs::terrain::TerrainSplit::Test))?;
-    Ok(report_job("eval tradyn", options.out, move |monitor, out| {
+    Ok(report_job("eval tradyn", output_dir("--out", options.out.as_deref(), || PathBuf::from("reports/tradyn"), invocation)?, move |monitor, out| {
         Ok(Summary::Tradyn(crate::eval::tradyn::evaluate(&models, maps, &config, &provenance, out, monitor)?))
     }))
 }

@@ -10,7 +10,7 @@ use crate::eval::summary::Summary;
 use crate::eval::swingup::{self, ModelSpec, SwingupConfig, SwingupSettings};
 use crate::jobs::cem_options::CemOptions;
 use crate::jobs::model_options::{accepting, report_unfinished, ModelOptions, PropagationChoice};
-use crate::jobs::{pendulum_variant, Invocation, Job, STEP_RECORD_BYTES};
+use crate::jobs::{output_dir, pendulum_variant, Invocation, Job, STEP_RECORD_BYTES};
 use crate::{refuse, Result};
 
 #[derive(Args, Debug)]
@@ -18,9 +18,9 @@ pub struct DatasetOptions {
     /// Dataset file written by `mbrl collect` or `mbrl plan`.
     #[arg(long, required_unless_present = "config", conflicts_with = "config")]
     input: Option<PathBuf>,
-    /// Report directory.
-    #[arg(long, default_value = "reports/dataset")]
-    out: PathBuf,
+    /// Report directory (default: reports/dataset; when that exists, the first free reports/dataset-2, -3, …).
+    #[arg(long)]
+    out: Option<PathBuf>,
     /// Redo the report of the dataset a dataset report recorded (its config.json).
     #[arg(long, value_name = "FILE")]
     config: Option<PathBuf>,
@@ -34,7 +34,7 @@ pub fn dataset(options: DatasetOptions, invocation: &Invocation) -> Result<Job<'
         }
         (None, input) => (input.unwrap_or_default(), invocation.provenance()),
     };
-    Ok(report_job("eval dataset", options.out, move |_, out| {
+    Ok(report_job("eval dataset", output_dir("--out", options.out.as_deref(), || PathBuf::from("reports/dataset"), invocation)?, move |_, out| {
         Ok(Summary::Dataset(crate::eval::dataset_report::report(&input, &provenance, out)?))
     }))
 }
@@ -53,9 +53,9 @@ pub struct SwingupOptions {
     steps: usize,
     #[command(flatten)]
     cem: CemOptions,
-    /// Report directory.
-    #[arg(long, default_value = "reports/pendulum-swingup")]
-    out: PathBuf,
+    /// Report directory (default: reports/pendulum-swingup; when that exists, the first free reports/pendulum-swingup-2, -3, …).
+    #[arg(long)]
+    out: Option<PathBuf>,
     /// Rerun the settings and seed a swing-up report recorded (its config.json); no other flag but --out.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["model", "particles", "propagation", "context", "allow_incomplete", "episodes", "env", "steps", "horizon", "candidates", "elites", "iters", "noise", "beta", "no_warm_start"])]
     config: Option<PathBuf>,
@@ -118,7 +118,7 @@ pub fn swingup(options: SwingupOptions, invocation: &Invocation) -> Result<Job<'
         crate::util::budget::times(&[config.episodes, config.settings.steps], STEP_RECORD_BYTES),
         "evaluate fewer or shorter episodes",
     )?;
-    Ok(report_job("eval pendulum-swingup", options.out, move |monitor, out| {
+    Ok(report_job("eval pendulum-swingup", output_dir("--out", options.out.as_deref(), || PathBuf::from("reports/pendulum-swingup"), invocation)?, move |monitor, out| {
         Ok(Summary::PendulumSwingup(swingup::evaluate(&config, model.as_deref(), &provenance, out, monitor)?))
     }))
 }
@@ -157,9 +157,9 @@ pub struct DlgpdOptions {
     /// Take a run still in training (its best-validation weights so far); the report says how far it got.
     #[arg(long)]
     allow_incomplete: bool,
-    /// Report directory.
-    #[arg(long, default_value = "reports/dlgpd")]
-    out: PathBuf,
+    /// Report directory (default: reports/dlgpd; when that exists, the first free reports/dlgpd-2, -3, …).
+    #[arg(long)]
+    out: Option<PathBuf>,
     /// Rerun the settings and seed a dlgpd report recorded (its config.json); no other flag but --out.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["model", "env", "evidence_rollouts", "runs", "steps", "candidates", "elites", "iters", "prediction_only", "allow_incomplete"])]
     config: Option<PathBuf>,
@@ -191,7 +191,7 @@ pub fn dlgpd(options: DlgpdOptions, invocation: &Invocation) -> Result<Job<'stat
     config.settings()?;
     let trained = crate::models::dlgpd::job::load(&config.model, accepting(config.allow_incomplete))?;
     report_unfinished(&config.model, &trained.progress);
-    Ok(report_job("eval dlgpd", options.out, move |monitor, out| {
+    Ok(report_job("eval dlgpd", output_dir("--out", options.out.as_deref(), || PathBuf::from("reports/dlgpd"), invocation)?, move |monitor, out| {
         Ok(Summary::Dlgpd(crate::eval::dlgpd::evaluate(&trained, &config, &provenance, out, monitor)?))
     }))
 }

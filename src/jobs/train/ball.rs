@@ -61,6 +61,6 @@ pub fn prepare(options: BallOptions, invocation: &Invocation) -> Result<Job<'sta
         variant: (),
         provenance: invocation.provenance(),
     };
-    let out = options.run.out.unwrap_or_else(default_out_dir);
-    train(out, request, options.run.resume_if_stopped)
+    let out = options.run.out.clone().unwrap_or_else(default_out_dir);
+    train(out, &options.run, request, invocation)
 }

@@ -116,7 +116,7 @@ pub fn prepare_context(options: ContextOptions, invocation: &Invocation) -> Resu
         variant: (),
         provenance: invocation.provenance(),
     };
-    train(planned.out, request, options.run.resume_if_stopped)
+    train(planned.out, &options.run, request, invocation)
 }
 
 pub fn prepare_tradyn(options: TradynOptions, invocation: &Invocation) -> Result<Job<'static, TrainSummary>> {
@@ -140,5 +140,5 @@ pub fn prepare_tradyn(options: TradynOptions, invocation: &Invocation) -> Result
         variant: terrain,
         provenance: invocation.provenance(),
     };
-    train(planned.out, request, options.run.resume_if_stopped)
+    train(planned.out, &options.run, request, invocation)
 }

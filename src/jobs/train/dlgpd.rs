@@ -73,6 +73,6 @@ pub fn prepare(options: DlgpdOptions, invocation: &Invocation) -> Result<Job<'st
         variant: (),
         provenance: invocation.provenance(),
     };
-    let out = options.run.out.unwrap_or_else(default_out_dir);
-    train(out, request, options.run.resume_if_stopped)
+    let out = options.run.out.clone().unwrap_or_else(default_out_dir);
+    train(out, &options.run, request, invocation)
 }

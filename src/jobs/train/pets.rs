@@ -106,5 +106,5 @@ pub fn prepare(options: PetsOptions, invocation: &Invocation) -> Result<Job<'sta
         variant: (),
         provenance: invocation.provenance(),
     };
-    train(planned.out, request, options.run.resume_if_stopped)
+    train(planned.out, &options.run, request, invocation)
 }

@@ -79,6 +79,6 @@ pub fn prepare(options: SeadsOptions, invocation: &Invocation) -> Result<Job<'st
         variant: (),
         provenance: invocation.provenance(),
     };
-    let out = options.run.out.unwrap_or_else(|| default_out_for(&env));
-    train(out, request, options.run.resume_if_stopped)
+    let out = options.run.out.clone().unwrap_or_else(|| default_out_for(&env));
+    train(out, &options.run, request, invocation)
 }
