@@ -10,15 +10,11 @@ macro_rules! say {
     };
 }
 
-mod calibrate;
 mod collect;
 mod common;
 mod completions;
 mod eval;
-mod plan;
-mod plan_unicycle;
 mod predict;
-mod solve_board;
 mod train;
 mod watch;
 
@@ -56,12 +52,12 @@ pub struct Cli {
 #[derive(Subcommand)]
 enum Command {
     Collect(collect::CollectArgs),
-    Plan(plan::PlanArgs),
+    Plan(mbrl::jobs::plan::PlanOptions),
     Train(train::TrainArgs),
-    Calibrate(calibrate::CalibrateArgs),
+    Calibrate(mbrl::jobs::calibrate::CalibrateOptions),
     Filter(mbrl::jobs::filter::FilterOptions),
     Predict(predict::PredictArgs),
-    SolveBoard(solve_board::SolveBoardArgs),
+    SolveBoard(mbrl::jobs::solve_board::SolveBoardOptions),
     Eval(eval::EvalArgs),
     Watch(watch::WatchArgs),
     Export(mbrl::jobs::export::ExportOptions),
@@ -80,14 +76,22 @@ fn main() {
         .unwrap_or_else(|err| exit_on_usage_error(err));
     let outcome = common::init_threads(&cli.global).and_then(|()| match cli.command {
         Command::Collect(args) => collect::run(&cli.global, args),
-        Command::Plan(args) => plan::run(&cli.global, args),
+        Command::Plan(args) => common::show(&cli.global, mbrl::jobs::plan::prepare(args, &cli.global.invocation())?),
         Command::Train(args) => train::run(&cli.global, args),
-        Command::Calibrate(args) => calibrate::run(&cli.global, args),
+        Command::Calibrate(args) => {
+            common::show(&cli.global, mbrl::jobs::calibrate::prepare(args, &cli.global.invocation())?)
+        }
         Command::Filter(args) => {
             common::show(&cli.global, mbrl::jobs::filter::prepare(args, &cli.global.invocation())?)
         }
         Command::Predict(args) => predict::run(&cli.global, args),
-        Command::SolveBoard(args) => solve_board::run(&cli.global, args),
+        Command::SolveBoard(args) => {
+            // A plan played that misses the goal is shown, then fails the command.
+            let job = mbrl::jobs::solve_board::prepare(args, &cli.global.invocation())?;
+            let summary = common::run_job(&cli.global, &job.title.clone(), |monitor| job.run(monitor))?;
+            say!("{summary}");
+            Ok(summary.verdict()?)
+        }
         Command::Eval(args) => eval::run(&cli.global, args),
         Command::Watch(args) => watch::run(&cli.global, args),
         Command::Export(args) => Ok(say!("{}", mbrl::jobs::export::run(args)?)),

@@ -116,7 +116,7 @@ pub struct CollectArgs {
     max_depth: Option<u8>,
     /// Only boards of this split (--boards), or the maps of this split of a map set (--maps DIR).
     #[arg(long, value_enum)]
-    split: Option<crate::solve_board::SplitChoice>,
+    split: Option<mbrl::jobs::choices::SplitChoice>,
     /// For --env terrain: how many maps to make. For --env unicycle: a map set directory (with terrain.json)
     /// whose --split maps the instances are drawn on.
     #[arg(long, value_name = "N|DIR", conflicts_with = "map")]

@@ -108,7 +108,7 @@ pub fn collect_embodied_episodes(
 pub fn unicycle_terrain(
     map: Option<&Path>,
     maps: Option<&str>,
-    split: Option<crate::solve_board::SplitChoice>,
+    split: Option<mbrl::jobs::choices::SplitChoice>,
 ) -> anyhow::Result<UnicycleTerrain> {
     match (map, maps) {
         (Some(path), _) => {

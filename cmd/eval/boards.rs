@@ -11,7 +11,7 @@ use mbrl::run::dir::Provenance;
 
 use super::{print, recorded};
 use crate::common::{run_job, GlobalArgs};
-use crate::solve_board::{EmbodimentChoice, SplitChoice};
+use mbrl::jobs::choices::{EmbodimentChoice, SplitChoice};
 use mbrl::jobs::model_options::{accepting, report_unfinished};
 
 #[derive(Args, Debug)]

@@ -6,12 +6,15 @@
 //!
 //! The one room that knows clap: the engine below never parses flags.
 
+pub mod calibrate;
 pub mod cem_options;
 pub mod choices;
 mod common;
 pub mod export;
 pub mod filter;
 pub mod model_options;
+pub mod plan;
+pub mod solve_board;
 
 pub use common::{
     check_output_file, file_stem, finite_f64, parse_floats, pendulum_variant, warn, Invocation, Job, STEP_RECORD_BYTES,
