@@ -9,7 +9,6 @@ use clap::Args;
 use mbrl::jobs::{Invocation, Job};
 use mbrl::run::{ChannelMonitor, ConsoleMonitor, Event, Monitor, NullMonitor};
 
-pub use mbrl::jobs::{check_output_file, file_stem, finite_f64, parse_floats, pendulum_variant};
 use mbrl::tui::{run_live, LiveOptions, LiveOutcome, DEFAULT_GRACE};
 
 #[derive(Args, Clone, Debug)]

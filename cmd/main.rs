@@ -10,12 +10,8 @@ macro_rules! say {
     };
 }
 
-mod calibrate;
 mod common;
 mod completions;
-mod plan;
-mod plan_unicycle;
-mod solve_board;
 mod train;
 mod watch;
 
@@ -53,12 +49,12 @@ pub struct Cli {
 #[derive(Subcommand)]
 enum Command {
     Collect(mbrl::jobs::collect::CollectOptions),
-    Plan(plan::PlanArgs),
+    Plan(mbrl::jobs::plan::PlanOptions),
     Train(mbrl::jobs::train::TrainOptions),
-    Calibrate(calibrate::CalibrateArgs),
+    Calibrate(mbrl::jobs::calibrate::CalibrateOptions),
     Filter(mbrl::jobs::filter::FilterOptions),
     Predict(mbrl::jobs::predict::PredictOptions),
-    SolveBoard(solve_board::SolveBoardArgs),
+    SolveBoard(mbrl::jobs::solve_board::SolveBoardOptions),
     Eval(mbrl::jobs::eval::EvalOptions),
     Watch(watch::WatchArgs),
     Export(mbrl::jobs::export::ExportOptions),
@@ -83,19 +79,27 @@ fn main() {
             }
             mbrl::jobs::collect::Collection::Viewed(job) => common::show(&cli.global, job),
         },
-        Command::Plan(args) => plan::run(&cli.global, args),
+        Command::Plan(args) => common::show(&cli.global, mbrl::jobs::plan::prepare(args, &cli.global.invocation())?),
         Command::Train(args) => match mbrl::jobs::train::prepare(args, &cli.global.invocation())? {
             Some(job) => common::show(&cli.global, job),
             None => exit_on_usage_error(
                 Cli::command().error(clap::error::ErrorKind::MissingSubcommand, mbrl::jobs::train::MISSING_METHOD),
             ),
         },
-        Command::Calibrate(args) => calibrate::run(&cli.global, args),
+        Command::Calibrate(args) => {
+            common::show(&cli.global, mbrl::jobs::calibrate::prepare(args, &cli.global.invocation())?)
+        }
         Command::Filter(args) => {
             common::show(&cli.global, mbrl::jobs::filter::prepare(args, &cli.global.invocation())?)
         }
         Command::Predict(args) => common::show(&cli.global, mbrl::jobs::predict::prepare(args, &cli.global.invocation())?),
-        Command::SolveBoard(args) => solve_board::run(&cli.global, args),
+        Command::SolveBoard(args) => {
+            // A plan played that misses the goal is shown, then fails the command.
+            let job = mbrl::jobs::solve_board::prepare(args, &cli.global.invocation())?;
+            let summary = common::run_job(&cli.global, &job.title.clone(), |monitor| job.run(monitor))?;
+            say!("{summary}");
+            Ok(summary.verdict()?)
+        }
         Command::Eval(args) => match mbrl::jobs::eval::prepare(args, &cli.global.invocation())? {
             mbrl::jobs::eval::Eval::Run(job) => common::show(&cli.global, job),
             mbrl::jobs::eval::Eval::Rendered(summary) => {

@@ -6,6 +6,7 @@
 //!
 //! The one room that knows clap: the engine below never parses flags.
 
+pub mod calibrate;
 pub mod cem_options;
 pub mod choices;
 pub mod collect;
@@ -14,7 +15,9 @@ pub mod eval;
 pub mod export;
 pub mod filter;
 pub mod model_options;
+pub mod plan;
 pub mod predict;
+pub mod solve_board;
 pub mod train;
 
 pub use common::{

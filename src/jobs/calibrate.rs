@@ -1,24 +1,25 @@
 //! `mbrl calibrate`: act in an unseen instance to infer its hidden parameters with a trained context model, and
 //! save the calibration transitions (the context set) for `plan --context`.
 
-use std::path::PathBuf;
+use std::fmt;
+use std::path::{Path, PathBuf};
 
-use anyhow::bail;
 use clap::Args;
-use mbrl::data::write_dataset;
-use mbrl::envs::terrain::TerrainMap;
-use mbrl::envs::unicycle::UnicycleTerrain;
-use mbrl::envs::{parse_env, EnvName};
-use mbrl::models::context::calibration::{
+
+use super::choices::StrategyChoice;
+use super::model_options::{accepting, report_unfinished};
+use super::{check_output_file, file_stem, parse_floats, Invocation, Job};
+use crate::data::write_dataset;
+use crate::envs::terrain::TerrainMap;
+use crate::envs::unicycle::UnicycleTerrain;
+use crate::envs::{parse_env, EnvName};
+use crate::models::context::calibration::{
     calibration_dataset, layout, run_calibration, CalibrationRequest, CalibrationSettings,
 };
-use mbrl::models::context::{self, fast::gaussian_entropy, LoadedModel};
-use mbrl::models::tradyn::{self, TradynModel};
-use mbrl::train::{Accept, OpenedCheckpoint};
-
-use crate::common::{check_output_file, command_line, file_stem, parse_floats, run_job, GlobalArgs};
-use mbrl::jobs::choices::StrategyChoice;
-use mbrl::jobs::model_options::{accepting, report_unfinished};
+use crate::models::context::{self, fast::gaussian_entropy, LoadedModel};
+use crate::models::tradyn::{self, TradynModel};
+use crate::train::{Accept, OpenedCheckpoint};
+use crate::{refuse, Result};
 
 /// Calibrate a context model in an instance of its env by expected information gain.
 #[derive(Args, Debug)]
@@ -35,7 +36,7 @@ CEM 1000 candidates / 100 elites / 10 iterations and 20 β samples; pendulum N =
 MountainCar N = 50, H_max = 30. The command prints the entropy of q(β | transitions) before and after.
 A TRADYN model calibrates with random colored actions (as its data were collected), 10 transitions by
 default, on the --map the robot drives on; the instance is the robot (mass, throttle and steering gains).")]
-pub struct CalibrateArgs {
+pub struct CalibrateOptions {
     /// A context-model checkpoint (`mbrl train context`, or `mbrl train tradyn` for the unicycle).
     #[arg(long)]
     model: PathBuf,
@@ -81,94 +82,119 @@ pub struct CalibrateArgs {
     allow_incomplete: bool,
 }
 
-pub fn run(global: &GlobalArgs, args: CalibrateArgs) -> anyhow::Result<()> {
-    let mut env = parse_env(&args.env)?;
+/// The entropy of q(β | context) before and after calibrating, and where the context set went.
+pub struct CalibrateSummary {
+    env: String,
+    instance_seed: u64,
+    instance: serde_json::Value,
+    transitions: usize,
+    strategy: &'static str,
+    prior_entropy: f64,
+    entropy: f64,
+    unfinished_note: String,
+    out: PathBuf,
+}
+
+impl fmt::Display for CalibrateSummary {
+    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        writeln!(
+            f,
+            "calibrated {} instance {} ({}) with {} {} transitions: entropy of q(β | context) {:.3} → {:.3} nats{}",
+            self.env,
+            self.instance_seed,
+            self.instance,
+            self.transitions,
+            self.strategy,
+            self.prior_entropy,
+            self.entropy,
+            self.unfinished_note
+        )?;
+        write!(f, "context set written to {}", self.out.display())
+    }
+}
+
+pub fn prepare(options: CalibrateOptions, invocation: &Invocation) -> Result<Job<'static, CalibrateSummary>> {
+    let mut env = parse_env(&options.env)?;
     let unicycle = matches!(env, EnvName::Unicycle(_));
-    match (&args.map, unicycle) {
+    match (&options.map, unicycle) {
         (Some(map), true) => env = env.with_terrain(UnicycleTerrain::new(vec![TerrainMap::read_png(map)?]))?,
-        (None, true) => bail!("--env unicycle: give --map PNG, the terrain the robot calibrates on"),
-        (Some(_), false) => bail!("--map is the unicycle's terrain; '{}' has none", env.canonical()),
+        (None, true) => refuse!("--env unicycle: give --map PNG, the terrain the robot calibrates on"),
+        (Some(_), false) => refuse!("--map is the unicycle's terrain; '{}' has none", env.canonical()),
         (None, false) => {}
     }
-    let strategy = args.strategy.into();
-    let transitions = args.transitions.unwrap_or(if unicycle { 10 } else { 30 });
+    let strategy = options.strategy.into();
+    let transitions = options.transitions.unwrap_or(if unicycle { 10 } else { 30 });
     let settings = CalibrationSettings {
         strategy,
         transitions,
-        horizon_max: args.horizon,
-        candidates: args.candidates,
-        elites: args.elites,
-        iterations: args.iters,
-        beta_samples: args.beta_samples,
+        horizon_max: options.horizon,
+        candidates: options.candidates,
+        elites: options.elites,
+        iterations: options.iters,
+        beta_samples: options.beta_samples,
     };
     settings.validate()?;
-    let init_state = args.init_state.as_deref().map(|s| parse_floats("--init-state", s)).transpose()?;
-    if !args.model.is_dir() {
-        bail!("--model {}: no such checkpoint directory", args.model.display());
+    let init_state = options.init_state.as_deref().map(|s| parse_floats("--init-state", s)).transpose()?;
+    if !options.model.is_dir() {
+        refuse!("--model {}: no such checkpoint directory", options.model.display());
     }
-    let model = load_model(&args.model, &env, accepting(args.allow_incomplete))?;
-    report_unfinished(&args.model, &model.progress);
-    let out = args.out.clone().unwrap_or_else(|| {
+    let model = load_model(&options.model, &env, accepting(options.allow_incomplete))?;
+    report_unfinished(&options.model, &model.progress);
+    let out = options.out.clone().unwrap_or_else(|| {
         PathBuf::from(format!(
             "datasets/calib-{}-{}-i{}.mcap",
             file_stem(&env.canonical()),
             strategy.name(),
-            args.instance_seed
+            options.instance_seed
         ))
     });
     check_output_file("--out", &out, "mcap")?;
-    let request = CalibrationRequest {
-        env: env.clone(),
-        instance_seed: args.instance_seed,
-        init_state,
-        settings,
-        seed: global.seed,
-    };
+    let seed = invocation.seed;
+    let request =
+        CalibrationRequest { env: env.clone(), instance_seed: options.instance_seed, init_state, settings, seed };
     let spec = env.build()?.spec();
+    let unfinished_note = model.progress.unfinished_note();
     let title = format!(
         "calibrate {} ({}, {} transitions, instance {}{})",
         env.canonical(),
         strategy.name(),
         transitions,
-        args.instance_seed,
-        model.progress.unfinished_note()
+        options.instance_seed,
+        unfinished_note
     );
-    let (calibration, instance) = run_job(global, "calibrate", |monitor| {
+    let command_line = invocation.command_line.clone();
+    Ok(Job::new("calibrate", move |monitor| {
         monitor.emit(&layout(&title, &spec.state_names));
         let (calibration, instance) = run_calibration(&model, &request, monitor)?;
-        let dataset = calibration_dataset(&env, &calibration, instance.clone(), global.seed, &command_line())?;
+        let dataset = calibration_dataset(&env, &calibration, instance.clone(), seed, &command_line)?;
         write_dataset(&out, &dataset)?;
-        Ok((calibration, instance))
-    })?;
-    let prior = gaussian_entropy(&model.fast.belief(&vec![0.0; model.fast.transition_features], 1).std);
-    let last = calibration.entropies.last().copied().unwrap_or(prior);
-    say!(
-        "calibrated {} instance {} ({}) with {} {} transitions: entropy of q(β | context) {:.3} → {:.3} nats{}",
-        env.canonical(),
-        args.instance_seed,
-        instance,
-        calibration.rollout.len(),
-        strategy.name(),
-        prior,
-        last,
-        model.progress.unfinished_note()
-    );
-    say!("context set written to {}", out.display());
-    Ok(())
+        let prior_entropy = gaussian_entropy(&model.fast.belief(&vec![0.0; model.fast.transition_features], 1).std);
+        Ok(CalibrateSummary {
+            env: env.canonical(),
+            instance_seed: request.instance_seed,
+            instance,
+            transitions: calibration.rollout.len(),
+            strategy: strategy.name(),
+            prior_entropy,
+            entropy: calibration.entropies.last().copied().unwrap_or(prior_entropy),
+            unfinished_note,
+            out,
+        })
+    }))
 }
 
 /// A context model of `env`, or a TRADYN model when `env` is the unicycle.
-fn load_model(dir: &std::path::Path, env: &EnvName, accept: Accept) -> anyhow::Result<LoadedModel> {
+fn load_model(dir: &Path, env: &EnvName, accept: Accept) -> Result<LoadedModel> {
     let method = OpenedCheckpoint::open(dir)?.manifest.method;
     let unicycle = matches!(env, EnvName::Unicycle(_));
     if unicycle && method != tradyn::METHOD {
-        bail!(
+        refuse!(
             "{}: is a '{method}' checkpoint; the unicycle calibrates a TRADYN model (`mbrl train tradyn`)",
             dir.display()
         );
     }
     if method == tradyn::METHOD && !unicycle {
-        bail!("{}: is a TRADYN model of the unicycle; calibrate it with --env unicycle --map PNG", dir.display());
+        refuse!("{}: is a TRADYN model of the unicycle; calibrate it with --env unicycle --map PNG", dir.display());
     }
     Ok(if unicycle { TradynModel::load(dir, accept)?.loaded } else { context::load(dir, env, accept)? })
 }

@@ -4,39 +4,28 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use anyhow::bail;
-use mbrl::control::BatchDynamics;
-use mbrl::data::{write_dataset, Dataset};
-use mbrl::envs::terrain::TerrainMap;
-use mbrl::envs::unicycle::UnicycleTerrain;
-use mbrl::envs::{instance_env, EnvName};
-use mbrl::models::context::calibration::read_context;
-use mbrl::models::tradyn::navigation::{layout, navigate, NavigationSettings, NavigationTask};
-use mbrl::models::tradyn::{self, TradynDynamics, TradynModel};
-use mbrl::train::OpenedCheckpoint;
+use super::{PlanOptions, PlanSummary};
+use crate::control::BatchDynamics;
+use crate::data::{write_dataset, Dataset};
+use crate::envs::terrain::TerrainMap;
+use crate::envs::unicycle::UnicycleTerrain;
+use crate::envs::{instance_env, EnvName};
+use crate::jobs::model_options::{report_unfinished, ModelOptions};
+use crate::jobs::{check_output_file, parse_floats, Invocation, Job};
+use crate::models::context::calibration::read_context;
+use crate::models::tradyn::navigation::{layout, navigate, NavigationSettings, NavigationTask};
+use crate::models::tradyn::{self, TradynDynamics, TradynModel};
+use crate::train::OpenedCheckpoint;
+use crate::{refuse, Result};
 
-use crate::common::{check_output_file, command_line, parse_floats, run_job, GlobalArgs};
-use mbrl::jobs::cem_options::CemOptions;
-use mbrl::jobs::model_options::{report_unfinished, ModelOptions};
-
-/// The unicycle flags of `plan`.
-pub struct UnicycleTask {
-    pub map: Option<PathBuf>,
-    pub start: Option<String>,
-    pub goal: Option<String>,
-    pub evidence: bool,
-    pub instance_seed: Option<u64>,
-    pub out: Option<PathBuf>,
-}
-
-fn task(flags: &UnicycleTask) -> anyhow::Result<NavigationTask> {
-    let (Some(start), Some(goal)) = (&flags.start, &flags.goal) else {
-        bail!("--env unicycle: give --start x,y,φ and --goal x,y (positions in [0, 1]²)");
+fn task(options: &PlanOptions) -> Result<NavigationTask> {
+    let (Some(start), Some(goal)) = (&options.start, &options.goal) else {
+        refuse!("--env unicycle: give --start x,y,φ and --goal x,y (positions in [0, 1]²)");
     };
     let start = parse_floats("--start", start)?;
     let goal = parse_floats("--goal", goal)?;
     let ([x, y, phi], [gx, gy]) = (start.as_slice(), goal.as_slice()) else {
-        bail!("--start takes x,y,φ (3 numbers) and --goal x,y (2 numbers); got {} and {}", start.len(), goal.len());
+        refuse!("--start takes x,y,φ (3 numbers) and --goal x,y (2 numbers); got {} and {}", start.len(), goal.len());
     };
     let task = NavigationTask { start: [*x, *y, *phi], goal: [*gx, *gy] };
     task.validate()?;
@@ -46,21 +35,21 @@ fn task(flags: &UnicycleTask) -> anyhow::Result<NavigationTask> {
 fn load_dynamics(
     model: &ModelOptions,
     map: &Arc<TerrainMap>,
-    truth: Box<dyn mbrl::envs::Dynamics>,
-) -> anyhow::Result<Box<dyn BatchDynamics>> {
+    truth: Box<dyn crate::envs::Dynamics>,
+) -> Result<Box<dyn BatchDynamics>> {
     if model.model == "true" {
         if model.context.is_some() {
-            bail!("--context conditions a TRADYN model; `--model true` plans with the simulator itself");
+            refuse!("--context conditions a TRADYN model; `--model true` plans with the simulator itself");
         }
         return Ok(Box::new(truth));
     }
     let dir = Path::new(&model.model);
     if !dir.is_dir() {
-        bail!("--model '{}': no such checkpoint directory; expected `true` or a TRADYN model", model.model);
+        refuse!("--model '{}': no such checkpoint directory; expected `true` or a TRADYN model", model.model);
     }
     let method = OpenedCheckpoint::open(dir)?.manifest.method;
     if method != tradyn::METHOD {
-        bail!(
+        refuse!(
             "{}: is a '{method}' checkpoint; unicycle navigation plans with a TRADYN model (`mbrl train tradyn`) or --model true",
             dir.display()
         );
@@ -74,44 +63,44 @@ fn load_dynamics(
     Ok(Box::new(TradynDynamics::new(trained, map.clone(), &rows)))
 }
 
-pub fn run(
-    global: &GlobalArgs,
-    model: &ModelOptions,
-    cem: &CemOptions,
+pub(super) fn prepare(
+    options: PlanOptions,
     steps: usize,
-    flags: UnicycleTask,
-) -> anyhow::Result<()> {
-    if flags.evidence {
-        bail!("--evidence conditions a DLGPD model; the unicycle adapts through --context (`mbrl calibrate`)");
+    invocation: &Invocation,
+) -> Result<Job<'static, PlanSummary>> {
+    if options.evidence.is_some() {
+        refuse!("--evidence conditions a DLGPD model; the unicycle adapts through --context (`mbrl calibrate`)");
     }
-    let Some(map_path) = &flags.map else {
-        bail!(
+    let Some(map_path) = &options.map else {
+        refuse!(
             "--env unicycle: give --map PNG, the terrain to drive on (e.g. a test map of `mbrl collect --env terrain`)"
         );
     };
-    let task = task(&flags)?;
+    let task = task(&options)?;
     let map = Arc::new(TerrainMap::read_png(map_path)?);
     let env_name = EnvName::Unicycle(None).with_terrain(UnicycleTerrain { maps: vec![map.clone()] })?;
     // The robot the instance seed draws (the nominal one without it); built again inside the job, which runs on
     // its own thread.
-    let make_env = || match flags.instance_seed {
+    let instance_seed = options.instance_seed;
+    let make_env = move || match instance_seed {
         Some(seed) => instance_env(&env_name, seed),
         None => env_name.build(),
     };
     let env = make_env()?;
     let truth = env.dynamics().expect("the unicycle has closed-form dynamics");
-    let dynamics = load_dynamics(model, &map, truth)?;
+    let dynamics = load_dynamics(&options.model, &map, truth)?;
     let mut settings = NavigationSettings::thesis();
     settings.steps = steps;
-    settings.cem = cem.over(settings.cem);
+    settings.cem = options.cem.over(settings.cem);
     settings.horizon = settings.cem.horizon;
     settings.validate()?;
-    let out = flags.out.clone().unwrap_or_else(|| PathBuf::from("datasets/plan-unicycle.mcap"));
+    let out = options.out.clone().unwrap_or_else(|| PathBuf::from("datasets/plan-unicycle.mcap"));
     check_output_file("--out", &out, "mcap")?;
     let robot = env.params();
     let title = format!("plan: unicycle navigation with {}", dynamics.describe());
-    let seed = global.seed;
-    let episode = run_job(global, "plan: unicycle navigation", |monitor| {
+    let seed = invocation.seed;
+    let command_line = invocation.command_line.clone();
+    Ok(Job::new("plan: unicycle navigation", move |monitor| {
         monitor.emit(&layout(&title, &map, task.goal));
         let mut env = make_env()?;
         let episode = navigate(env.as_mut(), dynamics.as_ref(), &task, &settings, seed, monitor, |_| {})?;
@@ -123,19 +112,16 @@ pub fn run(
                 vec![robot.clone()],
                 std::slice::from_ref(&episode.rollout),
                 seed,
-                &command_line(),
+                &command_line,
             ),
         )?;
-        Ok(episode)
-    })?;
-    say!(
-        "energy Σ throttle² {:.3}, final distance {:.4} m, success: {} (≤ {} m); robot {}; rollout saved to {}",
-        episode.energy,
-        episode.final_distance,
-        if episode.success { "yes" } else { "no" },
-        settings.success_distance,
-        robot,
-        out.display()
-    );
-    Ok(())
+        Ok(PlanSummary::Unicycle {
+            energy: episode.energy,
+            final_distance: episode.final_distance,
+            success: episode.success,
+            success_distance: settings.success_distance,
+            robot,
+            out,
+        })
+    }))
 }
