@@ -8,7 +8,7 @@ use clap::Args;
 
 use super::choices::StrategyChoice;
 use super::model_options::{accepting, report_unfinished};
-use super::{check_output_file, file_stem, parse_floats, Invocation, Job};
+use super::{file_stem, output_file, parse_floats, Invocation, Job};
 use crate::data::write_dataset;
 use crate::envs::terrain::TerrainMap;
 use crate::envs::unicycle::UnicycleTerrain;
@@ -140,15 +140,11 @@ pub fn prepare(options: CalibrateOptions, invocation: &Invocation) -> Result<Job
     }
     let model = load_model(&options.model, &env, accepting(options.allow_incomplete))?;
     report_unfinished(&options.model, &model.progress);
-    let out = options.out.clone().unwrap_or_else(|| {
-        PathBuf::from(format!(
-            "datasets/calib-{}-{}-i{}.mcap",
-            file_stem(&env.canonical()),
-            strategy.name(),
-            options.instance_seed
-        ))
-    });
-    check_output_file("--out", &out, "mcap")?;
+    let default = || {
+        let (env, strategy, instance) = (file_stem(&env.canonical()), strategy.name(), options.instance_seed);
+        PathBuf::from(format!("datasets/calib-{env}-{strategy}-i{instance}.mcap"))
+    };
+    let out = output_file("--out", options.out.as_deref(), default, "mcap", invocation)?;
     let seed = invocation.seed;
     let request =
         CalibrationRequest { env: env.clone(), instance_seed: options.instance_seed, init_state, settings, seed };

@@ -4,13 +4,13 @@ mod dlgpd;
 mod unicycle;
 
 use std::fmt;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use clap::Args;
 
 use super::cem_options::CemOptions;
 use super::model_options::ModelOptions;
-use super::{check_output_file, file_stem, pendulum_variant, Invocation, Job, STEP_RECORD_BYTES};
+use super::{file_stem, output_file, pendulum_variant, Invocation, Job, STEP_RECORD_BYTES};
 use crate::data::write_dataset;
 use crate::eval::swingup::{self, SwingupSettings};
 use crate::models::dlgpd::job::METHOD as DLGPD;
@@ -68,7 +68,8 @@ pub struct PlanOptions {
     /// Plan in the instance (hidden parameters) this seed names, as `calibrate --instance-seed` does.
     #[arg(long)]
     instance_seed: Option<u64>,
-    /// Where to save the executed rollout (default: datasets/plan-<env>.mcap).
+    /// Where to save the executed rollout (default: datasets/plan-<env>-<model>.mcap, <model> being `true` or the
+    /// checkpoint's directory name; when that exists, the first free name ending -2, -3, …).
     #[arg(long)]
     out: Option<PathBuf>,
 }
@@ -167,11 +168,11 @@ pub fn prepare(options: PlanOptions, invocation: &Invocation) -> Result<Job<'sta
     settings.instance_seed = options.instance_seed;
     settings.cem = options.cem.config(&settings.cem.action_low, &settings.cem.action_high);
     settings.cem.validate()?;
-    let out = options
-        .out
-        .clone()
-        .unwrap_or_else(|| PathBuf::from(format!("datasets/plan-{}.mcap", file_stem(&settings.variant.env_name()))));
-    check_output_file("--out", &out, "mcap")?;
+    let default = || {
+        let (env, model) = (file_stem(&settings.variant.env_name()), model_tag(&options.model.model));
+        PathBuf::from(format!("datasets/plan-{env}-{model}.mcap"))
+    };
+    let out = output_file("--out", options.out.as_deref(), default, "mcap", invocation)?;
     let env = crate::envs::parse_env(&options.env)?;
     // With --evidence the model can only be DLGPD, so its loader reports why a checkpoint does not open.
     let is_dlgpd = options.model.model != "true"
@@ -198,4 +199,10 @@ pub fn prepare(options: PlanOptions, invocation: &Invocation) -> Result<Job<'sta
         )?;
         Ok(PlanSummary::Swingup { total_return: episode.total_return, success: episode.success, out })
     }))
+}
+
+/// What a default output name says about the dynamics planned with: `true`, or the checkpoint's directory name.
+fn model_tag(model: &str) -> String {
+    let name = Path::new(model).file_name().map_or_else(|| model.to_string(), |n| n.to_string_lossy().into_owned());
+    file_stem(&name)
 }
