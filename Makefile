@@ -2,6 +2,9 @@
 # in a report come from running the method, never from a stored constant.
 
 MBRL := target/release/mbrl
+# Make remakes a target only when it is out of date, and then the output it names is meant to be replaced:
+# `--force` lets each command do so (without it mbrl refuses to replace a named output that exists).
+RUN := $(MBRL) --force
 SEED ?= 0
 
 .PHONY: build test bench completions repro-quick repro-swingup repro-pendulum-data repro-boards repro-ball repro-pets repro-pets-loop repro-context repro-context-mountaincar repro-tradyn repro-seads repro-dlgpd clean-reports
@@ -24,21 +27,21 @@ $(MBRL): build
 # `$(call train_or_resume,DIR,METHOD AND FLAGS)`: a new run in DIR, or the stopped run an interrupted make left
 # there resumed (`--resume-if-stopped` refuses one started with other flags), so re-running a long target loses
 # none of its training.
-train_or_resume = $(MBRL) train $(2) --no-tui -q --out $(1) --resume-if-stopped
+train_or_resume = $(RUN) train $(2) --no-tui -q --out $(1) --resume-if-stopped
 
 # The README's main job: a small reproduction of every implemented method (reports/quick/).
 repro-quick: build
-	$(MBRL) eval quick --seed $(SEED) --no-tui
+	$(RUN) eval quick --seed $(SEED) --no-tui
 
 # Thesis 3.5.2: ground-truth CEM swing-up, 10 episodes with the thesis' CEM settings.
 repro-swingup: build
-	$(MBRL) eval pendulum-swingup --model true --episodes 10 --horizon 20 --candidates 1000 \
+	$(RUN) eval pendulum-swingup --model true --episodes 10 --horizon 20 --candidates 1000 \
 		--elites 100 --iters 10 --steps 150 --seed $(SEED) --no-tui --out reports/pendulum-swingup
 
 # Thesis 3.5: 500 random rollouts of 30 transitions of the pendulum and each modified pendulum.
 repro-pendulum-data: build
 	for env in pendulum pendulum:light pendulum:heavy pendulum:inverted; do \
-		$(MBRL) collect --env $$env --rollouts 500 --steps 30 --seed $(SEED) --no-tui \
+		$(RUN) collect --env $$env --rollouts 500 --steps 30 --seed $(SEED) --no-tui \
 			--out datasets/$$(echo $$env | tr ':' '-')-random.mcap || exit 1; \
 	done
 
@@ -48,12 +51,12 @@ repro-pendulum-data: build
 # and plans one episode; the ground-truth model plans the same 10 episodes for comparison.
 PETS_SEEDS ?= 0 1 2 3 4 5 6 7 8 9
 datasets/pets/random-%.mcap: | $(MBRL)
-	$(MBRL) collect --env pendulum --rollouts 200 --steps 30 --seed $* --no-tui -q --out $@
+	$(RUN) collect --env pendulum --rollouts 200 --steps 30 --seed $* --no-tui -q --out $@
 repro-pets: build $(PETS_SEEDS:%=datasets/pets/random-%.mcap)
 	for s in $(PETS_SEEDS); do \
-		$(MBRL) train pets --env pendulum --data datasets/pets/random-$$s.mcap --seed $$s --no-tui -q --out models/pets/seed-$$s || exit 1; \
-		$(MBRL) eval pendulum-swingup --model models/pets/seed-$$s --episodes 1 --seed $$s --no-tui -q --out reports/pets/seed-$$s || exit 1; \
-		$(MBRL) eval pendulum-swingup --model true --episodes 1 --seed $$s --no-tui -q --out reports/pets/truth-$$s || exit 1; \
+		$(RUN) train pets --env pendulum --data datasets/pets/random-$$s.mcap --seed $$s --no-tui -q --out models/pets/seed-$$s || exit 1; \
+		$(RUN) eval pendulum-swingup --model models/pets/seed-$$s --episodes 1 --seed $$s --no-tui -q --out reports/pets/seed-$$s || exit 1; \
+		$(RUN) eval pendulum-swingup --model true --episodes 1 --seed $$s --no-tui -q --out reports/pets/truth-$$s || exit 1; \
 	done
 	@echo "seed,model,return,success" > reports/pets/summary.csv
 	@for s in $(PETS_SEEDS); do for m in seed truth; do \
@@ -65,11 +68,11 @@ repro-pets: build $(PETS_SEEDS:%=datasets/pets/random-%.mcap)
 # episode on the current model (executed in the simulator and saved) with retraining on all data so far.
 LOOP_ITERATIONS ?= 5
 repro-pets-loop: build
-	$(MBRL) collect --env pendulum --rollouts 10 --steps 30 --seed $(SEED) --no-tui -q --out datasets/pets-loop/iter-0.mcap
+	$(RUN) collect --env pendulum --rollouts 10 --steps 30 --seed $(SEED) --no-tui -q --out datasets/pets-loop/iter-0.mcap
 	for i in $$(seq 1 $(LOOP_ITERATIONS)); do \
 		data=$$(ls datasets/pets-loop/iter-*.mcap | sed 's/^/--data /' | tr '\n' ' '); \
-		$(MBRL) train pets --env pendulum $$data --steps 1000 --seed $(SEED) --no-tui -q --out models/pets-loop || exit 1; \
-		$(MBRL) plan --env pendulum --model models/pets-loop --steps 150 --seed $$i --no-tui --out datasets/pets-loop/iter-$$i.mcap || exit 1; \
+		$(RUN) train pets --env pendulum $$data --steps 1000 --seed $(SEED) --no-tui -q --out models/pets-loop || exit 1; \
+		$(RUN) plan --env pendulum --model models/pets-loop --steps 150 --seed $$i --no-tui --out datasets/pets-loop/iter-$$i.mcap || exit 1; \
 	done
 
 # Thesis 4.5 (Explore the Context): per env, instance pairs, a context model and the calibration protocol in
@@ -83,27 +86,27 @@ CONTEXT_CEM ?=
 CONTEXT_SWINGUP ?= --swingup
 CONTEXT_DATA = datasets/context/seed-$(SEED)
 $(CONTEXT_DATA)/toy-%.mcap: | $(MBRL)
-	$(MBRL) collect --env toy:$* --instances 5000 --steps 100 --seed $(SEED) --no-tui -q --out $@
+	$(RUN) collect --env toy:$* --instances 5000 --steps 100 --seed $(SEED) --no-tui -q --out $@
 $(CONTEXT_DATA)/pendulum-quadrant.mcap: | $(MBRL)
-	$(MBRL) collect --env pendulum:quadrant --instances 10000 --steps 100 --seed $(SEED) --no-tui -q --out $@
+	$(RUN) collect --env pendulum:quadrant --instances 10000 --steps 100 --seed $(SEED) --no-tui -q --out $@
 $(CONTEXT_DATA)/mountaincar.mcap: | $(MBRL)
-	$(MBRL) collect --env mountaincar --instances 5000 --steps 100 --seed $(SEED) --no-tui -q --out $@
+	$(RUN) collect --env mountaincar --instances 5000 --steps 100 --seed $(SEED) --no-tui -q --out $@
 $(CONTEXT_DATA)/mountaincar-10k.mcap: | $(MBRL)
-	$(MBRL) collect --env mountaincar --instances 10000 --steps 100 --seed $(SEED) --no-tui -q --out $@
+	$(RUN) collect --env mountaincar --instances 10000 --steps 100 --seed $(SEED) --no-tui -q --out $@
 repro-context: build $(CONTEXT_DATA)/toy-inner.mcap $(CONTEXT_DATA)/toy-outer.mcap \
 		$(CONTEXT_DATA)/pendulum-quadrant.mcap $(CONTEXT_DATA)/mountaincar.mcap
 	for sq in inner outer; do \
-		$(MBRL) train context --data $(CONTEXT_DATA)/toy-$$sq.mcap --preset $(CONTEXT_PRESET) --seed $(SEED) --no-tui -q --out models/context/toy-$$sq || exit 1; \
+		$(RUN) train context --data $(CONTEXT_DATA)/toy-$$sq.mcap --preset $(CONTEXT_PRESET) --seed $(SEED) --no-tui -q --out models/context/toy-$$sq || exit 1; \
 		for n in 1 2 3; do \
-			$(MBRL) eval context --model models/context/toy-$$sq --env toy:$$sq --transitions $$n --contexts $(CONTEXT_CONTEXTS) \
+			$(RUN) eval context --model models/context/toy-$$sq --env toy:$$sq --transitions $$n --contexts $(CONTEXT_CONTEXTS) \
 				$(CONTEXT_CEM) --seed $(SEED) --no-tui -q --out reports/context/toy-$$sq-n$$n || exit 1; \
 		done; \
 	done
 	$(call train_or_resume,models/context/pendulum-quadrant,context --data $(CONTEXT_DATA)/pendulum-quadrant.mcap --preset $(CONTEXT_PRESET) --seed $(SEED))
-	$(MBRL) eval context --model models/context/pendulum-quadrant --env pendulum:quadrant --transitions 30 --horizon 20 \
+	$(RUN) eval context --model models/context/pendulum-quadrant --env pendulum:quadrant --transitions 30 --horizon 20 \
 		--contexts $(CONTEXT_CONTEXTS) $(CONTEXT_CEM) $(CONTEXT_SWINGUP) --seed $(SEED) --no-tui -q --out reports/context/pendulum-quadrant
 	$(call train_or_resume,models/context/mountaincar,context --data $(CONTEXT_DATA)/mountaincar.mcap --preset $(CONTEXT_PRESET) --seed $(SEED))
-	$(MBRL) eval context --model models/context/mountaincar --env mountaincar --transitions 50 --horizon 30 \
+	$(RUN) eval context --model models/context/mountaincar --env mountaincar --transitions 50 --horizon 30 \
 		--contexts $(CONTEXT_CONTEXTS) $(CONTEXT_CEM) --seed $(SEED) --no-tui -q --out reports/context/mountaincar
 
 # Thesis 4.5.4 / Fig. 4.7 (MountainCar) at the scale measured on 2 cores: 10 000 instance pairs, the small
@@ -112,7 +115,7 @@ repro-context: build $(CONTEXT_DATA)/toy-inner.mcap $(CONTEXT_DATA)/toy-outer.mc
 # figures in the README are this run's, seed 0).
 repro-context-mountaincar: build $(CONTEXT_DATA)/mountaincar-10k.mcap
 	$(call train_or_resume,models/context/mountaincar-small,context --data $(CONTEXT_DATA)/mountaincar-10k.mcap --preset small --steps 30000 --seed $(SEED))
-	$(MBRL) eval context --model models/context/mountaincar-small --env mountaincar --transitions 50 --horizon 30 --contexts 50 \
+	$(RUN) eval context --model models/context/mountaincar-small --env mountaincar --transitions 50 --horizon 30 --contexts 50 \
 		--candidates 300 --elites 30 --iters 4 --beta-samples 10 --threads 1 --seed $(SEED) --no-tui -q --out reports/context/mountaincar-small
 
 # TRADYN (thesis 5.5) at the medium scale these two cores allow: the thesis' map set and data (100 maps,
@@ -126,18 +129,18 @@ TRADYN_CEM ?= --candidates 300 --elites 30 --iters 10
 TRADYN_DATA = datasets/tradyn/seed-$(SEED)
 # The map set is a directory (staged and renamed into place whole); its manifest stands for it.
 $(TRADYN_DATA)/maps/terrain.json: | $(MBRL)
-	$(MBRL) collect --env terrain --maps 100 --seed $(SEED) --no-tui -q --out $(@D)
+	$(RUN) collect --env terrain --maps 100 --seed $(SEED) --no-tui -q --out $(@D)
 $(TRADYN_DATA)/train.mcap: $(TRADYN_DATA)/maps/terrain.json | $(MBRL)
-	$(MBRL) collect --env unicycle --maps $(<D) --split train --instances 10000 --steps 100 \
+	$(RUN) collect --env unicycle --maps $(<D) --split train --instances 10000 --steps 100 \
 		--seed $(SEED) --no-tui -q --out $@
 # The two trainings run side by side; a bare `wait` would return 0 when one of them failed.
 repro-tradyn: build $(TRADYN_DATA)/train.mcap
-	$(MBRL) train tradyn --data $(TRADYN_DATA)/train.mcap --preset small --steps $(TRADYN_STEPS) \
+	$(RUN) train tradyn --data $(TRADYN_DATA)/train.mcap --preset small --steps $(TRADYN_STEPS) \
 		--seed $(SEED) --no-tui -q --out models/tradyn/terrain & terrain=$$!; \
-	$(MBRL) train tradyn --no-terrain --data $(TRADYN_DATA)/train.mcap --preset small --steps $(TRADYN_STEPS) \
+	$(RUN) train tradyn --no-terrain --data $(TRADYN_DATA)/train.mcap --preset small --steps $(TRADYN_STEPS) \
 		--seed $(SEED) --no-tui -q --out models/tradyn/no-terrain & no_terrain=$$!; \
 	status=0; wait $$terrain || status=1; wait $$no_terrain || status=1; exit $$status
-	$(MBRL) eval tradyn --model-terrain models/tradyn/terrain --model-no-terrain models/tradyn/no-terrain \
+	$(RUN) eval tradyn --model-terrain models/tradyn/terrain --model-no-terrain models/tradyn/no-terrain \
 		--maps $(TRADYN_DATA)/maps --tasks $(TRADYN_TASKS) $(TRADYN_CEM) --seed $(SEED) --no-tui --out reports/tradyn
 
 # Thesis chapter 7: SEADS skills and forward model on both Cursor games, then skill coverage and boards solved
@@ -145,9 +148,9 @@ repro-tradyn: build $(TRADYN_DATA)/train.mcap
 SEADS_PRESET ?= paper
 repro-seads: build
 	for game in lightsout tileswap; do \
-		$(MBRL) train seads --env $$game:cursor --preset $(SEADS_PRESET) --seed $(SEED) --no-tui -q \
+		$(RUN) train seads --env $$game:cursor --preset $(SEADS_PRESET) --seed $(SEED) --no-tui -q \
 			--out models/seads-$$game-cursor || exit 1; \
-		$(MBRL) eval seads --model models/seads-$$game-cursor --boards 20 --seed $(SEED) --no-tui -q \
+		$(RUN) eval seads --model models/seads-$$game-cursor --boards 20 --seed $(SEED) --no-tui -q \
 			--out reports/seads-$$game-cursor || exit 1; \
 	done
 
@@ -165,20 +168,20 @@ DLGPD_THREADS ?= 1
 DLGPD_EVAL ?= --env pendulum --env pendulum:inverted --evidence-rollouts 20 --runs 6 --candidates 200 --elites 20 --iters 8
 DLGPD_DATA = datasets/dlgpd/seed-$(SEED)
 $(DLGPD_DATA)/pendulum-frames.mcap: | $(MBRL)
-	$(MBRL) collect --env pendulum --images --rollouts 500 --steps 29 --seed $(SEED) --no-tui -q --out $@
+	$(RUN) collect --env pendulum --images --rollouts 500 --steps 29 --seed $(SEED) --no-tui -q --out $@
 repro-dlgpd: build $(DLGPD_DATA)/pendulum-frames.mcap
 	$(call train_or_resume,models/dlgpd-$(DLGPD_PRESET),dlgpd --data $(DLGPD_DATA)/pendulum-frames.mcap \
 		--preset $(DLGPD_PRESET) $(if $(DLGPD_STEPS),--steps $(DLGPD_STEPS)) --threads $(DLGPD_THREADS) --seed $(SEED))
-	$(MBRL) eval dlgpd --model models/dlgpd-$(DLGPD_PRESET) $(DLGPD_EVAL) --threads $(DLGPD_THREADS) --seed $(SEED) \
+	$(RUN) eval dlgpd --model models/dlgpd-$(DLGPD_PRESET) $(DLGPD_EVAL) --threads $(DLGPD_THREADS) --seed $(SEED) \
 		--no-tui -q --out reports/dlgpd
 
 # Thesis chapter 7 environments: depth/split tables, board sets, embodied play with scripted controllers.
 datasets/%-boards-d5.mcap: | $(MBRL)
-	$(MBRL) collect --env $* --boards --max-depth 5 --no-tui --out $@
+	$(RUN) collect --env $* --boards --max-depth 5 --no-tui --out $@
 repro-boards: build datasets/lightsout-boards-d5.mcap datasets/tileswap-boards-d5.mcap
-	$(MBRL) eval boards --no-tui --out reports/boards
+	$(RUN) eval boards --no-tui --out reports/boards
 	for game in lightsout tileswap; do for arm in cursor reacher; do \
-		$(MBRL) eval embodied --game $$game --embodiment $$arm --max-depth 5 --boards 500 --seed $(SEED) \
+		$(RUN) eval embodied --game $$game --embodiment $$arm --max-depth 5 --boards 500 --seed $(SEED) \
 			--no-tui --out reports/embodied-$$game-$$arm || exit 1; \
 	done; done
 
@@ -187,22 +190,22 @@ repro-boards: build datasets/lightsout-boards-d5.mcap datasets/tileswap-boards-d
 # and the black-box baseline on default and unseen launcher poses.
 BALL_DATA = datasets/ball/seed-$(SEED)
 $(BALL_DATA)/train.mcap: | $(MBRL)
-	$(MBRL) collect --env ball --trajectories 108 --augment-rotations 19 --seed $(SEED) --no-tui --out $@
+	$(RUN) collect --env ball --trajectories 108 --augment-rotations 19 --seed $(SEED) --no-tui --out $@
 $(BALL_DATA)/train-noaug.mcap: | $(MBRL)
-	$(MBRL) collect --env ball --trajectories 108 --seed $(SEED) --no-tui --out $@
+	$(RUN) collect --env ball --trajectories 108 --seed $(SEED) --no-tui --out $@
 repro-ball: build $(BALL_DATA)/train.mcap $(BALL_DATA)/train-noaug.mcap
-	$(MBRL) train ball-ekf --data $(BALL_DATA)/train.mcap --steps 2000 --seed $(SEED) --no-tui --out models/ball-ekf
-	$(MBRL) train ball-ekf --data $(BALL_DATA)/train.mcap --steps 2000 --launcher-prior --seed $(SEED) --no-tui \
+	$(RUN) train ball-ekf --data $(BALL_DATA)/train.mcap --steps 2000 --seed $(SEED) --no-tui --out models/ball-ekf
+	$(RUN) train ball-ekf --data $(BALL_DATA)/train.mcap --steps 2000 --launcher-prior --seed $(SEED) --no-tui \
 		--out models/ball-ekf-launch
-	$(MBRL) train ball-ekf --data $(BALL_DATA)/train-noaug.mcap --steps 2000 --seed $(SEED) --no-tui \
+	$(RUN) train ball-ekf --data $(BALL_DATA)/train-noaug.mcap --steps 2000 --seed $(SEED) --no-tui \
 		--out models/ball-ekf-noaug
-	$(MBRL) eval ball --model models/ball-ekf-launch --model models/ball-ekf --model models/ball-ekf-noaug --model thesis \
+	$(RUN) eval ball --model models/ball-ekf-launch --model models/ball-ekf --model models/ball-ekf-noaug --model thesis \
 		--seed $(SEED) --no-tui --out reports/ball
 
 completions: build
-	$(MBRL) completions bash > completions/mbrl.bash
-	$(MBRL) completions zsh > completions/_mbrl
-	$(MBRL) completions fish > completions/mbrl.fish
+	$(RUN) completions bash > completions/mbrl.bash
+	$(RUN) completions zsh > completions/_mbrl
+	$(RUN) completions fish > completions/mbrl.fish
 
 clean-reports:
 	rm -rf reports

@@ -92,7 +92,9 @@ fn main() {
         Command::Filter(args) => {
             common::show(&cli.global, mbrl::jobs::filter::prepare(args, &cli.global.invocation())?)
         }
-        Command::Predict(args) => common::show(&cli.global, mbrl::jobs::predict::prepare(args, &cli.global.invocation())?),
+        Command::Predict(args) => {
+            common::show(&cli.global, mbrl::jobs::predict::prepare(args, &cli.global.invocation())?)
+        }
         Command::SolveBoard(args) => {
             // A plan played that misses the goal is shown, then fails the command.
             let job = mbrl::jobs::solve_board::prepare(args, &cli.global.invocation())?;
@@ -108,7 +110,9 @@ fn main() {
             }
         },
         Command::Watch(args) => watch::run(&cli.global, args),
-        Command::Export(args) => mbrl::jobs::export::run(args, &cli.global.invocation()).map(|summary| say!("{summary}")).map_err(Into::into),
+        Command::Export(args) => {
+            mbrl::jobs::export::run(args, &cli.global.invocation()).map(|summary| say!("{summary}")).map_err(Into::into)
+        }
         Command::Completions(args) => completions::run(args),
     });
     if let Err(err) = outcome {

@@ -9,8 +9,8 @@ use std::time::Duration;
 use anyhow::Context;
 use clap::Args;
 use mbrl::run::dir::METRICS_FILE;
-use mbrl::run::lock::{RunLock, LOCK_FILE};
 use mbrl::run::follow::{latest_progress_only, MetricsFollower};
+use mbrl::run::lock::{RunLock, LOCK_FILE};
 use mbrl::run::Event;
 use mbrl::tui::{run_live, LiveOptions};
 

@@ -260,7 +260,7 @@ _mbrl() {
 
     case "${cmd}" in
         mbrl)
-            opts="-q -h -V --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version collect plan train calibrate filter predict solve-board eval watch export completions help"
+            opts="-q -h -V --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version collect plan train calibrate filter predict solve-board eval watch export completions help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 1 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -286,7 +286,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__calibrate)
-            opts="-q -h -V --model --env --map --instance-seed --strategy --transitions --horizon --candidates --elites --iters --beta-samples --init-state --out --allow-incomplete --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --model --env --map --instance-seed --strategy --transitions --horizon --candidates --elites --iters --beta-samples --init-state --out --allow-incomplete --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -364,7 +364,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__collect)
-            opts="-q -h -V --env --rollouts --instances --actions --init-state --instance-seed --board --episodes --steps --images --policy --out --trajectories --orientation --augment-rotations --boards --max-depth --split --maps --map --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --env --rollouts --instances --actions --init-state --instance-seed --board --episodes --steps --images --policy --out --trajectories --orientation --augment-rotations --boards --max-depth --split --maps --map --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -462,7 +462,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__completions)
-            opts="-q -h -V --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version bash zsh fish"
+            opts="-q -h -V --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version bash zsh fish"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -488,7 +488,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval)
-            opts="-q -h -V --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version quick dataset boards embodied ball context tradyn seads dlgpd pendulum-swingup render help"
+            opts="-q -h -V --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version quick dataset boards embodied ball context tradyn seads dlgpd pendulum-swingup render help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -514,7 +514,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__ball)
-            opts="-q -h -V --model --train-shots --augment-rotations --test-shots --unseen-shots --out --config --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --model --train-shots --augment-rotations --test-shots --unseen-shots --out --config --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -568,7 +568,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__boards)
-            opts="-q -h -V --out --config --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --out --config --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -602,7 +602,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__context)
-            opts="-q -h -V --model --env --contexts --validation-rollouts --validation-steps --transitions --horizon --strategy --candidates --elites --iters --beta-samples --swingup --swingup-steps --swingup-candidates --allow-incomplete --out --config --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --model --env --contexts --validation-rollouts --validation-steps --transitions --horizon --strategy --candidates --elites --iters --beta-samples --swingup --swingup-steps --swingup-candidates --allow-incomplete --out --config --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -692,7 +692,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__dataset)
-            opts="-q -h -V --input --out --config --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --input --out --config --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -730,7 +730,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__dlgpd)
-            opts="-q -h -V --model --env --evidence-rollouts --runs --steps --candidates --elites --iters --prediction-only --allow-incomplete --out --config --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --model --env --evidence-rollouts --runs --steps --candidates --elites --iters --prediction-only --allow-incomplete --out --config --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -796,7 +796,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__embodied)
-            opts="-q -h -V --game --embodiment --max-depth --boards --split --out --config --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --game --embodiment --max-depth --boards --split --out --config --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1032,7 +1032,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__pendulum__subcmd__swingup)
-            opts="-q -h -V --model --particles --propagation --context --allow-incomplete --episodes --env --steps --horizon --candidates --elites --iters --noise --beta --no-warm-start --out --config --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --model --particles --propagation --context --allow-incomplete --episodes --env --steps --horizon --candidates --elites --iters --noise --beta --no-warm-start --out --config --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1118,7 +1118,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__quick)
-            opts="-q -h -V --out --config --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --out --config --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1152,7 +1152,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__render)
-            opts="-q -h -V --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1178,7 +1178,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__seads)
-            opts="-q -h -V --model --max-depth --boards --coverage-boards --max-replans --split --max-nodes --out --allow-incomplete --config --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --model --max-depth --boards --coverage-boards --max-replans --split --max-nodes --out --allow-incomplete --config --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1240,7 +1240,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__tradyn)
-            opts="-q -h -V --model-terrain --model-no-terrain --maps --tasks --transitions --steps --horizon --candidates --elites --iters --prediction-steps --out --allow-incomplete --config --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --model-terrain --model-no-terrain --maps --tasks --transitions --steps --horizon --candidates --elites --iters --prediction-steps --out --allow-incomplete --config --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1318,7 +1318,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__export)
-            opts="-q -h -V --input --out --format --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --input --out --format --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1356,7 +1356,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__filter)
-            opts="-q -h -V --model --input --out --mcap --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --model --input --out --mcap --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1818,7 +1818,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__plan)
-            opts="-q -h -V --env --model --particles --propagation --context --allow-incomplete --steps --map --start --goal --horizon --candidates --elites --iters --noise --beta --no-warm-start --evidence --instance-seed --out --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --env --model --particles --propagation --context --allow-incomplete --steps --map --start --goal --horizon --candidates --elites --iters --noise --beta --no-warm-start --evidence --instance-seed --out --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1916,7 +1916,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__predict)
-            opts="-q -h -V --model --input --horizon --from-frame --plane-y --out --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --model --input --horizon --from-frame --plane-y --out --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1966,7 +1966,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__solve__subcmd__board)
-            opts="-q -h -V --game --board --random-depth --split --model --max-replans --allow-incomplete --embodiment --search --max-depth --max-nodes --max-memory-mib --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --game --board --random-depth --split --model --max-replans --allow-incomplete --embodiment --search --max-depth --max-nodes --max-memory-mib --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -2036,7 +2036,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__train)
-            opts="-q -h -V --resume --steps --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version pets ball-ekf context tradyn seads dlgpd help"
+            opts="-q -h -V --resume --steps --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version pets ball-ekf context tradyn seads dlgpd help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -2070,7 +2070,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__train__subcmd__ball__subcmd__ekf)
-            opts="-q -h -V --data --steps --batch --chunk --lr --launcher-prior --resume-if-stopped --out --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --data --steps --batch --chunk --lr --launcher-prior --resume-if-stopped --out --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -2120,7 +2120,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__train__subcmd__context)
-            opts="-q -h -V --data --env --config --preset --steps --batch --lr --resume-if-stopped --out --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --data --env --config --preset --steps --batch --lr --resume-if-stopped --out --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -2178,7 +2178,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__train__subcmd__dlgpd)
-            opts="-q -h -V --data --env --config --preset --steps --batch --lr --resume-if-stopped --out --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --data --env --config --preset --steps --batch --lr --resume-if-stopped --out --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -2348,7 +2348,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__train__subcmd__pets)
-            opts="-q -h -V --data --env --config --preset --ensemble --steps --batch --lr --reward --resume-if-stopped --out --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --data --env --config --preset --ensemble --steps --batch --lr --reward --resume-if-stopped --out --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -2414,7 +2414,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__train__subcmd__seads)
-            opts="-q -h -V --env --config --preset --skills --env-steps --no-relabel --no-second-best --no-novelty --resume-if-stopped --out --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --env --config --preset --skills --env-steps --no-relabel --no-second-best --no-novelty --resume-if-stopped --out --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -2464,7 +2464,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__train__subcmd__tradyn)
-            opts="-q -h -V --data --env --no-terrain --config --preset --steps --batch --lr --resume-if-stopped --out --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --data --env --no-terrain --config --preset --steps --batch --lr --resume-if-stopped --out --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -2522,7 +2522,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__watch)
-            opts="-q -h -V --seed --threads --tui --no-tui --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0

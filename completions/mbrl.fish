@@ -1,6 +1,6 @@
 # Print an optspec for argparse to handle cmd's options that are independent of any subcommand.
 function __fish_mbrl_global_optspecs
-    string join \n seed= threads= tui no-tui q/quiet max-memory-gib= h/help V/version
+    string join \n seed= threads= tui hold no-tui force q/quiet max-memory-gib= h/help V/version
 end
 
 function __fish_mbrl_needs_command
@@ -27,8 +27,10 @@ end
 complete -c mbrl -n "__fish_mbrl_needs_command" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_needs_command" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_needs_command" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
-complete -c mbrl -n "__fish_mbrl_needs_command" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_needs_command" -l tui -d 'Show the live terminal view (default when stdout is a terminal and MBRL_TUI is not `never`). It opens once the work has run a second and closes by itself when the work ends'
+complete -c mbrl -n "__fish_mbrl_needs_command" -l hold -d 'Keep the live view open when the work ends, until q is pressed (also MBRL_TUI=hold)'
 complete -c mbrl -n "__fish_mbrl_needs_command" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_needs_command" -l force -d 'Replace an output named with --out (or another output flag) that exists; without it such a command is refused. Default output names never replace anything: a free numbered name is used'
 complete -c mbrl -n "__fish_mbrl_needs_command" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_needs_command" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_needs_command" -s V -l version -d 'Print version'
@@ -54,7 +56,7 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l board -d 'With --a
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l episodes -d 'For <game>:cursor|reacher: N skill episodes of random actions, each from a scrambled board' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l steps -d 'Steps per rollout' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l policy -d 'Behaviour policy' -r -f -a "random\t'Random actions: uniform within the action bounds (the unicycle: colored noise, as its authors drew)'"
-complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l out -d 'Output file (default: datasets/<env>-random.mcap, <env>-pairs.mcap, <env>-replay.mcap, or <game>-boards-d<D>.mcap)' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l out -d 'Output file (default: datasets/<env>-random.mcap, <env>-pairs.mcap, <env>-replay.mcap, or <game>-boards-d<D>.mcap; when that exists, the first free name ending -2, -3, …). An existing --out is replaced only with --force' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l trajectories -d 'For the ball: number of simulated shots (each with exactly one table bounce)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l orientation -d 'For the ball: launcher pose, default or unseen-1..unseen-5 (thesis 6.5.1)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l augment-rotations -d 'For the ball: rotated copies added per shot, about z through its lowest point (19 in the thesis)' -r
@@ -68,8 +70,10 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l threads -d 'Worker
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l images -d 'Pendulum: also store a 64 × 64 RGB frame of every state (gym\'s rendering, DLGPD\'s observations), shown by Foxglove\'s Image panel on /frames'
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l boards -d 'For board games: write the set of all boards of solution depth 1..=--max-depth with their split'
-complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l tui -d 'Show the live terminal view (default when stdout is a terminal and MBRL_TUI is not `never`). It opens once the work has run a second and closes by itself when the work ends'
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l hold -d 'Keep the live view open when the work ends, until q is pressed (also MBRL_TUI=hold)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l force -d 'Replace an output named with --out (or another output flag) that exists; without it such a command is refused. Default output names never replace anything: a free numbered name is used'
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -s V -l version -d 'Print version'
@@ -93,14 +97,16 @@ colored\t'Power spectral density ∝ 1/f^β along time (iCEM)'"
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l beta -d 'Exponent β of colored noise (0.5; used with --noise colored)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l evidence -d 'DLGPD models: rollouts to condition the GPs on (a dataset written by `collect`)' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l instance-seed -d 'Plan in the instance (hidden parameters) this seed names, as `calibrate --instance-seed` does' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l out -d 'Where to save the executed rollout (default: datasets/plan-<env>.mcap)' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l out -d 'Where to save the executed rollout (default: datasets/plan-<env>-<model>.mcap, <model> being `true` or the checkpoint\'s directory name; when that exists, the first free name ending -2, -3, …)' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l allow-incomplete -d 'Take a run still in training (its best-validation weights so far); the output says how far it got'
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l no-warm-start -d 'Start every planning call from zero instead of the previous plan shifted by one step'
-complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l tui -d 'Show the live terminal view (default when stdout is a terminal and MBRL_TUI is not `never`). It opens once the work has run a second and closes by itself when the work ends'
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l hold -d 'Keep the live view open when the work ends, until q is pressed (also MBRL_TUI=hold)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l force -d 'Replace an output named with --out (or another output flag) that exists; without it such a command is refused. Default output names never replace anything: a free numbered name is used'
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -s V -l version -d 'Print version'
@@ -109,8 +115,10 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand train; and not __fish_seen_sub
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and not __fish_seen_subcommand_from pets ball-ekf context tradyn seads dlgpd help" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and not __fish_seen_subcommand_from pets ball-ekf context tradyn seads dlgpd help" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and not __fish_seen_subcommand_from pets ball-ekf context tradyn seads dlgpd help" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand train; and not __fish_seen_subcommand_from pets ball-ekf context tradyn seads dlgpd help" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and not __fish_seen_subcommand_from pets ball-ekf context tradyn seads dlgpd help" -l tui -d 'Show the live terminal view (default when stdout is a terminal and MBRL_TUI is not `never`). It opens once the work has run a second and closes by itself when the work ends'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and not __fish_seen_subcommand_from pets ball-ekf context tradyn seads dlgpd help" -l hold -d 'Keep the live view open when the work ends, until q is pressed (also MBRL_TUI=hold)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and not __fish_seen_subcommand_from pets ball-ekf context tradyn seads dlgpd help" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and not __fish_seen_subcommand_from pets ball-ekf context tradyn seads dlgpd help" -l force -d 'Replace an output named with --out (or another output flag) that exists; without it such a command is refused. Default output names never replace anything: a free numbered name is used'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and not __fish_seen_subcommand_from pets ball-ekf context tradyn seads dlgpd help" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and not __fish_seen_subcommand_from pets ball-ekf context tradyn seads dlgpd help" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and not __fish_seen_subcommand_from pets ball-ekf context tradyn seads dlgpd help" -s V -l version -d 'Print version'
@@ -137,8 +145,10 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcomm
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -l resume-if-stopped -d 'Resume the stopped run in --out when this command started it (same method, config, data and seed; a larger --steps extends a pets or dlgpd run); with no run there, or a finished one, train as without this flag. A re-run script then loses none of an interrupted run\'s training'
-complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -l tui -d 'Show the live terminal view (default when stdout is a terminal and MBRL_TUI is not `never`). It opens once the work has run a second and closes by itself when the work ends'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -l hold -d 'Keep the live view open when the work ends, until q is pressed (also MBRL_TUI=hold)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -l force -d 'Replace an output named with --out (or another output flag) that exists; without it such a command is refused. Default output names never replace anything: a free numbered name is used'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -s V -l version -d 'Print version'
@@ -153,8 +163,10 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcomm
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from ball-ekf" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from ball-ekf" -l launcher-prior -d 'Learn the spin prior from launcher settings (thesis C.1.3); recordings need side information'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from ball-ekf" -l resume-if-stopped -d 'Resume the stopped run in --out when this command started it (same method, config, data and seed; a larger --steps extends a pets or dlgpd run); with no run there, or a finished one, train as without this flag. A re-run script then loses none of an interrupted run\'s training'
-complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from ball-ekf" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from ball-ekf" -l tui -d 'Show the live terminal view (default when stdout is a terminal and MBRL_TUI is not `never`). It opens once the work has run a second and closes by itself when the work ends'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from ball-ekf" -l hold -d 'Keep the live view open when the work ends, until q is pressed (also MBRL_TUI=hold)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from ball-ekf" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from ball-ekf" -l force -d 'Replace an output named with --out (or another output flag) that exists; without it such a command is refused. Default output names never replace anything: a free numbered name is used'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from ball-ekf" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from ball-ekf" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from ball-ekf" -s V -l version -d 'Print version'
@@ -172,8 +184,10 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcomm
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -l resume-if-stopped -d 'Resume the stopped run in --out when this command started it (same method, config, data and seed; a larger --steps extends a pets or dlgpd run); with no run there, or a finished one, train as without this flag. A re-run script then loses none of an interrupted run\'s training'
-complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -l tui -d 'Show the live terminal view (default when stdout is a terminal and MBRL_TUI is not `never`). It opens once the work has run a second and closes by itself when the work ends'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -l hold -d 'Keep the live view open when the work ends, until q is pressed (also MBRL_TUI=hold)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -l force -d 'Replace an output named with --out (or another output flag) that exists; without it such a command is refused. Default output names never replace anything: a free numbered name is used'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -s V -l version -d 'Print version'
@@ -192,8 +206,10 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcomm
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -l no-terrain -d 'Ablation (thesis "−T"): no terrain lookup; the terrain features become part of the predicted state'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -l resume-if-stopped -d 'Resume the stopped run in --out when this command started it (same method, config, data and seed; a larger --steps extends a pets or dlgpd run); with no run there, or a finished one, train as without this flag. A re-run script then loses none of an interrupted run\'s training'
-complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -l tui -d 'Show the live terminal view (default when stdout is a terminal and MBRL_TUI is not `never`). It opens once the work has run a second and closes by itself when the work ends'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -l hold -d 'Keep the live view open when the work ends, until q is pressed (also MBRL_TUI=hold)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -l force -d 'Replace an output named with --out (or another output flag) that exists; without it such a command is refused. Default output names never replace anything: a free numbered name is used'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -s V -l version -d 'Print version'
@@ -212,8 +228,10 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcomm
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -l no-second-best -d 'Ablation: no second-best normalization of the reward'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -l no-novelty -d 'Ablation: no novelty bonus in the reward'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -l resume-if-stopped -d 'Resume the stopped run in --out when this command started it (same method, config, data and seed; a larger --steps extends a pets or dlgpd run); with no run there, or a finished one, train as without this flag. A re-run script then loses none of an interrupted run\'s training'
-complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -l tui -d 'Show the live terminal view (default when stdout is a terminal and MBRL_TUI is not `never`). It opens once the work has run a second and closes by itself when the work ends'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -l hold -d 'Keep the live view open when the work ends, until q is pressed (also MBRL_TUI=hold)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -l force -d 'Replace an output named with --out (or another output flag) that exists; without it such a command is refused. Default output names never replace anything: a free numbered name is used'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -s V -l version -d 'Print version'
@@ -231,8 +249,10 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcomm
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l resume-if-stopped -d 'Resume the stopped run in --out when this command started it (same method, config, data and seed; a larger --steps extends a pets or dlgpd run); with no run there, or a finished one, train as without this flag. A re-run script then loses none of an interrupted run\'s training'
-complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l tui -d 'Show the live terminal view (default when stdout is a terminal and MBRL_TUI is not `never`). It opens once the work has run a second and closes by itself when the work ends'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l hold -d 'Keep the live view open when the work ends, until q is pressed (also MBRL_TUI=hold)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l force -d 'Replace an output named with --out (or another output flag) that exists; without it such a command is refused. Default output names never replace anything: a free numbered name is used'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -s V -l version -d 'Print version'
@@ -257,25 +277,29 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l elites -d 'CEM e
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l iters -d 'CEM iterations' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l beta-samples -d 'β samples of the Monte Carlo information gain' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l init-state -d 'Start state, comma-separated in the env\'s state order (pendulum: θ,θ̇; unicycle: x,y,v,φ). Default: the thesis\' start (toy x = 0; MountainCar x = ẋ = 0; pendulum:quadrant hanging down, |θ − π|, |θ̇| ≤ 0.05, drawn from --seed), elsewhere a reset drawn from --seed' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l out -d 'Where to write the calibration transitions (default: datasets/calib-<env>-<strategy>-i<S>.mcap)' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l out -d 'Where to write the calibration transitions (default: datasets/calib-<env>-<strategy>-i<S>.mcap; when that exists, the first free name ending -2, -3, …)' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l allow-incomplete -d 'Take a run still in training (its best-validation weights so far); the output says how far it got'
-complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l tui -d 'Show the live terminal view (default when stdout is a terminal and MBRL_TUI is not `never`). It opens once the work has run a second and closes by itself when the work ends'
+complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l hold -d 'Keep the live view open when the work ends, until q is pressed (also MBRL_TUI=hold)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l force -d 'Replace an output named with --out (or another output flag) that exists; without it such a command is refused. Default output names never replace anything: a free numbered name is used'
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -s V -l version -d 'Print version'
 complete -c mbrl -n "__fish_mbrl_using_subcommand filter" -l model -d 'Ball model: thesis, initial, or a checkpoint directory' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand filter" -l input -d 'Recordings: a .mcap ball dataset or a .csv recording' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand filter" -l out -d 'CSV output: per frame the measurement, the state mean and its standard deviations' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand filter" -l out -d 'CSV output: per frame the measurement, the state mean and its standard deviations (default: filtered.csv; when that exists, the first free filtered-2.csv, …)' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand filter" -l mcap -d 'Also write the means with full covariances as MCAP' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand filter" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand filter" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand filter" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand filter" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand filter" -l tui -d 'Show the live terminal view (default when stdout is a terminal and MBRL_TUI is not `never`). It opens once the work has run a second and closes by itself when the work ends'
+complete -c mbrl -n "__fish_mbrl_using_subcommand filter" -l hold -d 'Keep the live view open when the work ends, until q is pressed (also MBRL_TUI=hold)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand filter" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand filter" -l force -d 'Replace an output named with --out (or another output flag) that exists; without it such a command is refused. Default output names never replace anything: a free numbered name is used'
 complete -c mbrl -n "__fish_mbrl_using_subcommand filter" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand filter" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand filter" -s V -l version -d 'Print version'
@@ -284,12 +308,14 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -l input -d 'Recordin
 complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -l horizon -d 'How far to predict: seconds with an `s` suffix (1s, 0.5s) or camera frames with `f` (90f)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -l from-frame -d 'Filter until this camera frame instead of one horizon before the end' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -l plane-y -d 'Report the crossing of the plane y = this value [m]' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -l out -d 'CSV of predicted points' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -l out -d 'CSV of predicted points (default: predicted.csv; when that exists, the first free predicted-2.csv, …)' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -l tui -d 'Show the live terminal view (default when stdout is a terminal and MBRL_TUI is not `never`). It opens once the work has run a second and closes by itself when the work ends'
+complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -l hold -d 'Keep the live view open when the work ends, until q is pressed (also MBRL_TUI=hold)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -l force -d 'Replace an output named with --out (or another output flag) that exists; without it such a command is refused. Default output names never replace anything: a free numbered name is used'
 complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -s V -l version -d 'Print version'
@@ -311,16 +337,20 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l seed -d 'Seed 
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l allow-incomplete -d 'Take a SEADS run still in training (the weights of its last checkpoint); a warning says how far it got'
-complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l tui -d 'Show the live terminal view (default when stdout is a terminal and MBRL_TUI is not `never`). It opens once the work has run a second and closes by itself when the work ends'
+complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l hold -d 'Keep the live view open when the work ends, until q is pressed (also MBRL_TUI=hold)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l force -d 'Replace an output named with --out (or another output flag) that exists; without it such a command is refused. Default output names never replace anything: a free numbered name is used'
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -s V -l version -d 'Print version'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context tradyn seads dlgpd pendulum-swingup render help" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context tradyn seads dlgpd pendulum-swingup render help" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context tradyn seads dlgpd pendulum-swingup render help" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context tradyn seads dlgpd pendulum-swingup render help" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context tradyn seads dlgpd pendulum-swingup render help" -l tui -d 'Show the live terminal view (default when stdout is a terminal and MBRL_TUI is not `never`). It opens once the work has run a second and closes by itself when the work ends'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context tradyn seads dlgpd pendulum-swingup render help" -l hold -d 'Keep the live view open when the work ends, until q is pressed (also MBRL_TUI=hold)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context tradyn seads dlgpd pendulum-swingup render help" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context tradyn seads dlgpd pendulum-swingup render help" -l force -d 'Replace an output named with --out (or another output flag) that exists; without it such a command is refused. Default output names never replace anything: a free numbered name is used'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context tradyn seads dlgpd pendulum-swingup render help" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context tradyn seads dlgpd pendulum-swingup render help" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context tradyn seads dlgpd pendulum-swingup render help" -s V -l version -d 'Print version'
@@ -336,34 +366,40 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subc
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context tradyn seads dlgpd pendulum-swingup render help" -f -a "pendulum-swingup" -d 'Pendulum swing-up with MPC: success rate, returns, angle plots'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context tradyn seads dlgpd pendulum-swingup render help" -f -a "render" -d 'Redraw a report (report.md, CSVs, PNGs) from its summary.json, without rerunning anything'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and not __fish_seen_subcommand_from quick dataset boards embodied ball context tradyn seads dlgpd pendulum-swingup render help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from quick" -l out -d 'Report directory' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from quick" -l out -d 'Report directory (default: reports/quick; when that exists, the first free reports/quick-2, -3, …)' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from quick" -l config -d 'Rerun with the seed a quick report recorded (its config.json)' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from quick" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from quick" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from quick" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from quick" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from quick" -l tui -d 'Show the live terminal view (default when stdout is a terminal and MBRL_TUI is not `never`). It opens once the work has run a second and closes by itself when the work ends'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from quick" -l hold -d 'Keep the live view open when the work ends, until q is pressed (also MBRL_TUI=hold)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from quick" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from quick" -l force -d 'Replace an output named with --out (or another output flag) that exists; without it such a command is refused. Default output names never replace anything: a free numbered name is used'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from quick" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from quick" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from quick" -s V -l version -d 'Print version'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dataset" -l input -d 'Dataset file written by `mbrl collect` or `mbrl plan`' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dataset" -l out -d 'Report directory' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dataset" -l out -d 'Report directory (default: reports/dataset; when that exists, the first free reports/dataset-2, -3, …)' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dataset" -l config -d 'Redo the report of the dataset a dataset report recorded (its config.json)' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dataset" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dataset" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dataset" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dataset" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dataset" -l tui -d 'Show the live terminal view (default when stdout is a terminal and MBRL_TUI is not `never`). It opens once the work has run a second and closes by itself when the work ends'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dataset" -l hold -d 'Keep the live view open when the work ends, until q is pressed (also MBRL_TUI=hold)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dataset" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dataset" -l force -d 'Replace an output named with --out (or another output flag) that exists; without it such a command is refused. Default output names never replace anything: a free numbered name is used'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dataset" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dataset" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dataset" -s V -l version -d 'Print version'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from boards" -l out -d 'Report directory' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from boards" -l out -d 'Report directory (default: reports/boards; when that exists, the first free reports/boards-2, -3, …)' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from boards" -l config -d 'Rerun with the seed a boards report recorded (its config.json)' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from boards" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from boards" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from boards" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from boards" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from boards" -l tui -d 'Show the live terminal view (default when stdout is a terminal and MBRL_TUI is not `never`). It opens once the work has run a second and closes by itself when the work ends'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from boards" -l hold -d 'Keep the live view open when the work ends, until q is pressed (also MBRL_TUI=hold)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from boards" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from boards" -l force -d 'Replace an output named with --out (or another output flag) that exists; without it such a command is refused. Default output names never replace anything: a free numbered name is used'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from boards" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from boards" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from boards" -s V -l version -d 'Print version'
@@ -374,13 +410,15 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l boards -d 'Boards drawn per depth (fewer when the split has fewer)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l split -d 'Split the boards come from' -r -f -a "train\t''
 test\t''"
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l out -d 'Report directory' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l out -d 'Report directory (default: reports/embodied; when that exists, the first free reports/embodied-2, -3, …)' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l config -d 'Rerun the settings and seed an embodied report recorded (its config.json); no other flag but --out' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l tui -d 'Show the live terminal view (default when stdout is a terminal and MBRL_TUI is not `never`). It opens once the work has run a second and closes by itself when the work ends'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l hold -d 'Keep the live view open when the work ends, until q is pressed (also MBRL_TUI=hold)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l force -d 'Replace an output named with --out (or another output flag) that exists; without it such a command is refused. Default output names never replace anything: a free numbered name is used'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -s V -l version -d 'Print version'
@@ -389,13 +427,15 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -l augment-rotations -d 'Rotated copies per training shot' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -l test-shots -d 'Default-pose test shots' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -l unseen-shots -d 'Test shots per unseen pose (5 poses)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -l out -d 'Report directory' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -l out -d 'Report directory (default: reports/ball; when that exists, the first free reports/ball-2, -3, …)' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -l config -d 'Rerun the settings and seed a ball report recorded (its config.json); no other flag but --out' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -l tui -d 'Show the live terminal view (default when stdout is a terminal and MBRL_TUI is not `never`). It opens once the work has run a second and closes by itself when the work ends'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -l hold -d 'Keep the live view open when the work ends, until q is pressed (also MBRL_TUI=hold)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -l force -d 'Replace an output named with --out (or another output flag) that exists; without it such a command is refused. Default output names never replace anything: a free numbered name is used'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -s V -l version -d 'Print version'
@@ -415,15 +455,17 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l beta-samples -d 'β samples of the information gain (thesis 20)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l swingup-steps -d 'Agent steps of each swing-up (thesis 50; the quadrant pendulum repeats each action twice)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l swingup-candidates -d 'CEM candidates of the swing-up planner (thesis 1000; elites are a tenth, 10 iterations, horizon 20)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l out -d 'Report directory' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l out -d 'Report directory (default: reports/context; when that exists, the first free reports/context-2, -3, …)' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l config -d 'Rerun the settings and seed a context report recorded (its config.json); no other flag but --out' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l swingup -d 'Pendulum: after each calibration, swing up with MPC on the calibrated model (thesis 4.5.3), and once on the true equations as the reference'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l allow-incomplete -d 'Take a run still in training (its best-validation weights so far); the report says how far it got'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l tui -d 'Show the live terminal view (default when stdout is a terminal and MBRL_TUI is not `never`). It opens once the work has run a second and closes by itself when the work ends'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l hold -d 'Keep the live view open when the work ends, until q is pressed (also MBRL_TUI=hold)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l force -d 'Replace an output named with --out (or another output flag) that exists; without it such a command is refused. Default output names never replace anything: a free numbered name is used'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -s V -l version -d 'Print version'
@@ -438,14 +480,16 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -l elites -d 'CEM elites (thesis 50)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -l iters -d 'CEM iterations (thesis 20)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -l prediction-steps -d 'Length of the random rollout per task whose open-loop prediction is scored (thesis 50)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -l out -d 'Report directory' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -l out -d 'Report directory (default: reports/tradyn; when that exists, the first free reports/tradyn-2, -3, …)' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -l config -d 'Rerun the settings and seed a tradyn report recorded (its config.json); no other flag but --out' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -l allow-incomplete -d 'Take runs still in training (their best-validation weights so far); the report says how far each got'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -l tui -d 'Show the live terminal view (default when stdout is a terminal and MBRL_TUI is not `never`). It opens once the work has run a second and closes by itself when the work ends'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -l hold -d 'Keep the live view open when the work ends, until q is pressed (also MBRL_TUI=hold)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -l force -d 'Replace an output named with --out (or another output flag) that exists; without it such a command is refused. Default output names never replace anything: a free numbered name is used'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -s V -l version -d 'Print version'
@@ -463,8 +507,10 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l allow-incomplete -d 'Take runs still in training (the weights of their last checkpoint); the report says how far each got'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l tui -d 'Show the live terminal view (default when stdout is a terminal and MBRL_TUI is not `never`). It opens once the work has run a second and closes by itself when the work ends'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l hold -d 'Keep the live view open when the work ends, until q is pressed (also MBRL_TUI=hold)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l force -d 'Replace an output named with --out (or another output flag) that exists; without it such a command is refused. Default output names never replace anything: a free numbered name is used'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -s V -l version -d 'Print version'
@@ -476,15 +522,17 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l candidates -d 'CEM candidates per iteration (the authors\': 1000, about 1.5 s a step on 2 cores at 10 evidence rollouts)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l elites -d 'CEM elites (the authors\': 100)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l iters -d 'At most this many CEM iterations per step (the authors\': 30, stopping at first-action std ≤ 0.01)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l out -d 'Report directory' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l out -d 'Report directory (default: reports/dlgpd; when that exists, the first free reports/dlgpd-2, -3, …)' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l config -d 'Rerun the settings and seed a dlgpd report recorded (its config.json); no other flag but --out' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l prediction-only -d 'Skip the swing-ups: only check the conditioned models\' reward predictions on held-out rollouts (seconds instead of an hour; tells a model that cannot see the pendulum from a planner that fails)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l allow-incomplete -d 'Take a run still in training (its best-validation weights so far); the report says how far it got'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l tui -d 'Show the live terminal view (default when stdout is a terminal and MBRL_TUI is not `never`). It opens once the work has run a second and closes by itself when the work ends'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l hold -d 'Keep the live view open when the work ends, until q is pressed (also MBRL_TUI=hold)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l force -d 'Replace an output named with --out (or another output flag) that exists; without it such a command is refused. Default output names never replace anything: a free numbered name is used'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -s V -l version -d 'Print version'
@@ -504,23 +552,27 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l noise -d 'Sampling noise (pendulum white; unicycle colored)' -r -f -a "white\t'Independent Gaussian samples (thesis Algorithm 1)'
 colored\t'Power spectral density ∝ 1/f^β along time (iCEM)'"
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l beta -d 'Exponent β of colored noise (0.5; used with --noise colored)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l out -d 'Report directory' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l out -d 'Report directory (default: reports/pendulum-swingup; when that exists, the first free reports/pendulum-swingup-2, -3, …)' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l config -d 'Rerun the settings and seed a swing-up report recorded (its config.json); no other flag but --out' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l allow-incomplete -d 'Take a run still in training (its best-validation weights so far); the output says how far it got'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l no-warm-start -d 'Start every planning call from zero instead of the previous plan shifted by one step'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l tui -d 'Show the live terminal view (default when stdout is a terminal and MBRL_TUI is not `never`). It opens once the work has run a second and closes by itself when the work ends'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l hold -d 'Keep the live view open when the work ends, until q is pressed (also MBRL_TUI=hold)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l force -d 'Replace an output named with --out (or another output flag) that exists; without it such a command is refused. Default output names never replace anything: a free numbered name is used'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -s V -l version -d 'Print version'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from render" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from render" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from render" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from render" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from render" -l tui -d 'Show the live terminal view (default when stdout is a terminal and MBRL_TUI is not `never`). It opens once the work has run a second and closes by itself when the work ends'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from render" -l hold -d 'Keep the live view open when the work ends, until q is pressed (also MBRL_TUI=hold)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from render" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from render" -l force -d 'Replace an output named with --out (or another output flag) that exists; without it such a command is refused. Default output names never replace anything: a free numbered name is used'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from render" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from render" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from render" -s V -l version -d 'Print version'
@@ -539,8 +591,10 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -l tui -d 'Show the live terminal view (default when stdout is a terminal and MBRL_TUI is not `never`). It opens once the work has run a second and closes by itself when the work ends'
+complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -l hold -d 'Keep the live view open when the work ends, until q is pressed (also MBRL_TUI=hold)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -l force -d 'Replace an output named with --out (or another output flag) that exists; without it such a command is refused. Default output names never replace anything: a free numbered name is used'
 complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -s V -l version -d 'Print version'
@@ -550,16 +604,20 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l format -d 'csv or n
 complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l tui -d 'Show the live terminal view (default when stdout is a terminal and MBRL_TUI is not `never`). It opens once the work has run a second and closes by itself when the work ends'
+complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l hold -d 'Keep the live view open when the work ends, until q is pressed (also MBRL_TUI=hold)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l force -d 'Replace an output named with --out (or another output flag) that exists; without it such a command is refused. Default output names never replace anything: a free numbered name is used'
 complete -c mbrl -n "__fish_mbrl_using_subcommand export" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand export" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand export" -s V -l version -d 'Print version'
 complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -l tui -d 'Show the live terminal view (default when stdout is a terminal)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -l tui -d 'Show the live terminal view (default when stdout is a terminal and MBRL_TUI is not `never`). It opens once the work has run a second and closes by itself when the work ends'
+complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -l hold -d 'Keep the live view open when the work ends, until q is pressed (also MBRL_TUI=hold)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -l force -d 'Replace an output named with --out (or another output flag) that exists; without it such a command is refused. Default output names never replace anything: a free numbered name is used'
 complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -s V -l version -d 'Print version'

@@ -74,7 +74,8 @@ pub struct CalibrateOptions {
     /// --seed), elsewhere a reset drawn from --seed.
     #[arg(long)]
     init_state: Option<String>,
-    /// Where to write the calibration transitions (default: datasets/calib-<env>-<strategy>-i<S>.mcap).
+    /// Where to write the calibration transitions (default: datasets/calib-<env>-<strategy>-i<S>.mcap; when
+    /// that exists, the first free name ending -2, -3, …).
     #[arg(long)]
     out: Option<PathBuf>,
     /// Take a run still in training (its best-validation weights so far); the output says how far it got.

@@ -139,14 +139,22 @@ pub fn output_file(
 
 /// As [`output_file`] for an output directory (a report, a map set): one that exists is replaced only with
 /// `--force` when named, never when it is the default.
-pub fn output_dir(flag: &str, given: Option<&Path>, default: impl FnOnce() -> PathBuf, invocation: &Invocation) -> Result<PathBuf> {
+pub fn output_dir(
+    flag: &str,
+    given: Option<&Path>,
+    default: impl FnOnce() -> PathBuf,
+    invocation: &Invocation,
+) -> Result<PathBuf> {
     match given {
         Some(path) => {
             if path.exists() && !path.is_dir() {
                 refuse!("{flag} {}: exists and is not a directory", path.display());
             }
             if is_nonempty_dir(path) && !invocation.force {
-                refuse!("{flag} {} exists; add --force to replace what is in it, or give another name", path.display());
+                refuse!(
+                    "{flag} {} exists and is not empty; add --force to replace what is in it, or give another name",
+                    path.display()
+                );
             }
             Ok(path.to_path_buf())
         }
@@ -163,7 +171,8 @@ const MAX_NUMBERED_NAMES: u32 = 10_000;
 
 /// `path` if nothing is there, else the first free `stem-N.ext` (N from 2).
 fn free_name(path: &Path) -> Result<PathBuf> {
-    let taken = |p: &Path| std::fs::symlink_metadata(p).is_ok() && !(p.is_dir() && !is_nonempty_dir(p));
+    // An empty directory is as good as nothing (a run stopped before it wrote anything, a `mkdir`).
+    let taken = |p: &Path| std::fs::symlink_metadata(p).is_ok() && (!p.is_dir() || is_nonempty_dir(p));
     if !taken(path) {
         return Ok(path.to_path_buf());
     }

@@ -21,6 +21,6 @@ pub mod solve_board;
 pub mod train;
 
 pub use common::{
-    output_dir, output_file,
-    check_output_file, file_stem, finite_f64, parse_floats, pendulum_variant, warn, Invocation, Job, STEP_RECORD_BYTES,
+    check_output_file, file_stem, finite_f64, output_dir, output_file, parse_floats, pendulum_variant, warn,
+    Invocation, Job, STEP_RECORD_BYTES,
 };

@@ -246,7 +246,8 @@ fn render_text_panel(panel: &TextPanel, frame: &mut Frame, area: Rect) {
 }
 
 /// `line` cut to `width` characters at a space, so a value shows whole or not at all (a step range of
-/// 1500-3000 never reads as 1500-300); the cut is marked with an ellipsis.
+/// 1500-3000 never reads as 1500-300); a line that is one item (a board's row) is cut at the border. The
+/// cut is marked with an ellipsis.
 fn fit_whole_items(line: &str, width: usize) -> String {
     if line.chars().count() <= width {
         return line.to_string();
@@ -257,7 +258,11 @@ fn fit_whole_items(line: &str, width: usize) -> String {
     let room = width - 1;
     let head: String = line.chars().take(room).collect();
     let cut_at_space = line.chars().nth(room).is_some_and(char::is_whitespace);
-    let kept = if cut_at_space { head.as_str() } else { head.rfind(char::is_whitespace).map_or("", |at| &head[..at]) };
+    let kept = match head.rfind(char::is_whitespace) {
+        _ if cut_at_space => head.as_str(),
+        Some(at) => &head[..at],
+        None => head.as_str(),
+    };
     format!("{}…", kept.trim_end())
 }
 
@@ -374,7 +379,7 @@ mod tests {
         assert_eq!(fit_whole_items("kl ramp  steps 1500-3000", 24), "kl ramp  steps 1500-3000");
         assert_eq!(fit_whole_items("kl ramp  steps 1500-3000", 15), "kl ramp  steps…");
         assert_eq!(fit_whole_items("kl ramp  steps 1500-3000", 14), "kl ramp…");
-        assert_eq!(fit_whole_items("1500-3000", 5), "…");
+        assert_eq!(fit_whole_items("1500-3000", 5), "1500…", "one item is cut at the border");
         assert_eq!(fit_whole_items("1500-3000", 0), "");
         let mut app = App::new("train context");
         app.ingest(&Event::text("settings", "lr           0.001\nkl schedule  steps 1500-3000, then 1"));
@@ -646,7 +651,8 @@ mod tests {
         assert!(!screen.contains("END"), "{screen}");
         let (row, col) = find(&screen, "■■■■").unwrap_or_else(|| panic!("{screen}"));
         assert_eq!(find(&screen, "next row"), Some((row + 1, col)), "{screen}");
-        assert_eq!(cell(&screen, row, 58), Some('■'), "the line runs to the border:\n{screen}");
+        assert_eq!(cell(&screen, row, 57), Some('■'), "the line runs to the border:\n{screen}");
+        assert_eq!(cell(&screen, row, 58), Some('…'), "and is marked as cut there:\n{screen}");
     }
 
     #[test]

@@ -16,7 +16,7 @@ fn run_ok(dir: &Path, args: &[&str]) -> String {
     stdout_of(&out)
 }
 
-fn train_tiny(dir: &Path, env: &str, data: &str, out: &str, steps: &str) {
+pub(crate) fn train_tiny(dir: &Path, env: &str, data: &str, out: &str, steps: &str) {
     std::fs::write(dir.join("tiny.toml"), TINY).unwrap();
     run_ok(dir, &["collect", "--env", env, "--instances", "12", "--steps", "20", "-q", "--out", data]);
     run_ok(

@@ -62,7 +62,7 @@ fn replays_start_from_the_given_board_and_run_every_embodiment() {
     assert_eq!(data.steps[0].state[2 + 1], 1.0, "field 0 holds chip 1");
     write(dir.path(), "r.csv", "1,-1,-1\n0.5,0.5,1\n");
     for env in ["lightsout:reacher", "tileswap:reacher"] {
-        let args = ["--env", env, "--actions", "r.csv", "--init-state", "0.3,-1.2,0,0.5", "--out", "r.mcap"];
+        let args = ["--env", env, "--actions", "r.csv", "--init-state", "0.3,-1.2,0,0.5", "--out", "r.mcap", "--force"];
         succeed(dir.path(), &args);
         let data = read_dataset(&dir.path().join("r.mcap")).unwrap();
         assert_eq!(data.steps[0].state[..4], [0.3, -1.2, 0.0, 0.5], "{env}");

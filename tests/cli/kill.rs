@@ -78,7 +78,7 @@ fn spawn(dir: &Path, args: &[&str]) -> std::process::Child {
         .current_dir(dir)
         .env("NO_COLOR", "1")
         .args(args)
-        .args(["--no-tui", "-q", "--threads", "1"])
+        .args(["--no-tui", "-q", "--threads", "1", "--force"])
         .stdout(std::process::Stdio::null())
         .stderr(std::process::Stdio::piped())
         .spawn()
@@ -264,5 +264,9 @@ fn a_run_directory_in_use_refuses_a_second_writer_naming_its_pid() {
     let out = mbrl(d).args(&long_run).args(["--no-tui", "-q"]).output().unwrap();
     assert!(stderr_of(&out).contains("holds a pets run stopped at step"), "{}", stderr_of(&out));
     let out = mbrl(d).args(["watch", "models/p", "--no-tui"]).output().unwrap();
-    assert!(stdout_of(&out).contains("status: stopped; continue with `mbrl train --resume models/p`"), "{}", stdout_of(&out));
+    assert!(
+        stdout_of(&out).contains("status: stopped; continue with `mbrl train --resume models/p`"),
+        "{}",
+        stdout_of(&out)
+    );
 }

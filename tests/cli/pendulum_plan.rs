@@ -31,7 +31,7 @@ fn same_command_same_bytes() {
     let plan = || {
         mbrl(dir.path())
             .args(["plan", "--env", "pendulum", "--model", "true", "--candidates", "100", "--elites", "10"])
-            .args(["--iters", "3", "--steps", "40", "--threads", "2", "-q", "--out", "p.mcap"])
+            .args(["--iters", "3", "--steps", "40", "--threads", "2", "-q", "--out", "p.mcap", "--force"])
             .assert()
             .success();
         std::fs::read(dir.path().join("p.mcap")).unwrap()
@@ -62,6 +62,7 @@ fn small_cem_swings_the_pendulum_up() {
         let out = mbrl(dir.path())
             .args(["plan", "--env", "pendulum", "--model", "true", "--horizon", "20", "--candidates", "200"])
             .args(["--elites", "20", "--iters", "5", "--steps", "150", "-q", "--out", "swing.mcap", "--seed", seed])
+            .arg("--force")
             .output()
             .unwrap();
         assert!(out.status.success(), "{}", stderr_of(&out));

@@ -122,9 +122,12 @@ fn resume_if_stopped_starts_a_new_run_in_an_empty_or_finished_directory() {
         stdout_of(&plain).replace("checkpoint: plain", ""),
         "a new run, as without the flag"
     );
-    // A finished run is replaced, as a plain `train` replaces it: the same seed trains the same bytes.
+    // A finished run in a named --out is replaced only with --force, as a plain `train` would: the same seed
+    // trains the same bytes.
     let before = trained_bytes(&d.join("m"));
-    run_ok(d, &[&args[..], &["--out", "m", "--resume-if-stopped"]].concat());
+    let refused = mbrl(d).args(args).args(["--out", "m", "--resume-if-stopped", "--no-tui"]).output().unwrap();
+    assert_one_line_error(&refused, &["holds a finished pets run (20 steps)", "--force"]);
+    run_ok(d, &[&args[..], &["--out", "m", "--resume-if-stopped", "--force"]].concat());
     assert_eq!(before, trained_bytes(&d.join("m")));
 }
 

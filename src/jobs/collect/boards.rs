@@ -7,7 +7,7 @@ use crate::data::boardset::{write_board_set, BoardSet};
 use crate::envs::boards::depth::{DenseIndex, DepthTable};
 use crate::envs::boards::sets::{board_set, BoardRecord};
 use crate::envs::boards::{BoardGame, GameSpec, LightsOut, Split, TileSwap};
-use crate::jobs::{output_file, file_stem, Invocation, Job};
+use crate::jobs::{file_stem, output_file, Invocation, Job};
 use crate::run::Monitor;
 use crate::{refuse, Result};
 

@@ -12,7 +12,7 @@ use crate::data::write_dataset;
 use crate::envs::boards::GameSpec;
 use crate::envs::embodiments::Embodiment;
 use crate::envs::EnvName;
-use crate::jobs::{output_file, file_stem, Invocation, Job};
+use crate::jobs::{file_stem, output_file, Invocation, Job};
 use crate::{refuse, Result};
 
 pub(super) fn prepare(

@@ -108,7 +108,8 @@ pub struct CollectOptions {
     #[arg(long, value_enum, default_value_t = Policy::Random)]
     policy: Policy,
     /// Output file (default: datasets/<env>-random.mcap, <env>-pairs.mcap, <env>-replay.mcap, or
-    /// <game>-boards-d<D>.mcap).
+    /// <game>-boards-d<D>.mcap; when that exists, the first free name ending -2, -3, …). An existing --out is
+    /// replaced only with --force.
     #[arg(long)]
     out: Option<PathBuf>,
     /// For the ball: number of simulated shots (each with exactly one table bounce).

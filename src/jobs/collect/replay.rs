@@ -8,7 +8,7 @@ use crate::data::collect::{parse_state, replay, ReplaySettings};
 use crate::data::collect_frames::{add_pendulum_frames, check_frames_size};
 use crate::data::write_dataset;
 use crate::envs::EnvName;
-use crate::jobs::{output_file, file_stem, Invocation, Job};
+use crate::jobs::{file_stem, output_file, Invocation, Job};
 use crate::Result;
 
 pub(super) fn prepare(

@@ -30,9 +30,11 @@ pub fn boards(options: BoardsOptions, invocation: &Invocation) -> Result<Job<'st
         Some(path) => recorded::<boards::BoardsConfig>(invocation, path)?.1,
         None => invocation.provenance(),
     };
-    Ok(report_job("eval boards", output_dir("--out", options.out.as_deref(), || PathBuf::from("reports/boards"), invocation)?, move |monitor, out| {
-        Ok(Summary::Boards(boards::depth_report(&provenance, out, monitor)?))
-    }))
+    Ok(report_job(
+        "eval boards",
+        output_dir("--out", options.out.as_deref(), || PathBuf::from("reports/boards"), invocation)?,
+        move |monitor, out| Ok(Summary::Boards(boards::depth_report(&provenance, out, monitor)?)),
+    ))
 }
 
 #[derive(Args, Debug)]
@@ -77,9 +79,11 @@ pub fn embodied(options: EmbodiedOptions, invocation: &Invocation) -> Result<Job
         ),
     };
     config.validate()?;
-    Ok(report_job("eval embodied", output_dir("--out", options.out.as_deref(), || PathBuf::from("reports/embodied"), invocation)?, move |monitor, out| {
-        Ok(Summary::Embodied(boards::embodied(&config, &provenance, out, monitor)?))
-    }))
+    Ok(report_job(
+        "eval embodied",
+        output_dir("--out", options.out.as_deref(), || PathBuf::from("reports/embodied"), invocation)?,
+        move |monitor, out| Ok(Summary::Embodied(boards::embodied(&config, &provenance, out, monitor)?)),
+    ))
 }
 
 #[derive(Args, Debug)]

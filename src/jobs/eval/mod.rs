@@ -155,9 +155,11 @@ pub fn prepare(options: EvalOptions, invocation: &Invocation) -> Result<Eval> {
                 Some(path) => recorded::<crate::eval::quick::QuickConfig>(invocation, path)?.1,
                 None => invocation.provenance(),
             };
-            report_job("eval quick", output_dir("--out", options.out.as_deref(), || PathBuf::from("reports/quick"), invocation)?, move |monitor, out| {
-                Ok(Summary::Quick(crate::eval::quick::run_quick(&provenance, out, monitor)?))
-            })
+            report_job(
+                "eval quick",
+                output_dir("--out", options.out.as_deref(), || PathBuf::from("reports/quick"), invocation)?,
+                move |monitor, out| Ok(Summary::Quick(crate::eval::quick::run_quick(&provenance, out, monitor)?)),
+            )
         }
         Protocol::Dataset(options) => pendulum::dataset(options, invocation)?,
         Protocol::Boards(options) => boards::boards(options, invocation)?,

@@ -62,9 +62,11 @@ pub fn ball(options: BallOptions, invocation: &Invocation) -> Result<Job<'static
     };
     let models = config.models.iter().map(|m| Ok((report_name(m), load_ball_model(m)?))).collect::<Result<Vec<_>>>()?;
     config.validate()?;
-    Ok(report_job("eval ball", output_dir("--out", options.out.as_deref(), || PathBuf::from("reports/ball"), invocation)?, move |monitor, out| {
-        Ok(Summary::Ball(ball::evaluate(&config, models, &provenance, out, monitor)?))
-    }))
+    Ok(report_job(
+        "eval ball",
+        output_dir("--out", options.out.as_deref(), || PathBuf::from("reports/ball"), invocation)?,
+        move |monitor, out| Ok(Summary::Ball(ball::evaluate(&config, models, &provenance, out, monitor)?)),
+    ))
 }
 
 #[derive(Args, Debug)]
@@ -185,9 +187,13 @@ pub fn context(options: ContextOptions, invocation: &Invocation) -> Result<Job<'
     config.validate(&env)?;
     let model = crate::models::context::load(&config.model, &env, accepting(config.allow_incomplete))?;
     report_unfinished(&config.model, &model.progress);
-    Ok(report_job("eval context", output_dir("--out", options.out.as_deref(), || PathBuf::from("reports/context"), invocation)?, move |monitor, out| {
-        Ok(Summary::Context(crate::eval::context::evaluate(&model, &env, &config, &provenance, out, monitor)?))
-    }))
+    Ok(report_job(
+        "eval context",
+        output_dir("--out", options.out.as_deref(), || PathBuf::from("reports/context"), invocation)?,
+        move |monitor, out| {
+            Ok(Summary::Context(crate::eval::context::evaluate(&model, &env, &config, &provenance, out, monitor)?))
+        },
+    ))
 }
 
 #[derive(Args, Debug)]
@@ -275,7 +281,11 @@ pub fn tradyn(options: TradynOptions, invocation: &Invocation) -> Result<Job<'st
     models.check()?;
     let maps =
         crate::data::terrain_set::read_terrain_set(&config.maps, Some(crate::envs::terrain::TerrainSplit::Test))?;
-    Ok(report_job("eval tradyn", output_dir("--out", options.out.as_deref(), || PathBuf::from("reports/tradyn"), invocation)?, move |monitor, out| {
-        Ok(Summary::Tradyn(crate::eval::tradyn::evaluate(&models, maps, &config, &provenance, out, monitor)?))
-    }))
+    Ok(report_job(
+        "eval tradyn",
+        output_dir("--out", options.out.as_deref(), || PathBuf::from("reports/tradyn"), invocation)?,
+        move |monitor, out| {
+            Ok(Summary::Tradyn(crate::eval::tradyn::evaluate(&models, maps, &config, &provenance, out, monitor)?))
+        },
+    ))
 }

@@ -34,9 +34,11 @@ pub fn dataset(options: DatasetOptions, invocation: &Invocation) -> Result<Job<'
         }
         (None, input) => (input.unwrap_or_default(), invocation.provenance()),
     };
-    Ok(report_job("eval dataset", output_dir("--out", options.out.as_deref(), || PathBuf::from("reports/dataset"), invocation)?, move |_, out| {
-        Ok(Summary::Dataset(crate::eval::dataset_report::report(&input, &provenance, out)?))
-    }))
+    Ok(report_job(
+        "eval dataset",
+        output_dir("--out", options.out.as_deref(), || PathBuf::from("reports/dataset"), invocation)?,
+        move |_, out| Ok(Summary::Dataset(crate::eval::dataset_report::report(&input, &provenance, out)?)),
+    ))
 }
 
 #[derive(Args, Debug)]
@@ -118,9 +120,13 @@ pub fn swingup(options: SwingupOptions, invocation: &Invocation) -> Result<Job<'
         crate::util::budget::times(&[config.episodes, config.settings.steps], STEP_RECORD_BYTES),
         "evaluate fewer or shorter episodes",
     )?;
-    Ok(report_job("eval pendulum-swingup", output_dir("--out", options.out.as_deref(), || PathBuf::from("reports/pendulum-swingup"), invocation)?, move |monitor, out| {
-        Ok(Summary::PendulumSwingup(swingup::evaluate(&config, model.as_deref(), &provenance, out, monitor)?))
-    }))
+    Ok(report_job(
+        "eval pendulum-swingup",
+        output_dir("--out", options.out.as_deref(), || PathBuf::from("reports/pendulum-swingup"), invocation)?,
+        move |monitor, out| {
+            Ok(Summary::PendulumSwingup(swingup::evaluate(&config, model.as_deref(), &provenance, out, monitor)?))
+        },
+    ))
 }
 
 #[derive(Args, Debug)]
@@ -191,7 +197,11 @@ pub fn dlgpd(options: DlgpdOptions, invocation: &Invocation) -> Result<Job<'stat
     config.settings()?;
     let trained = crate::models::dlgpd::job::load(&config.model, accepting(config.allow_incomplete))?;
     report_unfinished(&config.model, &trained.progress);
-    Ok(report_job("eval dlgpd", output_dir("--out", options.out.as_deref(), || PathBuf::from("reports/dlgpd"), invocation)?, move |monitor, out| {
-        Ok(Summary::Dlgpd(crate::eval::dlgpd::evaluate(&trained, &config, &provenance, out, monitor)?))
-    }))
+    Ok(report_job(
+        "eval dlgpd",
+        output_dir("--out", options.out.as_deref(), || PathBuf::from("reports/dlgpd"), invocation)?,
+        move |monitor, out| {
+            Ok(Summary::Dlgpd(crate::eval::dlgpd::evaluate(&trained, &config, &provenance, out, monitor)?))
+        },
+    ))
 }
