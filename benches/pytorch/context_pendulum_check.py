@@ -249,7 +249,8 @@ def loss(model, batch, chosen):
     kl_empty = (0.5 * (std_e**2 + mean_e**2 - 1) - std_e.log()).sum()
     kl_context = kl(mean_p, std_p, mean_q, std_q).clamp_min(0.1).sum(-1).mean()
     h0 = torch.tanh(model.state_enc(states.reshape(-1, 3)))
-    reconstruction = log_likelihood(model.decode(h0), states.reshape(-1, 3)).mean()
+    # Over the states a transition starts from, as the authors' loss (and mbrl's) averages it.
+    reconstruction = log_likelihood(model.decode(h0), states.reshape(-1, 3)).reshape(b, n)[:, :-1].mean()
     beta_single = (mean_p[:, None] + std_p[:, None] * noise * torch.randn(b, n - 1, args.latent)).reshape(-1, args.latent)
     h_single = model.step(h0.reshape(b, n, E)[:, :-1].reshape(-1, E), actions.reshape(-1, 1), beta_single)
     single = log_likelihood(model.decode(h_single), states[:, 1:].reshape(-1, 3)).mean()

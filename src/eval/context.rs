@@ -299,7 +299,8 @@ fn random_rollout(env: &mut dyn crate::envs::Env, steps: usize, rng: &mut rand_c
 }
 
 /// Entropy after a single transition from s = 0 under action a, the next state imagined by the model itself
-/// with β from the prior, averaged over `samples` draws (thesis Fig. 4.4a).
+/// with β from the prior (both ends of the transition the model's, as in EIG), averaged over `samples` draws
+/// (thesis Fig. 4.4a).
 pub fn entropy_after_one_action(model: &LoadedModel, actions: &[f64], samples: usize, seed: u64) -> Vec<f64> {
     let fast = &model.fast;
     let zero = vec![0.0f32; fast.transition_features];

@@ -36,12 +36,15 @@ pub struct NonNegLinear {
 impl LinearConfig {
     /// torch.nn.Linear's default initialization, from `rng`.
     pub fn init<R: Rng + ?Sized>(&self, device: &Device, rng: &mut R) -> Linear {
-        let (weight, bias) = self.init_parts(device, rng);
+        let (weight, bias) = self.init_parts(device, rng, std::convert::identity);
         Linear { weight, bias }
     }
 
+    /// The same draws with the weights' signs dropped, as the authors' positive-weights layer initializes: a
+    /// negative raw weight is ReLU'd to zero and gets no gradient, so a signed draw would leave about half of the
+    /// context std head dead from the start (and its initial std far from the authors').
     pub fn init_non_negative<R: Rng + ?Sized>(&self, device: &Device, rng: &mut R) -> NonNegLinear {
-        let (weight, bias) = self.init_parts(device, rng);
+        let (weight, bias) = self.init_parts(device, rng, f32::abs);
         NonNegLinear { weight, bias }
     }
 
@@ -49,9 +52,11 @@ impl LinearConfig {
         &self,
         device: &Device,
         rng: &mut R,
+        map_weight: fn(f32) -> f32,
     ) -> (Param<Tensor<2>>, Option<Param<Tensor<1>>>) {
         let (i, o) = (self.d_input, self.d_output);
-        let weight = Param::from_tensor(tensor(torch_uniform(rng, o * i, i), [o, i], device));
+        let drawn: Vec<f32> = torch_uniform(rng, o * i, i).into_iter().map(map_weight).collect();
+        let weight = Param::from_tensor(tensor(drawn, [o, i], device));
         let bias = self.bias.then(|| Param::from_tensor(tensor(torch_uniform(rng, o, i), [o], device)));
         (weight, bias)
     }

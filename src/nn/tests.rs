@@ -51,6 +51,23 @@ fn set_max_pool_starts_from_zero_and_ignores_padding() {
 }
 
 #[test]
+fn non_negative_linear_starts_from_the_absolute_values_of_the_usual_draw() {
+    // Every weight starts active, as the authors' positive-weights layer (abs of torch's draw); the bias keeps
+    // its sign.
+    let device = inference_device();
+    let config = LinearConfig::new(6, 5);
+    let plain = config.init(&device, &mut ChaCha8Rng::seed_from_u64(4));
+    let non_negative = config.init_non_negative(&device, &mut ChaCha8Rng::seed_from_u64(4));
+    let plain = ParamSet::<f32>::from_module(&plain, |s| s.into());
+    let non_negative = ParamSet::<f32>::from_module(&non_negative, |s| s.into());
+    let values = |p: &ParamSet, name: &str| p.get(name).unwrap().values.clone();
+    let drawn = values(&plain, "weight");
+    assert!(drawn.iter().any(|w| *w < 0.0), "the draw has negative weights to drop");
+    assert_eq!(values(&non_negative, "weight"), drawn.iter().map(|w| w.abs()).collect::<Vec<_>>());
+    assert_eq!(values(&non_negative, "bias"), values(&plain, "bias"));
+}
+
+#[test]
 fn non_negative_linear_ignores_negative_weights() {
     let device = inference_device();
     let layer = LinearConfig::new(2, 1).init_non_negative(&device, &mut ChaCha8Rng::seed_from_u64(2));

@@ -32,7 +32,7 @@ impl<'a> EigObjective<'a> {
     pub fn new(model: &'a FastContextModel, init: Vec<f32>, base_pool: Vec<f32>, samples: usize, seed: u64) -> Self {
         let belief = model.belief(&base_pool, 1);
         let mut rng = rng_for(seed, &[]);
-        let betas = (0..samples)
+        let betas: Vec<f32> = (0..samples)
             .flat_map(|_| {
                 belief
                     .mean
@@ -42,6 +42,12 @@ impl<'a> EigObjective<'a> {
                     .collect::<Vec<_>>()
             })
             .collect();
+        Self::from_samples(model, init, base_pool, betas)
+    }
+
+    /// The objective under given β samples (`betas`, [samples, D_β]).
+    pub fn from_samples(model: &'a FastContextModel, init: Vec<f32>, base_pool: Vec<f32>, betas: Vec<f32>) -> Self {
+        let samples = betas.len() / model.latent_dim;
         EigObjective { model, init, base_pool, betas, samples }
     }
 

@@ -27,4 +27,6 @@ pub fn load(dir: &Path, env: &EnvName, accept: Accept) -> Result<LoadedModel> {
 }
 
 #[cfg(test)]
+mod golden;
+#[cfg(test)]
 mod tests;

@@ -118,8 +118,9 @@ fn entropy_after_an_imagined_rollout_matches_pooling_it_by_hand() {
     let mut out = [0.0];
     fast.entropy_after(&fast.pool(&base), &init, &actions, &states, 1, horizon, &mut out, &mut Default::default());
     let mut all = base.clone();
+    let start = fast.reconstruct(&init);
     for t in 0..horizon {
-        all.extend_from_slice(if t == 0 { &init } else { &states[(t - 1) * s..t * s] });
+        all.extend_from_slice(if t == 0 { &start } else { &states[(t - 1) * s..t * s] });
         all.extend_from_slice(&actions[t * a..(t + 1) * a]);
         all.extend_from_slice(&states[t * s..(t + 1) * s]);
     }

@@ -228,9 +228,22 @@ impl FastContextModel {
         }
     }
 
+    /// The model's reconstruction of a state: its predicted features decoded from their embedding (the GRU's
+    /// start), the local ones as they are.
+    pub fn reconstruct(&self, state: &[f32]) -> Vec<f32> {
+        let (p, mut scratch) = (self.predicted_dim, StackScratch::default());
+        let (mut h, mut out) = (Vec::new(), Vec::new());
+        self.state_encoder.forward(&state[..p], 1, &mut h, &mut scratch);
+        self.mean_decoder.forward(&h, 1, &mut out, &mut scratch);
+        out.extend_from_slice(&state[p..]);
+        out
+    }
+
     /// Entropy of q(β | base ∪ chop(R)) per row, where R is the row's imagined rollout from `init` (`actions`
     /// rows × H × A, `states` its predictions rows × H × S) and `base_pool` the pooled features of the
-    /// transitions observed so far.
+    /// transitions observed so far. R's first transition starts at the model's reconstruction of `init`, not at
+    /// `init`: the authors' calibration chops the model's mean predictions from index 0, the decoded start, so
+    /// every imagined transition is the model's own.
     #[allow(clippy::too_many_arguments)] // flat buffers of the hot path, kept apart to avoid copies
     pub fn entropy_after(
         &self,
@@ -244,10 +257,11 @@ impl FastContextModel {
         w: &mut RolloutScratch,
     ) {
         let (s, a, f) = (self.state_dim, self.action_dim, self.transition_features);
+        let start = self.reconstruct(init);
         w.transitions.clear();
         for r in 0..rows {
             for t in 0..horizon {
-                let from = if t == 0 { init } else { &states[(r * horizon + t - 1) * s..(r * horizon + t) * s] };
+                let from = if t == 0 { &start[..] } else { &states[(r * horizon + t - 1) * s..(r * horizon + t) * s] };
                 w.transitions.extend_from_slice(from);
                 w.transitions.extend_from_slice(&actions[(r * horizon + t) * a..(r * horizon + t + 1) * a]);
                 w.transitions.extend_from_slice(&states[(r * horizon + t) * s..(r * horizon + t + 1) * s]);

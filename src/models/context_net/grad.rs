@@ -375,9 +375,12 @@ pub fn loss_and_gradients(
     let kl_context = kl_values.iter().map(|v| v.max(kl_floor)).sum::<f32>() / b as f32;
     let kl_weight = config.kl_weight as f32;
 
-    // Embeddings and the GRU input gates shared by the single-step and multi-step predictions.
+    // Embeddings and the GRU input gates shared by the single-step and multi-step predictions. Only the N − 1
+    // states a transition starts from are embedded (chunk i's state k at row i·T + k): the reconstruction term
+    // averages over them as the authors' loss does, and the last state is never stepped from.
     let predicted: Vec<f32> = batch.states.chunks(s).flat_map(|row| &row[..p]).copied().collect();
-    let (mut h_all, state_tape) = net.state_encoder.forward(&predicted, b * n);
+    let starts: Vec<f32> = (0..b).flat_map(|i| &predicted[i * n * p..(i * n + t) * p]).copied().collect();
+    let (mut h_all, state_tape) = net.state_encoder.forward(&starts, b * t);
     h_all.iter_mut().for_each(|x| *x = tanh(*x));
     let (mut act_emb, act_tape) = net.action_encoder.forward(&batch.actions, b * t);
     relu_in_place(&mut act_emb);
@@ -407,11 +410,7 @@ pub fn loss_and_gradients(
     relu_in_place(&mut ctx_single);
     let mut gi_single = action_gates.clone();
     net.gru.add_input_gates(&ctx_single, b * t, 0, &mut gi_single);
-    let h_prev_single: Vec<f32> = (0..b)
-        .flat_map(|i| (0..t).flat_map(move |k| (i * n + k) * e..(i * n + k + 1) * e))
-        .map(|at| h_all[at])
-        .collect();
-    let mut h_single = h_prev_single.clone();
+    let mut h_single = h_all.clone();
     let single_tape = net.gru.step(&gi_single, &mut h_single, b * t);
 
     // Multi-step: one β per chunk, open loop from s_0; the predictions of s_2.. enter the sum.
@@ -420,7 +419,7 @@ pub fn loss_and_gradients(
     relu_in_place(&mut ctx_seq);
     let mut ctx_gates = vec![0.0; b * g];
     net.gru.add_input_gates(&ctx_seq, b, 0, &mut ctx_gates);
-    let mut h: Vec<f32> = (0..b).flat_map(|i| h_all[i * n * e..(i * n + 1) * e].iter().copied()).collect();
+    let mut h: Vec<f32> = (0..b).flat_map(|i| h_all[i * t * e..(i * t + 1) * e].iter().copied()).collect();
     // Step-major: row k·B + i is chunk i at step k.
     let mut seq_h_prev = Vec::with_capacity(t * b * e);
     let mut seq_tapes = Vec::with_capacity(t);
@@ -444,13 +443,13 @@ pub fn loss_and_gradients(
     }
 
     // One decoder pass over the reconstruction, single-step and multi-step GRU states.
-    let rows = b * n + b * t + b * steps;
+    let rows = 2 * b * t + b * steps;
     let mut decoded = Vec::with_capacity(rows * e);
     decoded.extend_from_slice(&h_all);
     decoded.extend_from_slice(&h_single);
     decoded.extend_from_slice(&open_loop);
     let mut targets = Vec::with_capacity(rows * p);
-    targets.extend_from_slice(&predicted);
+    targets.extend_from_slice(&starts);
     for i in 0..b {
         targets.extend_from_slice(&predicted[(i * n + 1) * p..(i * n + n) * p]);
     }
@@ -471,9 +470,9 @@ pub fn loss_and_gradients(
     };
     let (ll, dm, dv) = gaussian_log_likelihood(&targets, &mean, &variance, p);
     let sum = |range: std::ops::Range<usize>| ll[range].iter().map(|x| *x as f64).sum::<f64>();
-    let reconstruction = sum(0..b * n) / (b * n) as f64;
-    let single_step = sum(b * n..b * (n + t)) / (b * t) as f64;
-    let multi_step = sum(b * (n + t)..rows) / b as f64;
+    let reconstruction = sum(0..b * t) / (b * t) as f64;
+    let single_step = sum(b * t..2 * b * t) / (b * t) as f64;
+    let multi_step = sum(2 * b * t..rows) / b as f64;
     let kl_total = kl_empty as f64 + kl_context as f64 * config.kl_weight;
     let mean_of = |v: &[f32]| v.iter().map(|x| *x as f64).sum::<f64>() / v.len() as f64;
     let values = LossValues {
@@ -490,11 +489,10 @@ pub fn loss_and_gradients(
     }
 
     let mut grads = zero_gradients(params);
-    // ∂loss/∂(row log-likelihood): the three terms are means over rows (the multi-step one a sum over steps).
+    // ∂loss/∂(row log-likelihood): the reconstruction and single-step terms are means over their B·T rows, the
+    // multi-step one a mean over chunks of a sum over steps.
     let row_weight = |row: usize| -> f32 {
-        if row < b * n {
-            -1.0 / (b * n) as f32
-        } else if row < b * (n + t) {
+        if row < 2 * b * t {
             -1.0 / (b * t) as f32
         } else {
             -1.0 / b as f32
@@ -523,9 +521,9 @@ pub fn loss_and_gradients(
         }
         (Variance::Decoder(_), None) => unreachable!("a variance decoder's forward pass leaves its tape"),
     }
-    let mut d_h_all = d_decoded[..b * n * e].to_vec();
-    let d_h_single = &d_decoded[b * n * e..b * (n + t) * e];
-    let d_open = &d_decoded[b * (n + t) * e..];
+    let mut d_h_all = d_decoded[..b * t * e].to_vec();
+    let d_h_single = &d_decoded[b * t * e..2 * b * t * e];
+    let d_open = &d_decoded[2 * b * t * e..];
 
     // Back through the open loop.
     let mut d_gi_seq = vec![0.0; b * t * g];
@@ -548,7 +546,7 @@ pub fn loss_and_gradients(
         }
     }
     for i in 0..b {
-        add_into(&mut d_h_all[i * n * e..(i * n + 1) * e], &dh[i * e..(i + 1) * e]);
+        add_into(&mut d_h_all[i * t * e..(i * t + 1) * e], &dh[i * e..(i + 1) * e]);
     }
     net.gru.hidden_weight_backward(&seq_h_prev, &seq_d_gh, t * b, &mut grads);
 
@@ -556,14 +554,9 @@ pub fn loss_and_gradients(
     let mut d_gi_single = vec![0.0; b * t * g];
     let mut single_d_gh = vec![0.0; b * t * g];
     let d_h_prev_single =
-        net.gru.step_backward(&single_tape, &h_prev_single, d_h_single, b * t, &mut d_gi_single, &mut single_d_gh);
-    net.gru.hidden_weight_backward(&h_prev_single, &single_d_gh, b * t, &mut grads);
-    for i in 0..b {
-        for k in 0..t {
-            let dst = &mut d_h_all[(i * n + k) * e..(i * n + k + 1) * e];
-            add_into(dst, &d_h_prev_single[(i * t + k) * e..(i * t + k + 1) * e]);
-        }
-    }
+        net.gru.step_backward(&single_tape, &h_all, d_h_single, b * t, &mut d_gi_single, &mut single_d_gh);
+    net.gru.hidden_weight_backward(&h_all, &single_d_gh, b * t, &mut grads);
+    add_into(&mut d_h_all, &d_h_prev_single);
 
     // The input gates: the action (and terrain) part and b_ih are shared by both predictions.
     let d_action_gates: Vec<f32> = d_gi_single.iter().zip(&d_gi_seq).map(|(a, b)| a + b).collect();
@@ -594,7 +587,7 @@ pub fn loss_and_gradients(
     // The state encoder.
     let mut d_state = d_h_all;
     d_state.iter_mut().zip(&h_all).for_each(|(d, y)| *d *= 1.0 - y * y);
-    net.state_encoder.backward(&predicted, &state_tape, &d_state, b * n, &mut grads, false);
+    net.state_encoder.backward(&starts, &state_tape, &d_state, b * t, &mut grads, false);
 
     // The beliefs: reparameterized samples and the KL terms.
     let mut d_post_mean = vec![0.0; b * lat];

@@ -177,6 +177,9 @@ impl ContextNet {
 
     /// Eq. 4.32 over a batch: −mean_batch[mean_t recon + mean_t single-step + Σ_t multi-step]
     /// + KL(q(β|∅) ‖ N(0, I)) + λ_KL · mean_batch Σ_i max(floor, KL_i(q(β|C∪D) ‖ q(β|C))).
+    ///
+    /// The reconstruction term averages over the N − 1 states a transition starts from, as the authors' loss
+    /// does (their reconstruction is a by-product of the single-step pass, which never starts at the last state).
     pub fn loss(&self, batch: &Batch, config: &ContextConfig, device: &Device) -> LossParts {
         let (b, n) = (batch.size, batch.chunk);
         let t = n - 1;
@@ -211,9 +214,11 @@ impl ContextNet {
 
         // The GRU input is [context embedding, action embedding (, terrain embedding)]: the per-step parts of the
         // input gates are shared by the single-step and multi-step predictions, and the multi-step context part
-        // is one row per chunk.
+        // is one row per chunk. Only the N − 1 states a transition starts from are embedded: the last one is
+        // neither reconstructed nor stepped from.
         let predicted = if sp < s { states.clone().slice([0..b, 0..n, 0..sp]) } else { states.clone() };
-        let h_all = self.embed_state(predicted.clone().reshape([b * n, sp]));
+        let starts = predicted.clone().slice([0..b, 0..t, 0..sp]).reshape([b * t, sp]);
+        let h_all = self.embed_state(starts.clone());
         let actions = tensor(batch.actions.clone(), [b * t, a], device);
         let mut action_gates = self.gru.input_gates_part(self.embed_action(actions), e..2 * e) + self.gru.input_bias();
         if sp < s {
@@ -227,15 +232,14 @@ impl ContextNet {
         let post_std = posterior.std.clone().unsqueeze_dim::<3>(1).expand([b, t, latent]);
         let beta_single = post_mean + post_std * tensor(batch.noise_single.clone(), [b, t, latent], device);
         let ctx_single = self.embed_context(beta_single.reshape([b * t, latent]));
-        let h_prev = h_all.clone().reshape([b, n, e]).slice([0..b, 0..t, 0..e]).reshape([b * t, e]);
         let gi_single = action_gates.clone() + self.gru.input_gates_part(ctx_single, 0..e);
-        let h_single = self.gru.step_from_input_gates(gi_single, h_prev);
+        let h_single = self.gru.step_from_input_gates(gi_single, h_all.clone());
 
         // Multi-step: one β for the whole chunk, open loop from s_0; predictions of s_2.. enter the sum.
         let beta = posterior.mean + posterior.std * tensor(batch.noise_sequence.clone(), [b, latent], device);
         let ctx_gates = self.gru.input_gates_part(self.embed_context(beta), 0..e);
         let gi_seq = action_gates.reshape([b, t, 3 * e]) + ctx_gates.unsqueeze_dim::<3>(1).expand([b, t, 3 * e]);
-        let mut h = h_all.clone().reshape([b, n, e]).slice([0..b, 0..1, 0..e]).reshape([b, e]);
+        let mut h = h_all.clone().reshape([b, t, e]).slice([0..b, 0..1, 0..e]).reshape([b, e]);
         let mut open_loop = Vec::with_capacity(t.saturating_sub(1));
         for k in 0..t {
             let gi = gi_seq.clone().slice([0..b, k..k + 1, 0..3 * e]).reshape([b, 3 * e]);
@@ -251,21 +255,18 @@ impl ContextNet {
         if steps > 0 {
             decoded.push(Tensor::stack::<3>(open_loop, 1).reshape([b * steps, e]));
         }
-        let mut targets = vec![
-            predicted.clone().reshape([b * n, sp]),
-            predicted.clone().slice([0..b, 1..n, 0..sp]).reshape([b * t, sp]),
-        ];
+        let mut targets = vec![starts, predicted.clone().slice([0..b, 1..n, 0..sp]).reshape([b * t, sp])];
         if steps > 0 {
             targets.push(predicted.slice([0..b, 2..n, 0..sp]).reshape([b * steps, sp]));
         }
         let likelihood = log_likelihood(self.decode(Tensor::cat(decoded, 0)), Tensor::cat(targets, 0));
         let rows = |start: usize, len: usize| likelihood.clone().slice([start..start + len, 0..1]);
-        let reconstruction = rows(0, b * n).reshape([b, n]).mean_dim(1);
-        let single_step = rows(b * n, b * t).reshape([b, t]).mean_dim(1);
+        let reconstruction = rows(0, b * t).reshape([b, t]).mean_dim(1);
+        let single_step = rows(b * t, b * t).reshape([b, t]).mean_dim(1);
         let multi_step = if steps == 0 {
             zeros([b, 1], device).sum_dim(1)
         } else {
-            rows(b * (n + t), b * steps).reshape([b, steps]).sum_dim(1)
+            rows(2 * b * t, b * steps).reshape([b, steps]).sum_dim(1)
         };
 
         let reconstruction = reconstruction.reshape([b]).mean();
