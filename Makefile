@@ -31,7 +31,7 @@ train_or_resume = $(RUN) train $(2) --no-tui -q --out $(1) --resume-if-stopped
 
 # The README's main job: a small reproduction of every implemented method (reports/quick/).
 repro-quick: build
-	$(RUN) eval quick --seed $(SEED) --no-tui
+	$(RUN) eval quick --seed $(SEED) --no-tui --out reports/quick
 
 # Thesis 3.5.2: ground-truth CEM swing-up, 10 episodes with the thesis' CEM settings.
 repro-swingup: build
