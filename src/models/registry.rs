@@ -14,11 +14,28 @@ use crate::train::job::{carry_out, resume};
 use crate::train::run_dir::Decision;
 use crate::train::{Extension, Method, OpenedCheckpoint, Request, RunRecord, Trained};
 
+/// The loss plot a run leaves beside its checkpoint, with losses.csv.
+#[derive(Clone, Copy, Debug)]
+pub struct LossPlot {
+    pub title: &'static str,
+    pub y_label: &'static str,
+    /// The CSV column and axis label of the validation metric when it is another quantity than the training
+    /// loss (PETS validates its mean prediction's MSE against an NLL objective): drawn in a panel of its own,
+    /// never on the loss axis. `None` when both measure the same objective and share one axis.
+    pub separate_validation: Option<(&'static str, &'static str)>,
+}
+
+impl LossPlot {
+    pub const fn same_objective(title: &'static str, y_label: &'static str) -> Self {
+        LossPlot { title, y_label, separate_validation: None }
+    }
+}
+
 /// What a method adds to the training job's view of it once it is a model: how a finished run reports
 /// itself, and whether planners can roll it out.
 pub trait ModelMethod: Method {
-    /// The loss plot a run leaves beside its checkpoint: its title and y-axis label.
-    const LOSS_PLOT: (&'static str, &'static str);
+    /// The loss plot a run leaves beside its checkpoint.
+    const LOSS_PLOT: LossPlot;
     type Summary: Display + Send + 'static;
 
     fn summary(trained: &Trained<Self>, dir: &Path) -> Result<Self::Summary>;
@@ -47,7 +64,7 @@ pub const PLANNING_METHODS: &str = "pets, context, dlgpd (with --evidence)";
 pub trait RegisteredMethod: Sync {
     fn name(&self) -> &'static str;
     fn extendable(&self) -> bool;
-    fn loss_plot(&self) -> (&'static str, &'static str);
+    fn loss_plot(&self) -> LossPlot;
     /// Continues the stopped run in `dir` (to a larger total with `extension`) and reports it.
     fn resume(
         &self,
@@ -74,7 +91,7 @@ impl<M: ModelMethod> RegisteredMethod for Entry<M> {
         M::EXTENDABLE
     }
 
-    fn loss_plot(&self) -> (&'static str, &'static str) {
+    fn loss_plot(&self) -> LossPlot {
         M::LOSS_PLOT
     }
 
@@ -129,7 +146,11 @@ pub fn train<M: ModelMethod>(
 }
 
 impl ModelMethod for pets::Pets {
-    const LOSS_PLOT: (&'static str, &'static str) = ("PETS training loss (Gaussian NLL summed over members)", "loss");
+    const LOSS_PLOT: LossPlot = LossPlot {
+        title: "PETS training loss (Gaussian NLL summed over members)",
+        y_label: "loss",
+        separate_validation: Some(("validation_mse", "validation MSE of the mean (held out)")),
+    };
     type Summary = pets::PetsSummary;
 
     fn summary(trained: &Trained<Self>, dir: &Path) -> Result<Self::Summary> {
@@ -153,7 +174,7 @@ impl ModelMethod for pets::Pets {
 }
 
 impl ModelMethod for context::Context {
-    const LOSS_PLOT: (&'static str, &'static str) = ("Context-model training loss (eq. 4.32)", "loss");
+    const LOSS_PLOT: LossPlot = LossPlot::same_objective("Context-model training loss (eq. 4.32)", "loss");
     type Summary = context::ContextSummary;
 
     fn summary(trained: &Trained<Self>, dir: &Path) -> Result<Self::Summary> {
@@ -176,7 +197,7 @@ impl ModelMethod for context::Context {
 }
 
 impl ModelMethod for tradyn::Tradyn {
-    const LOSS_PLOT: (&'static str, &'static str) = ("TRADYN training loss (eq. 4.32 with terrain input)", "loss");
+    const LOSS_PLOT: LossPlot = LossPlot::same_objective("TRADYN training loss (eq. 4.32 with terrain input)", "loss");
     type Summary = context::ContextSummary;
 
     fn summary(trained: &Trained<Self>, dir: &Path) -> Result<Self::Summary> {
@@ -185,8 +206,8 @@ impl ModelMethod for tradyn::Tradyn {
 }
 
 impl ModelMethod for dlgpd::job::Dlgpd {
-    const LOSS_PLOT: (&'static str, &'static str) =
-        ("DLGPD training loss (eq. 3.16 with the SNR penalty, per batch)", "loss");
+    const LOSS_PLOT: LossPlot =
+        LossPlot::same_objective("DLGPD training loss (eq. 3.16 with the SNR penalty, per batch)", "loss");
     type Summary = dlgpd::job::DlgpdSummary;
 
     fn summary(trained: &Trained<Self>, dir: &Path) -> Result<Self::Summary> {
@@ -208,8 +229,8 @@ impl ModelMethod for dlgpd::job::Dlgpd {
 }
 
 impl ModelMethod for seads::Seads {
-    const LOSS_PLOT: (&'static str, &'static str) =
-        ("SEADS forward-model NLL per bit on each epoch's new episodes", "nats per bit");
+    const LOSS_PLOT: LossPlot =
+        LossPlot::same_objective("SEADS forward-model NLL per bit on each epoch's new episodes", "nats per bit");
     type Summary = seads::SeadsSummary;
 
     fn summary(trained: &Trained<Self>, dir: &Path) -> Result<Self::Summary> {
@@ -218,8 +239,8 @@ impl ModelMethod for seads::Seads {
 }
 
 impl ModelMethod for ball::learn::job::BallEkf {
-    const LOSS_PLOT: (&'static str, &'static str) =
-        ("Training loss (eq. 6.24, per measurement)", "negative log-likelihood");
+    const LOSS_PLOT: LossPlot =
+        LossPlot::same_objective("Training loss (eq. 6.24, per measurement)", "negative log-likelihood");
     type Summary = ball::learn::job::BallSummary;
 
     fn summary(trained: &Trained<Self>, dir: &Path) -> Result<Self::Summary> {

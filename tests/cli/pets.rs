@@ -39,6 +39,9 @@ fn collect_train_plan_round_trip() {
     for file in ["checkpoint.json", "config.json", "model.safetensors", "state.safetensors", "metrics.jsonl"] {
         assert!(dir.path().join("models/p").join(file).is_file(), "{file} missing");
     }
+    // The held-out metric is an MSE, not the NLL being trained: its own column (and panel of loss.png).
+    let losses = std::fs::read_to_string(dir.path().join("models/p/losses.csv")).unwrap();
+    assert!(losses.starts_with("step,loss,validation_mse\n"), "{losses}");
     let manifest: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dir.path().join("models/p/checkpoint.json")).unwrap()).unwrap();
     assert_eq!(manifest["complete"], true);

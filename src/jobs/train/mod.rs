@@ -131,8 +131,7 @@ pub fn resume(dir: PathBuf, extension: Option<Extension>) -> Result<Job<'static,
     let method = registry::method(&OpenedCheckpoint::open(&dir)?.manifest.method, &dir)?;
     Ok(Job::new(format!("train {} (resumed)", method.name()), move |monitor| {
         let summary = method.resume(&dir, extension.as_ref(), monitor)?;
-        let (plot_title, y_label) = method.loss_plot();
-        write_loss_report(&dir, plot_title, y_label)?;
+        write_loss_report(&dir, method.loss_plot())?;
         Ok(summary)
     }))
 }

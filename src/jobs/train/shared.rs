@@ -96,8 +96,7 @@ pub fn train<M: ModelMethod>(
     };
     Ok(Job::new(title, move |monitor| {
         let summary = registry::train(&out, &request, &decision, monitor)?;
-        let (plot_title, y_label) = M::LOSS_PLOT;
-        write_loss_report(&out, plot_title, y_label)?;
+        write_loss_report(&out, M::LOSS_PLOT)?;
         Ok(Box::new(summary) as TrainSummary)
     }))
 }

@@ -185,6 +185,15 @@ impl std::fmt::Display for PetsSummary {
         }
         if let (Some(step), Some(v)) = (o.best_step, o.best_valid_loss) {
             writeln!(f, "best validation MSE {v:.3e} at step {step} (saved as model.safetensors)")?;
+            // PETS training does not depend on its total, so the first `step` steps of a shorter run are these.
+            if step.saturating_mul(2) <= o.steps {
+                writeln!(
+                    f,
+                    "the steps after {step} only fit the training data closer: --steps {step} trains the same saved \
+                     model in {:.0} % of the time",
+                    100.0 * step as f64 / o.steps as f64
+                )?;
+            }
         }
         write!(f, "checkpoint: {}", self.dir.display())
     }
