@@ -327,9 +327,15 @@ impl std::fmt::Display for QuickSummary {
     }
 }
 
+/// The slices `eval quick` announces, one header each.
+const QUICK_SECTIONS: usize = 10;
+
 pub fn run_quick(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) -> Result<QuickSummary> {
     std::fs::create_dir_all(out_dir).map_err(|e| Error::io(out_dir, e))?;
     write_config(&QuickConfig {}, provenance, out_dir)?;
+    // A header per slice, so the progress lines that follow it have an owner.
+    let section = |k: usize, name: &str| monitor.message(&format!("[{k}/{QUICK_SECTIONS}] {name}"));
+    section(1, "pendulum swing-up with the true model (CEM)");
     let settings = SwingupSettings::thesis(PendulumVariant::Standard);
     let config = SwingupConfig::ground_truth(settings.clone(), SWINGUP_EPISODES);
     let swing = swingup::evaluate(&config, None, provenance, &out_dir.join("pendulum-swingup"), monitor)?;
@@ -340,6 +346,7 @@ pub fn run_quick(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor)
         successes: swing.successes(),
         episodes: swing.episodes.len(),
     };
+    section(2, "board depth tables (LightsOut 5x5, TileSwap)");
     let rows = boards::depth_report(provenance, &out_dir.join("boards"), monitor)?.rows;
     let boards = BoardsSlice {
         depths: rows.len(),
@@ -356,6 +363,7 @@ pub fn run_quick(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor)
             split: Split::Test,
         },
     };
+    section(3, "LightsOut played by the scripted Reacher");
     let played = boards::embodied_report(
         &LightsOut::new(5)?,
         &embodied,
@@ -365,14 +373,20 @@ pub fn run_quick(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor)
     )?;
     let (total, solved) = played.totals();
     let embodied = EmbodiedSlice { solved, boards: total };
+    section(4, "PETS: collect, train, plan");
     let pets = pets_slice(provenance, out_dir, monitor)?;
+    section(5, "ball EKF: learn and predict");
     let ball = ball_slice(provenance, out_dir, monitor)?;
     let mut context = Vec::new();
-    for squash in [Squash::Inner, Squash::Outer] {
+    for (k, squash) in [(6, Squash::Inner), (7, Squash::Outer)] {
+        section(k, &format!("Explore the Context on toy:{}", squash.name()));
         context.push(context_slice(squash, provenance, out_dir, monitor)?);
     }
+    section(8, "SEADS on tileswap:cursor");
     let seads = seads_slice(provenance, out_dir, monitor)?;
+    section(9, "DLGPD: train and swing up");
     let dlgpd = dlgpd_slice(provenance, out_dir, monitor)?;
+    section(10, "TRADYN: ±terrain navigation");
     let tradyn = tradyn_slice(provenance, out_dir, monitor)?;
     let summary = QuickSummary {
         provenance: provenance.clone(),
