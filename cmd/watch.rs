@@ -8,52 +8,74 @@ use std::time::Duration;
 
 use anyhow::Context;
 use clap::Args;
-use mbrl::run::dir::METRICS_FILE;
-use mbrl::run::follow::{latest_progress_only, MetricsFollower};
-use mbrl::run::lock::{RunLock, LOCK_FILE};
+use mbrl::run::follow::{follow_runs, RunUpdate, WatchedRun};
+use mbrl::run::watched::{run_dir, run_labels, Liveness, RunSummary};
 use mbrl::run::Event;
-use mbrl::tui::{run_live, LiveOptions};
+use mbrl::tui::{run_live, run_overlay, LiveOptions};
 
 use crate::common::GlobalArgs;
 
-/// Follow a running or finished run (training or eval) in the live view.
+/// Follow running or finished runs (training or eval) in the live view; several runs are overlaid.
 #[derive(Args, Debug)]
 #[command(after_help = "\
+With one run the view is the run's own live view. With several, each metric gets one panel that draws it
+for every run that records it, one colour per run, over a shared step axis; a Runs list names each run
+(its directory name, lengthened by its parents where two would clash) with its state (running, stopped,
+unfinished for a report without a lock, finished, failed) and progress. ←/→ scroll when the panels do not
+all fit. Without a terminal (or with --no-tui) one run prints a summary of its metrics, several print one
+status line each.
+
 Examples:
   mbrl watch reports/quick/pendulum-swingup
-  mbrl watch models/my-run --no-tui      # print a summary of the metrics instead")]
+  mbrl watch models/my-run --no-tui      # print a summary of the metrics instead
+  mbrl watch models/pets-seed1 models/pets-seed2      # overlay two runs' curves")]
 pub struct WatchArgs {
-    /// Run directory (holds metrics.jsonl) or the metrics file itself.
-    run_dir: PathBuf,
+    /// Run directories (each holds metrics.jsonl) or metrics files themselves.
+    #[arg(required = true, value_name = "RUN_DIR")]
+    run_dirs: Vec<PathBuf>,
 }
 
 pub fn run(global: &GlobalArgs, args: WatchArgs) -> anyhow::Result<()> {
-    let path = if args.run_dir.is_dir() { args.run_dir.join(METRICS_FILE) } else { args.run_dir.clone() };
-    let mut follower = MetricsFollower::open(&path)?;
+    let runs = args.run_dirs.iter().map(|dir| WatchedRun::open(dir)).collect::<mbrl::Result<Vec<_>>>()?;
+    if let [single] = &args.run_dirs[..] {
+        return watch_one(global, runs, single);
+    }
+    let labels = run_labels(&args.run_dirs.iter().map(|arg| run_dir(arg)).collect::<Vec<_>>());
     if !global.use_tui() {
-        return print_summary(&follower.poll()?, &unfinished_status(&path));
+        for (label, mut run) in labels.iter().zip(runs) {
+            let mut summary = RunSummary::default();
+            run.read_all()?.iter().for_each(|event| summary.ingest(event));
+            say!("{}", summary.status_line(label, run.liveness()));
+        }
+        return Ok(());
     }
     let (sender, receiver) = std::sync::mpsc::channel();
     let cancel = Arc::new(AtomicBool::new(false));
     let stop = cancel.clone();
-    let title = format!("watch {}", args.run_dir.display());
     std::thread::scope(|scope| {
-        let reader = scope.spawn(move || -> mbrl::Result<()> {
-            let mut backlog = true;
-            while !stop.load(Ordering::Relaxed) {
-                let mut events = follower.poll()?;
-                if std::mem::take(&mut backlog) {
-                    events = latest_progress_only(events);
-                }
-                for event in events {
-                    let finished = matches!(event, Event::Finished { .. });
-                    if sender.send(event).is_err() || finished {
-                        return Ok(());
-                    }
-                }
-                std::thread::sleep(Duration::from_millis(200));
-            }
-            Ok(())
+        let reader = scope.spawn(move || follow_runs(runs, &stop, |update| sender.send(update).is_ok()));
+        run_overlay(receiver, cancel.clone(), labels).context("terminal view failed")?;
+        cancel.store(true, Ordering::Relaxed);
+        reader.join().map_err(|_| anyhow::anyhow!("the metrics reader panicked"))??;
+        Ok(())
+    })
+}
+
+fn watch_one(global: &GlobalArgs, mut runs: Vec<WatchedRun>, arg: &std::path::Path) -> anyhow::Result<()> {
+    if !global.use_tui() {
+        let run = &mut runs[0];
+        return print_summary(&run.read_all()?, &unfinished_status(run.liveness(), &run_dir(arg)));
+    }
+    let (sender, receiver) = std::sync::mpsc::channel();
+    let cancel = Arc::new(AtomicBool::new(false));
+    let stop = cancel.clone();
+    let title = format!("watch {}", arg.display());
+    std::thread::scope(|scope| {
+        let reader = scope.spawn(move || {
+            follow_runs(runs, &stop, |update| match update {
+                RunUpdate::Event { event, .. } => sender.send(event).is_ok(),
+                RunUpdate::Liveness { .. } => true,
+            })
         });
         // Watching is for reading: the view stays until q, even after the run ends.
         let options = LiveOptions { hold: true, grace: Duration::ZERO };
@@ -66,14 +88,11 @@ pub fn run(global: &GlobalArgs, args: WatchArgs) -> anyhow::Result<()> {
 
 /// What a stream without its end means: a training run's lock tells running from stopped; other runs (eval
 /// reports) keep no lock, so for them it cannot be told.
-fn unfinished_status(metrics: &std::path::Path) -> String {
-    let dir = metrics.parent().unwrap_or(std::path::Path::new("."));
-    if RunLock::is_held(dir) {
-        "running".to_string()
-    } else if dir.join(LOCK_FILE).is_file() {
-        format!("stopped; continue with `mbrl train --resume {}`", dir.display())
-    } else {
-        "running (or stopped without finishing)".to_string()
+fn unfinished_status(liveness: Liveness, dir: &std::path::Path) -> String {
+    match liveness {
+        Liveness::Running => "running".to_string(),
+        Liveness::Stopped => format!("stopped; continue with `mbrl train --resume {}`", dir.display()),
+        Liveness::Unknown => "running (or stopped without finishing)".to_string(),
     }
 }
 

@@ -380,7 +380,7 @@ pub fn write(exported: &Exported, format: ExportFormat, out: &Path) -> Result<()
 
 /// Shortest text that reads back to the same f64; missing values (NaN) are empty cells, which
 /// `numpy.genfromtxt` and pandas read as NaN.
-fn format_f64(x: f64) -> String {
+pub(crate) fn format_f64(x: f64) -> String {
     if x.is_nan() {
         String::new()
     } else if x == 0.0 || !x.is_finite() || (1e-4..1e16).contains(&x.abs()) {

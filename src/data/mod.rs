@@ -14,6 +14,7 @@ pub mod dataset;
 pub mod export;
 pub mod frames;
 pub mod mcap_io;
+pub mod metrics_export;
 pub mod rollout;
 pub mod scene;
 pub mod schema;

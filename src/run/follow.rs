@@ -3,8 +3,15 @@
 use std::io::{Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
+
 use super::event::Event;
+use super::watched::{metrics_path, run_dir, Liveness};
 use crate::error::{Error, Result};
+
+/// How often a followed run's file and lock are read again.
+const POLL_INTERVAL: Duration = Duration::from_millis(200);
 
 pub struct MetricsFollower {
     path: PathBuf,
@@ -47,6 +54,72 @@ impl MetricsFollower {
         }
         Ok(events)
     }
+}
+
+/// What a followed run reported: an event from its file, or a change of its lock's state.
+#[derive(Clone, Debug, PartialEq)]
+pub enum RunUpdate {
+    Event { run: usize, event: Event },
+    Liveness { run: usize, liveness: Liveness },
+}
+
+/// One run `watch` follows: its directory (for the lock) and its metrics file.
+pub struct WatchedRun {
+    dir: PathBuf,
+    follower: MetricsFollower,
+    finished: bool,
+    liveness: Option<Liveness>,
+}
+
+impl WatchedRun {
+    /// A run directory, or a metrics file itself.
+    pub fn open(arg: &Path) -> Result<Self> {
+        let follower = MetricsFollower::open(&metrics_path(arg))?;
+        Ok(WatchedRun { dir: run_dir(arg), follower, finished: false, liveness: None })
+    }
+
+    /// Everything written so far, for a summary of a run that is not followed further.
+    pub fn read_all(&mut self) -> Result<Vec<Event>> {
+        self.follower.poll()
+    }
+
+    pub fn liveness(&self) -> Liveness {
+        Liveness::of(&self.dir)
+    }
+}
+
+/// Follows `runs` until every one has finished, `stop` is set, or `send` returns false (its receiver is gone),
+/// sending each new event and each change of a run's lock. The backlog each run has at the start comes with
+/// only its latest progress (see [`latest_progress_only`]).
+pub fn follow_runs(mut runs: Vec<WatchedRun>, stop: &AtomicBool, mut send: impl FnMut(RunUpdate) -> bool) -> Result<()> {
+    let mut backlog = true;
+    while !stop.load(Ordering::Relaxed) {
+        for (run, watched) in runs.iter_mut().enumerate().filter(|(_, w)| !w.finished) {
+            let mut events = watched.follower.poll()?;
+            if backlog {
+                events = latest_progress_only(events);
+            }
+            for event in events {
+                watched.finished |= matches!(event, Event::Finished { .. });
+                if !send(RunUpdate::Event { run, event }) {
+                    return Ok(());
+                }
+            }
+            let liveness = watched.liveness();
+            if !watched.finished && watched.liveness != Some(liveness) {
+                watched.liveness = Some(liveness);
+                if !send(RunUpdate::Liveness { run, liveness }) {
+                    return Ok(());
+                }
+            }
+        }
+        backlog = false;
+        if runs.iter().all(|w| w.finished) {
+            return Ok(());
+        }
+        std::thread::sleep(POLL_INTERVAL);
+    }
+    Ok(())
 }
 
 /// A run's backlog with each phase's progress reduced to its latest update, in place. Replayed at once,
@@ -99,6 +172,58 @@ mod tests {
         std::fs::write(&path, "{\"kind\":\"finished\",\"ok\":true}\nnot json\n").unwrap();
         let err = MetricsFollower::open(&path).unwrap().poll().unwrap_err().to_string();
         assert!(err.contains("metrics.jsonl") && err.contains("line 2"), "{err}");
+    }
+
+    #[test]
+    fn following_several_runs_tags_events_and_ends_when_all_finished() {
+        let dir = tempfile::tempdir().unwrap();
+        let write = |name: &str, events: &[Event]| {
+            let run = dir.path().join(name);
+            std::fs::create_dir(&run).unwrap();
+            let lines: Vec<String> = events.iter().map(|e| serde_json::to_string(e).unwrap() + "\n").collect();
+            std::fs::write(run.join("metrics.jsonl"), lines.concat()).unwrap();
+            WatchedRun::open(&run).unwrap()
+        };
+        let a = write("a", &[Event::progress("train", 1, 9), Event::progress("train", 2, 9), Event::Finished { ok: true }]);
+        let b = write("b", &[Event::scalar("loss", 4, 1.0), Event::Finished { ok: false }]);
+        let mut updates = Vec::new();
+        follow_runs(vec![a, b], &AtomicBool::new(false), |u| {
+            updates.push(u);
+            true
+        })
+        .unwrap();
+        let event = |run, event| RunUpdate::Event { run, event };
+        assert_eq!(
+            updates,
+            vec![
+                event(0, Event::progress("train", 2, 9)),
+                event(0, Event::Finished { ok: true }),
+                event(1, Event::scalar("loss", 4, 1.0)),
+                event(1, Event::Finished { ok: false }),
+            ]
+        );
+    }
+
+    #[test]
+    fn an_unfinished_run_reports_its_lock_once_and_stops_when_told() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("metrics.jsonl"), "").unwrap();
+        let run = WatchedRun::open(dir.path()).unwrap();
+        let stop = AtomicBool::new(false);
+        let mut updates = Vec::new();
+        std::thread::scope(|scope| {
+            // Several polls pass before the stop: an unchanged lock must not be sent again.
+            scope.spawn(|| {
+                std::thread::sleep(POLL_INTERVAL * 4);
+                stop.store(true, Ordering::Relaxed);
+            });
+            follow_runs(vec![run], &stop, |u| {
+                updates.push(u);
+                true
+            })
+            .unwrap();
+        });
+        assert_eq!(updates, vec![RunUpdate::Liveness { run: 0, liveness: Liveness::Unknown }]);
     }
 
     #[test]

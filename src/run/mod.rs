@@ -5,6 +5,7 @@ pub mod event;
 pub mod follow;
 pub mod lock;
 pub mod monitor;
+pub mod watched;
 
 pub use event::{Background, Event, PanelSpec, PathView};
 pub use monitor::{ChannelMonitor, ConsoleMonitor, Fanout, JsonlMonitor, Monitor, NullMonitor, Tee};

@@ -5,6 +5,8 @@
 pub mod app;
 mod keys;
 mod method;
+mod overlay;
+mod overlay_view;
 mod panel;
 mod path;
 mod plot;
@@ -14,4 +16,4 @@ pub mod terminal;
 mod text_panel;
 
 pub use app::App;
-pub use terminal::{run_live, LiveOptions, LiveOutcome, DEFAULT_GRACE};
+pub use terminal::{run_live, run_overlay, LiveOptions, LiveOutcome, DEFAULT_GRACE};

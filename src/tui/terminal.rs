@@ -8,14 +8,47 @@ use std::sync::mpsc::{Receiver, RecvTimeoutError, TryRecvError};
 use std::sync::{Arc, Once};
 use std::time::{Duration, Instant};
 
-use crossterm::event::{self as input, Event as InputEvent};
+use crossterm::event::{self as input, Event as InputEvent, KeyEvent};
 use crossterm::{cursor, execute, terminal as term};
 use ratatui::backend::CrosstermBackend;
-use ratatui::Terminal;
+use ratatui::{Frame, Terminal};
 
 use super::app::App;
+use super::overlay::Overlay;
 use super::render::render;
+use crate::run::follow::RunUpdate;
 use crate::run::Event;
+
+/// What the terminal loop drives: state folded from a stream of updates, drawn every frame.
+pub(crate) trait LiveState {
+    type Update;
+    fn ingest(&mut self, update: Self::Update);
+    /// Returns true when the user asked to quit.
+    fn handle_key(&mut self, key: KeyEvent) -> bool;
+    fn is_finished(&self) -> bool;
+    /// The sender hung up.
+    fn mark_ended(&mut self);
+    fn draw(&self, frame: &mut Frame);
+}
+
+impl LiveState for App {
+    type Update = Event;
+    fn ingest(&mut self, event: Event) {
+        App::ingest(self, &event);
+    }
+    fn handle_key(&mut self, key: KeyEvent) -> bool {
+        App::handle_key(self, key)
+    }
+    fn is_finished(&self) -> bool {
+        App::is_finished(self)
+    }
+    fn mark_ended(&mut self) {
+        App::mark_ended(self);
+    }
+    fn draw(&self, frame: &mut Frame) {
+        render(self, frame);
+    }
+}
 
 /// How the live view ended.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -64,12 +97,27 @@ pub fn run_live(
     title: &str,
     options: LiveOptions,
 ) -> io::Result<LiveOutcome> {
-    let mut app = App::new(title);
-    if !options.hold && ends_within(&events, &mut app, options.grace) {
+    show(App::new(title), events, cancel, options)
+}
+
+/// `mbrl watch` over several runs: their same-named curves overlaid, one colour per run named by `labels`,
+/// until the user quits. Quitting never stops the runs themselves; `cancel` tells the reader to stop reading.
+pub fn run_overlay(updates: Receiver<RunUpdate>, cancel: Arc<AtomicBool>, labels: Vec<String>) -> io::Result<()> {
+    let options = LiveOptions { hold: true, grace: Duration::ZERO };
+    show(Overlay::new(labels), updates, cancel, options).map(drop)
+}
+
+fn show<S: LiveState>(
+    mut state: S,
+    events: Receiver<S::Update>,
+    cancel: Arc<AtomicBool>,
+    options: LiveOptions,
+) -> io::Result<LiveOutcome> {
+    if !options.hold && ends_within(&events, &mut state, options.grace) {
         return Ok(LiveOutcome::Finished);
     }
     let mut screen = Screen::take()?;
-    let outcome = event_loop(&mut screen.terminal, &mut app, &events, options.hold)?;
+    let outcome = event_loop(&mut screen.terminal, &mut state, &events, options.hold)?;
     if outcome == LiveOutcome::QuitByUser {
         cancel.store(true, Ordering::Relaxed);
     }
@@ -138,12 +186,12 @@ fn install_panic_hook() {
 }
 
 /// Ingests events for up to `grace`; true when the job ended within it.
-fn ends_within(events: &Receiver<Event>, app: &mut App, grace: Duration) -> bool {
+fn ends_within<S: LiveState>(events: &Receiver<S::Update>, app: &mut S, grace: Duration) -> bool {
     let deadline = Instant::now() + grace;
     loop {
         match events.recv_timeout(deadline.saturating_duration_since(Instant::now())) {
             Ok(event) => {
-                app.ingest(&event);
+                app.ingest(event);
                 if app.is_finished() {
                     return true;
                 }
@@ -157,10 +205,10 @@ fn ends_within(events: &Receiver<Event>, app: &mut App, grace: Duration) -> bool
     }
 }
 
-fn event_loop(
+fn event_loop<S: LiveState>(
     terminal: &mut LiveTerminal,
-    app: &mut App,
-    events: &Receiver<Event>,
+    app: &mut S,
+    events: &Receiver<S::Update>,
     hold: bool,
 ) -> io::Result<LiveOutcome> {
     let mut connected = true;
@@ -174,7 +222,7 @@ fn event_loop(
         if app.is_finished() && !hold {
             return Ok(LiveOutcome::Finished);
         }
-        terminal.draw(|frame| render(app, frame))?;
+        terminal.draw(|frame| app.draw(frame))?;
         if wait_for_quit(app, FRAME_INTERVAL)? {
             return Ok(outcome_on_quit(app));
         }
@@ -182,11 +230,11 @@ fn event_loop(
 }
 
 /// Ingests what has arrived; returns false once the sender has hung up.
-fn drain(events: &Receiver<Event>, app: &mut App, budget: Duration) -> bool {
+fn drain<S: LiveState>(events: &Receiver<S::Update>, app: &mut S, budget: Duration) -> bool {
     let deadline = Instant::now() + budget;
     while Instant::now() < deadline {
         match events.try_recv() {
-            Ok(event) => app.ingest(&event),
+            Ok(event) => app.ingest(event),
             Err(TryRecvError::Empty) => return true,
             Err(TryRecvError::Disconnected) => {
                 app.mark_ended();
@@ -199,7 +247,7 @@ fn drain(events: &Receiver<Event>, app: &mut App, budget: Duration) -> bool {
 
 /// Handles input for up to `timeout`; returns true when the user asked to quit. Returns early after a
 /// key so the screen reflects it at once.
-fn wait_for_quit(app: &mut App, timeout: Duration) -> io::Result<bool> {
+fn wait_for_quit<S: LiveState>(app: &mut S, timeout: Duration) -> io::Result<bool> {
     let mut timeout = timeout;
     while input::poll(timeout)? {
         if let InputEvent::Key(key) = input::read()? {
@@ -212,7 +260,7 @@ fn wait_for_quit(app: &mut App, timeout: Duration) -> io::Result<bool> {
     Ok(false)
 }
 
-fn outcome_on_quit(app: &App) -> LiveOutcome {
+fn outcome_on_quit<S: LiveState>(app: &S) -> LiveOutcome {
     if app.is_finished() {
         LiveOutcome::Finished
     } else {

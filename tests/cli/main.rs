@@ -26,3 +26,4 @@ mod surface;
 mod tradyn;
 mod train_methods;
 mod unicycle;
+mod watch_export;
