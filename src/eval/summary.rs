@@ -70,7 +70,7 @@ impl Summary {
             Summary::Seads(s) => super::seads::render(s, dir),
             Summary::SeadsCompare(s) => super::seads::render_comparison(s, dir),
             Summary::Dlgpd(s) => super::dlgpd::render(s, dir),
-            Summary::Quick(s) => super::quick::render(s, dir),
+            Summary::Quick(s) => super::quick_report::render(s, dir),
         }
     }
 
