@@ -99,17 +99,20 @@ pub fn parse_env(name: &str) -> Result<EnvName> {
             return Ok(EnvName::Embodied(GameSpec::parse(game)?, embodiment));
         }
     }
-    let unknown = || Error::config(format!("unknown env '{name}'{}; supported: {KNOWN_ENVS}", did_you_mean(name, ENV_NAMES)));
+    let unknown =
+        || Error::config(format!("unknown env '{name}'{}; supported: {KNOWN_ENVS}", did_you_mean(name, ENV_NAMES)));
     let (family, variant) = name.split_once(':').unwrap_or((name, ""));
     match family {
         "pendulum" => Ok(EnvName::Pendulum(PendulumVariant::parse(variant)?)),
         "toy" => Ok(EnvName::Toy(Squash::parse(variant)?)),
         "mountaincar" if variant.is_empty() => Ok(EnvName::MountainCar),
         // A mistyped manipulator (`lightsout:cursr`) reads as a board size; name the env it was meant to be.
-        "lightsout" | "tileswap" => GameSpec::parse(name).map(EnvName::Board).map_err(|e| match nearest(name, ENV_NAMES) {
-            Some(_) => unknown(),
-            None => e,
-        }),
+        "lightsout" | "tileswap" => {
+            GameSpec::parse(name).map(EnvName::Board).map_err(|e| match nearest(name, ENV_NAMES) {
+                Some(_) => unknown(),
+                None => e,
+            })
+        }
         "ball" if variant.is_empty() => Ok(EnvName::Ball),
         "unicycle" if variant.is_empty() => Ok(EnvName::Unicycle(None)),
         "terrain" if variant.is_empty() => Ok(EnvName::Terrain),
@@ -258,9 +261,9 @@ mod tests {
             crate::envs::toy::SQUASH_NAMES.map(|v| format!("toy:{v}")).to_vec(),
             crate::envs::boards::spec::GAME_NAMES.map(String::from).to_vec(),
         ];
-        let embodied = crate::envs::boards::spec::GAME_NAMES.iter().flat_map(|g| {
-            crate::envs::embodiments::EMBODIMENT_NAMES.map(|e| format!("{g}:{e}"))
-        });
+        let embodied = crate::envs::boards::spec::GAME_NAMES
+            .iter()
+            .flat_map(|g| crate::envs::embodiments::EMBODIMENT_NAMES.map(|e| format!("{g}:{e}")));
         for name in families.into_iter().flatten().chain(embodied) {
             assert!(ENV_NAMES.contains(&name.as_str()), "{name} is missing from ENV_NAMES");
         }

@@ -36,7 +36,7 @@ fn presets_show_sizes_and_a_cost_from_the_preset() {
     let out = mbrl(dir.path()).args(["list", "presets"]).output().unwrap();
     let text = stdout_of(&out);
     let pets_small = text.lines().find(|l| l.starts_with("pets") && l.contains("small")).unwrap();
-    for cell in ["3×64", "2000", "256", "2.56M transitions", "measured"] {
+    for cell in ["3×64", "2000", "256", "2.56M transitions", "MEASURED (2 cores)"] {
         assert!(pets_small.contains(cell) || text.contains(cell), "{cell} missing: {pets_small}");
     }
     let bad = mbrl(dir.path()).args(["list", "presest"]).output().unwrap();
@@ -51,7 +51,10 @@ fn mistyped_names_get_the_nearest_one_and_the_full_list() {
     assert_one_line_error(&out, &["unknown env 'pendlum' (did you mean 'pendulum'?)", "supported: pendulum"]);
     let out = mbrl(dir.path()).args(["collect", "--env", "tileswap:cursr", "--rollouts", "1"]).output().unwrap();
     assert_one_line_error(&out, &["did you mean 'tileswap:cursor'?"]);
-    let out = mbrl(dir.path()).args(["solve-board", "--game", "lightsot", "--random-depth", "2", "--model", "true"]).output().unwrap();
+    let out = mbrl(dir.path())
+        .args(["solve-board", "--game", "lightsot", "--random-depth", "2", "--model", "true"])
+        .output()
+        .unwrap();
     assert_one_line_error(&out, &["unknown board game 'lightsot' (did you mean 'lightsout'?)", "tileswap"]);
     let out = mbrl(dir.path()).args(["train", "seads", "--env", "lightsout:cursr"]).output().unwrap();
     assert_one_line_error(&out, &["did you mean 'lightsout:cursor'?"]);

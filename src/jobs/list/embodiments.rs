@@ -27,7 +27,9 @@ pub fn table() -> Table {
         ]);
     }
     table.note("");
-    table.note("Play a board game with one: --env lightsout:cursor (collect, train seads) or --embodiment (solve-board).");
+    table.note(
+        "Play a board game with one: --env lightsout:cursor (collect, train seads) or --embodiment (solve-board).",
+    );
     table
 }
 

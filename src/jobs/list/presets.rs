@@ -24,10 +24,11 @@ fn measured(method: &str, preset: &str, family: &str) -> &'static str {
 pub fn table() -> Table {
     let header = ["METHOD", "PRESET", "FOR", "NETWORK", "STEPS", "BATCH", "WORK", "MEASURED (2 cores)"];
     let mut table = Table::new(&header);
-    let mut add = |method: &str, preset: &str, family: &str, network: String, steps: String, batch: String, work: String| {
-        let cells = [method, preset, family, &network, &steps, &batch, &work, measured(method, preset, family)];
-        table.row(cells.map(String::from).to_vec());
-    };
+    let mut add =
+        |method: &str, preset: &str, family: &str, network: String, steps: String, batch: String, work: String| {
+            let cells = [method, preset, family, &network, &steps, &batch, &work, measured(method, preset, family)];
+            table.row(cells.map(String::from).to_vec());
+        };
     for (preset, name) in [(PetsPreset::Small, "small"), (PetsPreset::Medium, "medium")] {
         let c = PetsConfig::preset(match preset {
             PetsPreset::Small => PetsEnginePreset::Small,
@@ -49,7 +50,15 @@ pub fn table() -> Table {
             let transitions = c.steps * (c.batch_size * (c.chunk_states - 1)) as u64;
             let batch = format!("{} × {} states", c.batch_size, c.chunk_states);
             let family = if label == "toy" { "toy" } else { label };
-            add("context", name, family, network, c.steps.to_string(), batch, format!("{} transitions", si(transitions)));
+            add(
+                "context",
+                name,
+                family,
+                network,
+                c.steps.to_string(),
+                batch,
+                format!("{} transitions", si(transitions)),
+            );
         }
     }
     for (preset, name) in scale_presets() {
@@ -86,7 +95,9 @@ pub fn table() -> Table {
     let batch = format!("{} × {} frames", ball.batch_size, ball.chunk_len);
     add("ball-ekf", "(none)", "ball", "gray-box EKF".into(), ball.steps.to_string(), batch, work);
     table.note("");
-    table.note("WORK = steps × batch (× ensemble members for pets): the samples a run processes, from the preset alone.");
+    table.note(
+        "WORK = steps × batch (× ensemble members for pets): the samples a run processes, from the preset alone.",
+    );
     table.note("tradyn trains the context model with the pendulum/mountaincar/unicycle column of its presets.");
     table.note("Measured: release build, 2-core machine with other builds running; the dataset is in brackets.");
     table
@@ -104,7 +115,13 @@ fn si(n: u64) -> String {
         1_000_000..1_000_000_000 => (n as f64 / 1e6, "M"),
         _ => (n as f64 / 1e9, "G"),
     };
-    let digits = if value >= 100.0 { 0 } else if value >= 10.0 { 1 } else { 2 };
+    let digits = if value >= 100.0 {
+        0
+    } else if value >= 10.0 {
+        1
+    } else {
+        2
+    };
     format!("{value:.digits$}{suffix}")
 }
 

@@ -73,7 +73,8 @@ mod tests {
         t.row(vec!["toy".into(), "—".into(), "b c".into()]);
         let text = t.to_string();
         let lines: Vec<&str> = text.lines().collect();
-        let column = |line: &str, word: &str| line.chars().collect::<String>().find(word).map(|b| line[..b].chars().count());
+        let column =
+            |line: &str, word: &str| line.chars().collect::<String>().find(word).map(|b| line[..b].chars().count());
         assert_eq!(column(lines[0], "DT"), column(lines[1], "0.05"));
         assert_eq!(column(lines[0], "DT"), column(lines[2], "—"));
         assert_eq!(column(lines[0], "WHAT"), column(lines[2], "b c"));
