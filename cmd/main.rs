@@ -35,7 +35,8 @@ Examples:
   mbrl collect --env ball --trajectories 20 --out datasets/ball.mcap
   mbrl predict --model thesis --input datasets/ball.mcap --horizon 1s
   mbrl watch reports/quick/pendulum-swingup
-  mbrl export --input datasets/heavy.mcap --out heavy.npz";
+  mbrl export --input datasets/heavy.mcap --out heavy.npz
+  mbrl list envs                       # also: methods, presets, embodiments";
 
 #[derive(Parser)]
 #[command(name = "mbrl", version, about = ABOUT, after_help = AFTER_HELP, propagate_version = true)]
@@ -58,6 +59,7 @@ enum Command {
     Eval(mbrl::jobs::eval::EvalOptions),
     Watch(watch::WatchArgs),
     Export(mbrl::jobs::export::ExportOptions),
+    List(mbrl::jobs::list::ListOptions),
     Completions(completions::CompletionsArgs),
 }
 
@@ -113,6 +115,7 @@ fn main() {
         Command::Export(args) => {
             mbrl::jobs::export::run(args, &cli.global.invocation()).map(|summary| say!("{summary}")).map_err(Into::into)
         }
+        Command::List(args) => mbrl::jobs::list::run(args).map(|table| say!("{table}")).map_err(Into::into),
         Command::Completions(args) => completions::run(args),
     });
     if let Err(err) = outcome {

@@ -37,6 +37,9 @@ _mbrl() {
             mbrl,help)
                 cmd="mbrl__subcmd__help"
                 ;;
+            mbrl,list)
+                cmd="mbrl__subcmd__list"
+                ;;
             mbrl,plan)
                 cmd="mbrl__subcmd__plan"
                 ;;
@@ -144,6 +147,9 @@ _mbrl() {
                 ;;
             mbrl__subcmd__help,help)
                 cmd="mbrl__subcmd__help__subcmd__help"
+                ;;
+            mbrl__subcmd__help,list)
+                cmd="mbrl__subcmd__help__subcmd__list"
                 ;;
             mbrl__subcmd__help,plan)
                 cmd="mbrl__subcmd__help__subcmd__plan"
@@ -260,7 +266,7 @@ _mbrl() {
 
     case "${cmd}" in
         mbrl)
-            opts="-q -h -V --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version collect plan train calibrate filter predict solve-board eval watch export completions help"
+            opts="-q -h -V --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version collect plan train calibrate filter predict solve-board eval watch export list completions help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 1 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -297,7 +303,7 @@ _mbrl() {
                     return 0
                     ;;
                 --env)
-                    COMPREPLY=($(compgen -f "${cur}"))
+                    COMPREPLY=($(compgen -W "pendulum pendulum:light pendulum:heavy pendulum:inverted pendulum:quadrant toy:inner toy:outer mountaincar unicycle terrain lightsout tileswap lightsout:cursor lightsout:reacher tileswap:cursor tileswap:reacher ball" -- "${cur}"))
                     return 0
                     ;;
                 --map)
@@ -371,7 +377,7 @@ _mbrl() {
             fi
             case "${prev}" in
                 --env)
-                    COMPREPLY=($(compgen -f "${cur}"))
+                    COMPREPLY=($(compgen -W "pendulum pendulum:light pendulum:heavy pendulum:inverted pendulum:quadrant toy:inner toy:outer mountaincar unicycle terrain lightsout tileswap lightsout:cursor lightsout:reacher tileswap:cursor tileswap:reacher ball" -- "${cur}"))
                     return 0
                     ;;
                 --rollouts)
@@ -419,7 +425,7 @@ _mbrl() {
                     return 0
                     ;;
                 --orientation)
-                    COMPREPLY=($(compgen -f "${cur}"))
+                    COMPREPLY=($(compgen -W "default unseen-1 unseen-2 unseen-3 unseen-4 unseen-5" -- "${cur}"))
                     return 0
                     ;;
                 --augment-rotations)
@@ -613,7 +619,7 @@ _mbrl() {
                     return 0
                     ;;
                 --env)
-                    COMPREPLY=($(compgen -f "${cur}"))
+                    COMPREPLY=($(compgen -W "pendulum pendulum:light pendulum:heavy pendulum:inverted pendulum:quadrant toy:inner toy:outer mountaincar unicycle terrain lightsout tileswap lightsout:cursor lightsout:reacher tileswap:cursor tileswap:reacher ball" -- "${cur}"))
                     return 0
                     ;;
                 --contexts)
@@ -741,7 +747,7 @@ _mbrl() {
                     return 0
                     ;;
                 --env)
-                    COMPREPLY=($(compgen -f "${cur}"))
+                    COMPREPLY=($(compgen -W "pendulum pendulum:light pendulum:heavy pendulum:inverted pendulum:quadrant" -- "${cur}"))
                     return 0
                     ;;
                 --evidence-rollouts)
@@ -803,7 +809,7 @@ _mbrl() {
             fi
             case "${prev}" in
                 --game)
-                    COMPREPLY=($(compgen -f "${cur}"))
+                    COMPREPLY=($(compgen -W "lightsout tileswap" -- "${cur}"))
                     return 0
                     ;;
                 --embodiment)
@@ -1059,7 +1065,7 @@ _mbrl() {
                     return 0
                     ;;
                 --env)
-                    COMPREPLY=($(compgen -f "${cur}"))
+                    COMPREPLY=($(compgen -W "pendulum pendulum:light pendulum:heavy pendulum:inverted pendulum:quadrant" -- "${cur}"))
                     return 0
                     ;;
                 --steps)
@@ -1333,7 +1339,7 @@ _mbrl() {
                     return 0
                     ;;
                 --format)
-                    COMPREPLY=($(compgen -f "${cur}"))
+                    COMPREPLY=($(compgen -W "csv npz" -- "${cur}"))
                     return 0
                     ;;
                 --seed)
@@ -1398,7 +1404,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__help)
-            opts="collect plan train calibrate filter predict solve-board eval watch export completions help"
+            opts="collect plan train calibrate filter predict solve-board eval watch export list completions help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1663,6 +1669,20 @@ _mbrl() {
             COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
             return 0
             ;;
+        mbrl__subcmd__help__subcmd__list)
+            opts=""
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
         mbrl__subcmd__help__subcmd__plan)
             opts=""
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
@@ -1817,6 +1837,32 @@ _mbrl() {
             COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
             return 0
             ;;
+        mbrl__subcmd__list)
+            opts="-q -h -V --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version envs methods presets embodiments"
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                --seed)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --max-memory-gib)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
         mbrl__subcmd__plan)
             opts="-q -h -V --env --model --particles --propagation --context --allow-incomplete --steps --map --start --goal --horizon --candidates --elites --iters --noise --beta --no-warm-start --evidence --instance-seed --out --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
@@ -1825,7 +1871,7 @@ _mbrl() {
             fi
             case "${prev}" in
                 --env)
-                    COMPREPLY=($(compgen -f "${cur}"))
+                    COMPREPLY=($(compgen -W "pendulum pendulum:light pendulum:heavy pendulum:inverted pendulum:quadrant unicycle" -- "${cur}"))
                     return 0
                     ;;
                 --model)
@@ -1973,7 +2019,7 @@ _mbrl() {
             fi
             case "${prev}" in
                 --game)
-                    COMPREPLY=($(compgen -f "${cur}"))
+                    COMPREPLY=($(compgen -W "lightsout tileswap" -- "${cur}"))
                     return 0
                     ;;
                 --board)
@@ -2131,7 +2177,7 @@ _mbrl() {
                     return 0
                     ;;
                 --env)
-                    COMPREPLY=($(compgen -f "${cur}"))
+                    COMPREPLY=($(compgen -W "pendulum pendulum:light pendulum:heavy pendulum:inverted pendulum:quadrant toy:inner toy:outer mountaincar unicycle terrain lightsout tileswap lightsout:cursor lightsout:reacher tileswap:cursor tileswap:reacher ball" -- "${cur}"))
                     return 0
                     ;;
                 --config)
@@ -2189,7 +2235,7 @@ _mbrl() {
                     return 0
                     ;;
                 --env)
-                    COMPREPLY=($(compgen -f "${cur}"))
+                    COMPREPLY=($(compgen -W "pendulum pendulum:light pendulum:heavy pendulum:inverted pendulum:quadrant toy:inner toy:outer mountaincar unicycle terrain lightsout tileswap lightsout:cursor lightsout:reacher tileswap:cursor tileswap:reacher ball" -- "${cur}"))
                     return 0
                     ;;
                 --config)
@@ -2359,7 +2405,7 @@ _mbrl() {
                     return 0
                     ;;
                 --env)
-                    COMPREPLY=($(compgen -f "${cur}"))
+                    COMPREPLY=($(compgen -W "pendulum pendulum:light pendulum:heavy pendulum:inverted pendulum:quadrant toy:inner toy:outer mountaincar unicycle terrain lightsout tileswap lightsout:cursor lightsout:reacher tileswap:cursor tileswap:reacher ball" -- "${cur}"))
                     return 0
                     ;;
                 --config)
@@ -2421,7 +2467,7 @@ _mbrl() {
             fi
             case "${prev}" in
                 --env)
-                    COMPREPLY=($(compgen -f "${cur}"))
+                    COMPREPLY=($(compgen -W "lightsout:cursor lightsout:reacher tileswap:cursor tileswap:reacher" -- "${cur}"))
                     return 0
                     ;;
                 --config)

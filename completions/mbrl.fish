@@ -44,9 +44,26 @@ complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "solve-board" -d 'Find a s
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "eval" -d 'Run an evaluation protocol and write a report directory (report.md, CSV, PNG, summary.json, config.json)'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "watch" -d 'Follow a running or finished run (training or eval) in the live view'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "export" -d 'Convert a dataset, board set, ball recording or filter-estimate file to CSV or NumPy `.npz`'
+complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "list" -d 'List envs, methods, presets or embodiments with their parameters'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "completions" -d 'Print a shell completion script'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l env -d 'Environment: pendulum[:light|heavy|mass=<m>|inverted|quadrant], toy:inner|outer, mountaincar, unicycle (with --map or --maps), terrain (map sets), lightsout[:<n>x<n>], tileswap, <game>:cursor|reacher (a board game played by a manipulator, e.g. lightsout:cursor), ball' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l env -d 'Environment: pendulum[:light|heavy|mass=<m>|inverted|quadrant], toy:inner|outer, mountaincar, unicycle (with --map or --maps), terrain (map sets), lightsout[:<n>x<n>], tileswap, <game>:cursor|reacher (a board game played by a manipulator, e.g. lightsout:cursor), ball' -r -f -a "pendulum\t''
+pendulum:light\t''
+pendulum:heavy\t''
+pendulum:inverted\t''
+pendulum:quadrant\t''
+toy:inner\t''
+toy:outer\t''
+mountaincar\t''
+unicycle\t''
+terrain\t''
+lightsout\t''
+tileswap\t''
+lightsout:cursor\t''
+lightsout:reacher\t''
+tileswap:cursor\t''
+tileswap:reacher\t''
+ball\t''"
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l rollouts -d 'Number of rollouts, each in its own instance of a parametrized env' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l instances -d 'Instead of --rollouts: N instances with two rollouts each (ids 2k, 2k+1), for context models' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l actions -d 'Replay these actions (CSV: one row per step, one column per action dimension) instead of random ones' -r -F
@@ -58,7 +75,12 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l steps -d 'Steps pe
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l policy -d 'Behaviour policy' -r -f -a "random\t'Random actions: uniform within the action bounds (the unicycle: colored noise, as its authors drew)'"
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l out -d 'Output file (default: datasets/<env>-random.mcap, <env>-pairs.mcap, <env>-replay.mcap, or <game>-boards-d<D>.mcap; when that exists, the first free name ending -2, -3, …). An existing --out is replaced only with --force' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l trajectories -d 'For the ball: number of simulated shots (each with exactly one table bounce)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l orientation -d 'For the ball: launcher pose, default or unseen-1..unseen-5 (thesis 6.5.1)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l orientation -d 'For the ball: launcher pose, default or unseen-1..unseen-5 (thesis 6.5.1)' -r -f -a "default\t''
+unseen-1\t''
+unseen-2\t''
+unseen-3\t''
+unseen-4\t''
+unseen-5\t''"
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l augment-rotations -d 'For the ball: rotated copies added per shot, about z through its lowest point (19 in the thesis)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l max-depth -d 'Deepest solution depth in a board set' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l split -d 'Only boards of this split (--boards), or the maps of this split of a map set (--maps DIR)' -r -f -a "train\t''
@@ -77,7 +99,12 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l force -d 'Replace 
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -s V -l version -d 'Print version'
-complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l env -d 'Environment: pendulum[:light|heavy|mass=<m>|inverted|quadrant] or unicycle' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l env -d 'Environment: pendulum[:light|heavy|mass=<m>|inverted|quadrant] or unicycle' -r -f -a "pendulum\t''
+pendulum:light\t''
+pendulum:heavy\t''
+pendulum:inverted\t''
+pendulum:quadrant\t''
+unicycle\t''"
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l model -d 'Dynamics the planner uses: `true` (the simulator\'s equations) or a checkpoint directory written by `mbrl train` (e.g. models/pets-pendulum)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l particles -d 'Particles per candidate for stochastic learned models (PETS: trajectory sampling)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand plan" -l propagation -d 'How particles use the ensemble members' -r -f -a "ts1\t'TS-1: each particle draws an ensemble member anew at every step'
@@ -130,7 +157,23 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand train; and not __fish_seen_sub
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and not __fish_seen_subcommand_from pets ball-ekf context tradyn seads dlgpd help" -f -a "dlgpd" -d 'DLGPD (thesis ch. 3): a VAE on pendulum frames (`collect --images`) with Gaussian-process latent dynamics and reward; plan with `mbrl plan --model DIR --evidence E.mcap`'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and not __fish_seen_subcommand_from pets ball-ekf context tradyn seads dlgpd help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -l data -d 'Rollout datasets (.mcap) of one env, merged (repeatable)' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -l env -d 'The env the data must come from (default: the dataset\'s env)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -l env -d 'The env the data must come from (default: the dataset\'s env)' -r -f -a "pendulum\t''
+pendulum:light\t''
+pendulum:heavy\t''
+pendulum:inverted\t''
+pendulum:quadrant\t''
+toy:inner\t''
+toy:outer\t''
+mountaincar\t''
+unicycle\t''
+terrain\t''
+lightsout\t''
+tileswap\t''
+lightsout:cursor\t''
+lightsout:reacher\t''
+tileswap:cursor\t''
+tileswap:reacher\t''
+ball\t''"
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -l config -d 'Hyperparameters from a TOML file (keys of config.json\'s `config` table), over the preset\'s' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -l preset -d 'Network size and training length (default: small)' -r -f -a "small\t'3 hidden layers × 64 SiLU units, 2000 steps (≈ 10 s on 2 cores)'
 medium\t'4 × 200 SiLU units, 5000 steps: mbrl-lib\'s PETS pendulum network'"
@@ -171,7 +214,23 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcomm
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from ball-ekf" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from ball-ekf" -s V -l version -d 'Print version'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -l data -d 'An instance-pair dataset (.mcap) from `mbrl collect --instances N`' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -l env -d 'The env the data must come from (default: the dataset\'s env)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -l env -d 'The env the data must come from (default: the dataset\'s env)' -r -f -a "pendulum\t''
+pendulum:light\t''
+pendulum:heavy\t''
+pendulum:inverted\t''
+pendulum:quadrant\t''
+toy:inner\t''
+toy:outer\t''
+mountaincar\t''
+unicycle\t''
+terrain\t''
+lightsout\t''
+tileswap\t''
+lightsout:cursor\t''
+lightsout:reacher\t''
+tileswap:cursor\t''
+tileswap:reacher\t''
+ball\t''"
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -l config -d 'Hyperparameters from a TOML file (keys of config.json\'s `config` table), over the preset\'s' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -l preset -d 'Network size and training length (default: small; paper: Table B.1)' -r -f -a "small\t'Minutes on 2 cores: what `eval quick` and the tests train'
 medium\t'The largest scale the README\'s reproductions run on 2 cores'
@@ -213,7 +272,10 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcomm
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -s V -l version -d 'Print version'
-complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -l env -d 'The embodied board game: lightsout:cursor, tileswap:cursor, lightsout:reacher or tileswap:reacher' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -l env -d 'The embodied board game: lightsout:cursor, tileswap:cursor, lightsout:reacher or tileswap:reacher' -r -f -a "lightsout:cursor\t''
+lightsout:reacher\t''
+tileswap:cursor\t''
+tileswap:reacher\t''"
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -l config -d 'Hyperparameters from a TOML file (keys of config.json\'s `config` table), over the preset\'s' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -l preset -d 'Network sizes and budget (default: small; paper: 500k env steps on the Cursor, 10M on the Reacher)' -r -f -a "small\t'Minutes on 2 cores: what `eval quick` and the tests train'
 medium\t'The largest scale the README\'s reproductions run on 2 cores'
@@ -236,7 +298,23 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcomm
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -s V -l version -d 'Print version'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l data -d 'Pendulum rollouts (.mcap), merged (repeatable): with frames (`collect --images`) for the medium and paper presets, any for the small one' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l env -d 'The env the data must come from (default: the dataset\'s env)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l env -d 'The env the data must come from (default: the dataset\'s env)' -r -f -a "pendulum\t''
+pendulum:light\t''
+pendulum:heavy\t''
+pendulum:inverted\t''
+pendulum:quadrant\t''
+toy:inner\t''
+toy:outer\t''
+mountaincar\t''
+unicycle\t''
+terrain\t''
+lightsout\t''
+tileswap\t''
+lightsout:cursor\t''
+lightsout:reacher\t''
+tileswap:cursor\t''
+tileswap:reacher\t''
+ball\t''"
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l config -d 'Hyperparameters from a TOML file (keys of config.json\'s `config` table), over the preset\'s' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l preset -d 'Model and training size (default: small, which learns from the pole angle instead of frames)' -r -f -a "small\t'Minutes on 2 cores: what `eval quick` and the tests train'
 medium\t'The largest scale the README\'s reproductions run on 2 cores'
@@ -264,7 +342,23 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcomm
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from help" -f -a "dlgpd" -d 'DLGPD (thesis ch. 3): a VAE on pendulum frames (`collect --images`) with Gaussian-process latent dynamics and reward; plan with `mbrl plan --model DIR --evidence E.mcap`'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l model -d 'A context-model checkpoint (`mbrl train context`, or `mbrl train tradyn` for the unicycle)' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l env -d 'Environment the model was trained on, e.g. toy:inner, pendulum:quadrant, mountaincar, unicycle' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l env -d 'Environment the model was trained on, e.g. toy:inner, pendulum:quadrant, mountaincar, unicycle' -r -f -a "pendulum\t''
+pendulum:light\t''
+pendulum:heavy\t''
+pendulum:inverted\t''
+pendulum:quadrant\t''
+toy:inner\t''
+toy:outer\t''
+mountaincar\t''
+unicycle\t''
+terrain\t''
+lightsout\t''
+tileswap\t''
+lightsout:cursor\t''
+lightsout:reacher\t''
+tileswap:cursor\t''
+tileswap:reacher\t''
+ball\t''"
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l map -d 'For --env unicycle: the terrain map (PNG) the robot calibrates on' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l instance-seed -d 'Which instance (hidden parameters) to calibrate in' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l strategy -r -f -a "random\t'Uniformly random actions (the baseline)'
@@ -319,7 +413,8 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -l force -d 'Replace 
 complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand predict" -s V -l version -d 'Print version'
-complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l game -d 'Game: lightsout (5x5), lightsout:<n>x<n> (n = 2..13), tileswap (default with a SEADS --model: its game)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l game -d 'Game: lightsout (5x5), lightsout:<n>x<n> (n = 2..13), tileswap (default with a SEADS --model: its game)' -r -f -a "lightsout\t''
+tileswap\t''"
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l board -d 'The board to solve' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l random-depth -d 'Draw a random board whose shortest solution has this many moves (5x5 LightsOut, TileSwap)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l split -d 'Draw the random board from this split only (thesis appendix D.1.4)' -r -f -a "train\t''
@@ -403,7 +498,8 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from boards" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from boards" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from boards" -s V -l version -d 'Print version'
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l game -d 'Game: lightsout (5x5) or tileswap' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l game -d 'Game: lightsout (5x5) or tileswap' -r -f -a "lightsout\t''
+tileswap\t''"
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l embodiment -d 'Manipulator' -r -f -a "cursor\t'A point moved by steps of at most 0.2, pushing where it stands (10 steps per move)'
 reacher\t'A torque-driven two-link arm over a 0.3 m board (50 steps per move)'"
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l max-depth -d 'Boards of depth 1..=max-depth are evaluated' -r
@@ -440,7 +536,23 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -s V -l version -d 'Print version'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l model -d 'A context-model checkpoint (`mbrl train context`)' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l env -d 'The env the model was trained on' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l env -d 'The env the model was trained on' -r -f -a "pendulum\t''
+pendulum:light\t''
+pendulum:heavy\t''
+pendulum:inverted\t''
+pendulum:quadrant\t''
+toy:inner\t''
+toy:outer\t''
+mountaincar\t''
+unicycle\t''
+terrain\t''
+lightsout\t''
+tileswap\t''
+lightsout:cursor\t''
+lightsout:reacher\t''
+tileswap:cursor\t''
+tileswap:reacher\t''
+ball\t''"
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l contexts -d 'Unseen contexts (instances) to calibrate in (thesis: 50)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l validation-rollouts -d 'Random validation rollouts per context (thesis: 20)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l validation-steps -d 'Steps per validation rollout (thesis: 50)' -r
@@ -515,7 +627,11 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -s V -l version -d 'Print version'
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l model -d 'A DLGPD checkpoint (`mbrl train dlgpd`)' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l env -d 'Settings to swing up (repeatable; default: the thesis\' pendulum, pendulum:inverted, pendulum:light, pendulum:heavy)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l env -d 'Settings to swing up (repeatable; default: the thesis\' pendulum, pendulum:inverted, pendulum:light, pendulum:heavy)' -r -f -a "pendulum\t''
+pendulum:light\t''
+pendulum:heavy\t''
+pendulum:inverted\t''
+pendulum:quadrant\t''"
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l evidence-rollouts -d 'Evidence sizes in rollouts of 30 frames (thesis: 10, 20, 30, 50, 70, 100, 200)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l runs -d 'Runs per point, each with its own evidence pool and start state (thesis: 27)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l steps -d 'Steps per swing-up' -r
@@ -543,7 +659,11 @@ tsinf\t'TS-∞: each particle keeps one member for the whole horizon'
 expectation\t'Each member\'s mean prediction, no sampling'"
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l context -d 'Calibration transitions (`mbrl calibrate --out`) a context model is conditioned on; without it the model plans with its prior mean context' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l episodes -d 'Number of episodes (each with its own start state)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l env -d 'Environment variant: pendulum[:light|heavy|mass=<m>|inverted|quadrant]' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l env -d 'Environment variant: pendulum[:light|heavy|mass=<m>|inverted|quadrant]' -r -f -a "pendulum\t''
+pendulum:light\t''
+pendulum:heavy\t''
+pendulum:inverted\t''
+pendulum:quadrant\t''"
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l steps -d 'Steps per episode' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l horizon -d 'Planning horizon in steps (pendulum 20; unicycle 30, shrinking to the steps left)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l candidates -d 'Candidate action sequences per iteration (1000)' -r
@@ -600,7 +720,8 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -s h -l help -d 'Print 
 complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -s V -l version -d 'Print version'
 complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l input -d 'An mbrl MCAP file: a dataset (`collect`), board set, ball recording or `filter --out *.mcap` output' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l out -d 'Output file; its extension (.csv or .npz) chooses the format unless --format is given' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l format -d 'csv or npz; must agree with --out\'s extension when that names a format' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l format -d 'csv or npz; must agree with --out\'s extension when that names a format' -r -f -a "csv\t''
+npz\t''"
 complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
@@ -611,6 +732,16 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l force -d 'Replace a
 complete -c mbrl -n "__fish_mbrl_using_subcommand export" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand export" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand export" -s V -l version -d 'Print version'
+complete -c mbrl -n "__fish_mbrl_using_subcommand list" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand list" -l threads -d 'Worker threads (0 = one per core)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand list" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand list" -l tui -d 'Show the live terminal view (default when stdout is a terminal and MBRL_TUI is not `never`). It opens once the work has run a second and closes by itself when the work ends'
+complete -c mbrl -n "__fish_mbrl_using_subcommand list" -l hold -d 'Keep the live view open when the work ends, until q is pressed (also MBRL_TUI=hold)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand list" -l no-tui -d 'Print plain progress lines on stderr instead of the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand list" -l force -d 'Replace an output named with --out (or another output flag) that exists; without it such a command is refused. Default output names never replace anything: a free numbered name is used'
+complete -c mbrl -n "__fish_mbrl_using_subcommand list" -s q -l quiet -d 'Print only results and errors'
+complete -c mbrl -n "__fish_mbrl_using_subcommand list" -s h -l help -d 'Print help (see more with \'--help\')'
+complete -c mbrl -n "__fish_mbrl_using_subcommand list" -s V -l version -d 'Print version'
 complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
@@ -621,18 +752,19 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -l force -d 'Repl
 complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand completions" -s V -l version -d 'Print version'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "collect" -d 'Collect rollouts from a simulator into an MCAP dataset'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "plan" -d 'Plan with CEM on a model and execute the plan in the simulator (MPC)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "train" -d 'Train a model and write it to a checkpoint directory (config.json, weights, metrics.jsonl)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "calibrate" -d 'Calibrate a context model in an instance of its env by expected information gain'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "filter" -d 'Filter table-tennis ball recordings with the gray-box EKF (thesis chapter 6)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "predict" -d 'Predict table-tennis ball trajectories: filter until a horizon before the end, then predict ahead'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "solve-board" -d 'Find a shortest solution of a LightsOut or TileSwap board and optionally play it with a manipulator'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "eval" -d 'Run an evaluation protocol and write a report directory (report.md, CSV, PNG, summary.json, config.json)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "watch" -d 'Follow a running or finished run (training or eval) in the live view'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "export" -d 'Convert a dataset, board set, ball recording or filter-estimate file to CSV or NumPy `.npz`'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "completions" -d 'Print a shell completion script'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export list completions help" -f -a "collect" -d 'Collect rollouts from a simulator into an MCAP dataset'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export list completions help" -f -a "plan" -d 'Plan with CEM on a model and execute the plan in the simulator (MPC)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export list completions help" -f -a "train" -d 'Train a model and write it to a checkpoint directory (config.json, weights, metrics.jsonl)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export list completions help" -f -a "calibrate" -d 'Calibrate a context model in an instance of its env by expected information gain'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export list completions help" -f -a "filter" -d 'Filter table-tennis ball recordings with the gray-box EKF (thesis chapter 6)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export list completions help" -f -a "predict" -d 'Predict table-tennis ball trajectories: filter until a horizon before the end, then predict ahead'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export list completions help" -f -a "solve-board" -d 'Find a shortest solution of a LightsOut or TileSwap board and optionally play it with a manipulator'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export list completions help" -f -a "eval" -d 'Run an evaluation protocol and write a report directory (report.md, CSV, PNG, summary.json, config.json)'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export list completions help" -f -a "watch" -d 'Follow a running or finished run (training or eval) in the live view'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export list completions help" -f -a "export" -d 'Convert a dataset, board set, ball recording or filter-estimate file to CSV or NumPy `.npz`'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export list completions help" -f -a "list" -d 'List envs, methods, presets or embodiments with their parameters'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export list completions help" -f -a "completions" -d 'Print a shell completion script'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export list completions help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from train" -f -a "pets" -d 'Probabilistic ensemble of MLPs on (state, action) → state change (PETS, Chua et al. 2018), for any env that `collect` rolls out; plan with it via `mbrl plan --model DIR`'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from train" -f -a "ball-ekf" -d 'Gray-box table-tennis ball EKF: learn the impact matrix, noise levels and initial values by maximizing the filter\'s marginal likelihood (thesis 6.4.4, eq. 6.24)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from train" -f -a "context" -d 'Context-conditional GRU dynamics with a context encoder (Explore the Context, thesis ch. 4), trained on instance-pair datasets (`collect --instances N`); calibrate with `mbrl calibrate`'

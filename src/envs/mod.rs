@@ -14,7 +14,7 @@ pub mod unicycle;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
-pub use registry::{instance_env, parse_env, EnvName, INSTANCE_STREAM};
+pub use registry::{instance_env, parse_env, EnvName, ENV_NAMES, INSTANCE_STREAM};
 
 /// Names, sizes and bounds of an environment.
 #[derive(Clone, Debug, PartialEq)]

@@ -11,6 +11,7 @@ use super::unicycle::{Unicycle, UnicycleTerrain};
 use super::Env;
 use crate::error::{Error, Result};
 use crate::util::seeding::rng_for;
+use crate::util::suggest::{did_you_mean, nearest};
 use std::sync::Arc;
 
 /// The pendulum family as a flag's help text names it; a macro so `concat!` can build help strings from it.
@@ -35,6 +36,30 @@ macro_rules! known_envs {
 }
 
 pub const KNOWN_ENVS: &str = known_envs!();
+
+/// Every env name without a number in it, as completion offers them and typos are matched against. The
+/// numbered forms (`pendulum:mass=<m>`, `lightsout:<n>x<n>[:cursor|reacher]`) are typed: a list of every
+/// mass cannot be written, and the 36 sizes would bury the names. A test keeps this list in step with the
+/// variant lists of each family and with [`parse_env`].
+pub const ENV_NAMES: [&str; 17] = [
+    "pendulum",
+    "pendulum:light",
+    "pendulum:heavy",
+    "pendulum:inverted",
+    "pendulum:quadrant",
+    "toy:inner",
+    "toy:outer",
+    "mountaincar",
+    "unicycle",
+    "terrain",
+    "lightsout",
+    "tileswap",
+    "lightsout:cursor",
+    "lightsout:reacher",
+    "tileswap:cursor",
+    "tileswap:reacher",
+    "ball",
+];
 
 /// What to give when the unicycle is named without maps.
 pub const UNICYCLE_NEEDS_MAPS: &str = "'unicycle' drives on terrain maps: give --map MAP.png, or --maps DIR --split \
@@ -74,16 +99,24 @@ pub fn parse_env(name: &str) -> Result<EnvName> {
             return Ok(EnvName::Embodied(GameSpec::parse(game)?, embodiment));
         }
     }
+    let unknown =
+        || Error::config(format!("unknown env '{name}'{}; supported: {KNOWN_ENVS}", did_you_mean(name, ENV_NAMES)));
     let (family, variant) = name.split_once(':').unwrap_or((name, ""));
     match family {
         "pendulum" => Ok(EnvName::Pendulum(PendulumVariant::parse(variant)?)),
         "toy" => Ok(EnvName::Toy(Squash::parse(variant)?)),
         "mountaincar" if variant.is_empty() => Ok(EnvName::MountainCar),
-        "lightsout" | "tileswap" => Ok(EnvName::Board(GameSpec::parse(name)?)),
+        // A mistyped manipulator (`lightsout:cursr`) reads as a board size; name the env it was meant to be.
+        "lightsout" | "tileswap" => {
+            GameSpec::parse(name).map(EnvName::Board).map_err(|e| match nearest(name, ENV_NAMES) {
+                Some(_) => unknown(),
+                None => e,
+            })
+        }
         "ball" if variant.is_empty() => Ok(EnvName::Ball),
         "unicycle" if variant.is_empty() => Ok(EnvName::Unicycle(None)),
         "terrain" if variant.is_empty() => Ok(EnvName::Terrain),
-        _ => Err(Error::config(format!("unknown env '{name}'; supported: {KNOWN_ENVS}"))),
+        _ => Err(unknown()),
     }
 }
 
@@ -198,6 +231,42 @@ mod tests {
     fn unknown_family_names_supported_envs() {
         let err = parse_env("cartpole").unwrap_err().to_string();
         assert!(err.contains("cartpole") && err.contains("pendulum"), "{err}");
+    }
+
+    #[test]
+    fn typos_are_answered_with_the_nearest_name() {
+        for (typo, meant) in [
+            ("pendlum", "'pendulum'"),
+            ("mountaincat", "'mountaincar'"),
+            ("lightsout:cursr", "'lightsout:cursor'"),
+            ("tilswap", "'tileswap'"),
+            ("pendulum:haevy", "'heavy'"),
+            ("toy:iner", "'inner'"),
+        ] {
+            let err = parse_env(typo).unwrap_err().to_string();
+            assert!(err.contains(&format!("did you mean {meant}?")), "{typo}: {err}");
+            assert!(err.contains("expected one of") || err.contains("supported: pendulum"), "{err}");
+        }
+        let err = parse_env("lightsout:8x9").unwrap_err().to_string();
+        assert!(err.contains("unknown board game 'lightsout:8x9'"), "{err}");
+    }
+
+    #[test]
+    fn every_listed_name_parses_to_itself_and_every_named_variant_is_listed() {
+        for name in ENV_NAMES {
+            assert_eq!(parse_env(name).unwrap().canonical(), name);
+        }
+        let families = [
+            crate::envs::pendulum::variant::VARIANT_NAMES.map(|v| format!("pendulum:{v}")).to_vec(),
+            crate::envs::toy::SQUASH_NAMES.map(|v| format!("toy:{v}")).to_vec(),
+            crate::envs::boards::spec::GAME_NAMES.map(String::from).to_vec(),
+        ];
+        let embodied = crate::envs::boards::spec::GAME_NAMES
+            .iter()
+            .flat_map(|g| crate::envs::embodiments::EMBODIMENT_NAMES.map(|e| format!("{g}:{e}")));
+        for name in families.into_iter().flatten().chain(embodied) {
+            assert!(ENV_NAMES.contains(&name.as_str()), "{name} is missing from ENV_NAMES");
+        }
     }
 
     #[test]

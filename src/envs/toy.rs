@@ -11,6 +11,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::envs::{Dynamics, Env, EnvSpec, Step};
 use crate::error::{Error, Result};
+use crate::util::suggest::did_you_mean;
 
 /// x' = A x + [α, 0]ᵀ δ(u) + ε.
 const A: [[f64; 2]; 2] = [[0.8, 0.2], [-0.2, 0.8]];
@@ -29,13 +30,19 @@ pub enum Squash {
 
 pub const SQUASH_HELP: &str = "inner (δ = max(1−|u|, 0)), outer (δ = max(|u|−1, 0))";
 
+/// The variants `toy:<name>` takes.
+pub const SQUASH_NAMES: [&str; 2] = ["inner", "outer"];
+
 impl Squash {
     pub fn parse(text: &str) -> Result<Self> {
         match text {
             "inner" => Ok(Squash::Inner),
             "outer" => Ok(Squash::Outer),
             "" => Err(Error::config(format!("'toy' needs its squashing: toy:inner or toy:outer ({SQUASH_HELP})"))),
-            other => Err(Error::config(format!("unknown toy variant '{other}'; expected one of: {SQUASH_HELP}"))),
+            other => Err(Error::config(format!(
+                "unknown toy variant '{other}'{}; expected one of: {SQUASH_HELP}",
+                did_you_mean(other, SQUASH_NAMES)
+            ))),
         }
     }
 

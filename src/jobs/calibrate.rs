@@ -41,7 +41,7 @@ pub struct CalibrateOptions {
     #[arg(long)]
     model: PathBuf,
     /// Environment the model was trained on, e.g. toy:inner, pendulum:quadrant, mountaincar, unicycle.
-    #[arg(long)]
+    #[arg(long, value_parser = crate::jobs::names::envs(), hide_possible_values = true)]
     env: String,
     /// For --env unicycle: the terrain map (PNG) the robot calibrates on.
     #[arg(long)]

@@ -47,7 +47,7 @@ pub struct ExportOptions {
     #[arg(long)]
     out: Option<PathBuf>,
     /// csv or npz (metrics: csv only); must agree with --out's extension when that names a format.
-    #[arg(long)]
+    #[arg(long, value_parser = crate::jobs::names::export_formats(), hide_possible_values = true)]
     format: Option<String>,
 }
 
@@ -132,7 +132,11 @@ fn choose_format(options: &ExportOptions) -> Result<ExportFormat> {
     let named = match &options.format {
         Some(text) => match ExportFormat::parse(text) {
             Some(f) => Some(f),
-            None => refuse!("--format '{text}' is not known; supported: {}", ExportFormat::NAMES),
+            None => refuse!(
+                "--format '{text}' is not known{}; supported: {}",
+                crate::util::suggest::did_you_mean(text, ExportFormat::NAMES.split(", ")),
+                ExportFormat::NAMES
+            ),
         },
         None => None,
     };

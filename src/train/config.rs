@@ -27,7 +27,8 @@ pub fn apply_toml<T: Serialize + DeserializeOwned>(base: &T, text: &str) -> std:
         let Some(slot) = object.get_mut(&key) else {
             let mut known: Vec<&str> = object.keys().map(String::as_str).collect();
             known.sort_unstable();
-            return Err(format!("unknown key '{key}'; known keys: {}", known.join(", ")));
+            let hint = crate::util::suggest::did_you_mean(&key, known.iter().copied());
+            return Err(format!("unknown key '{key}'{hint}; known keys: {}", known.join(", ")));
         };
         *slot = serde_json::to_value(&item).map_err(|e| format!("key '{key}': {e}"))?;
     }
@@ -61,7 +62,7 @@ mod tests {
     #[test]
     fn unknown_keys_and_wrong_types_are_errors() {
         let err = apply_toml(&base(), "stepz = 20").unwrap_err();
-        assert!(err.contains("unknown key 'stepz'") && err.contains("steps"), "{err}");
+        assert!(err.contains("unknown key 'stepz' (did you mean 'steps'?)") && err.contains("known keys"), "{err}");
         let err = apply_toml(&base(), "steps = \"many\"").unwrap_err();
         assert!(err.contains("wrong value type"), "{err}");
         assert!(apply_toml(&base(), "steps = ").is_err());

@@ -11,4 +11,5 @@ pub mod interrupt;
 pub mod png;
 pub mod rk45;
 pub mod seeding;
+pub mod suggest;
 pub mod table;

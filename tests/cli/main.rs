@@ -17,6 +17,7 @@ mod eval_render;
 mod export;
 mod foxglove_schemas;
 mod kill;
+mod list;
 mod outputs;
 mod pendulum_plan;
 mod pendulum_reference;

@@ -22,6 +22,7 @@ const SUBCOMMANDS: &[&[&str]] = &[
     &["predict"],
     &["watch"],
     &["completions"],
+    &["list"],
 ];
 
 #[test]

@@ -78,7 +78,9 @@ impl Orientation {
                 .map(Orientation::Unseen),
         };
         parsed.ok_or_else(|| {
-            Error::config(format!("unknown launcher orientation {name:?}; expected one of: {VALID_NAMES}"))
+            let names = Orientation::ALL.map(|o| o.name());
+            let hint = crate::util::suggest::did_you_mean(trimmed, names.iter().map(String::as_str));
+            Error::config(format!("unknown launcher orientation {name:?}{hint}; expected one of: {VALID_NAMES}"))
         })
     }
 

@@ -2,8 +2,12 @@
 
 use super::lightsout::MAX_SIDE;
 use crate::error::{Error, Result};
+use crate::util::suggest::did_you_mean;
 
 pub const GAME_HELP: &str = "lightsout (5x5), lightsout:<n>x<n> (n = 2..13), tileswap";
+
+/// The games by their default names (LightsOut's other sizes are `lightsout:<n>x<n>`).
+pub const GAME_NAMES: [&str; 2] = ["lightsout", "tileswap"];
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum GameSpec {
@@ -13,7 +17,11 @@ pub enum GameSpec {
 
 impl GameSpec {
     pub fn parse(name: &str) -> Result<Self> {
-        let bad = || Error::config(format!("unknown board game '{name}'; supported: {GAME_HELP}"));
+        let bad = || {
+            let sizes: Vec<String> = (2..=MAX_SIDE).map(|n| format!("lightsout:{n}x{n}")).collect();
+            let hint = did_you_mean(name, GAME_NAMES.into_iter().chain(sizes.iter().map(String::as_str)));
+            Error::config(format!("unknown board game '{name}'{hint}; supported: {GAME_HELP}"))
+        };
         let (family, size) = name.split_once(':').unwrap_or((name, ""));
         match family {
             "lightsout" if size.is_empty() => Ok(GameSpec::LightsOut(5)),

@@ -9,8 +9,12 @@ pub mod reacher;
 pub use manipulator::{BoardPoint, Manipulator, ScriptedController};
 
 use crate::error::{Error, Result};
+use crate::util::suggest::did_you_mean;
 
 pub const EMBODIMENT_HELP: &str = "cursor, reacher";
+
+/// Every manipulator's name, as `<game>:<name>` and `--embodiment` take it.
+pub const EMBODIMENT_NAMES: [&str; 2] = ["cursor", "reacher"];
 
 /// The manipulators a user can name.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -25,7 +29,10 @@ impl Embodiment {
         match name {
             "cursor" => Ok(Embodiment::Cursor),
             "reacher" => Ok(Embodiment::Reacher),
-            other => Err(Error::config(format!("unknown embodiment '{other}'; supported: {EMBODIMENT_HELP}"))),
+            other => Err(Error::config(format!(
+                "unknown embodiment '{other}'{}; supported: {EMBODIMENT_HELP}",
+                did_you_mean(other, EMBODIMENT_NAMES)
+            ))),
         }
     }
 

@@ -5,6 +5,7 @@ use rand_chacha::ChaCha8Rng;
 
 use super::params::{PendulumParams, QuadrantActuator};
 use crate::error::{Error, Result};
+use crate::util::suggest::did_you_mean;
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum PendulumVariant {
@@ -20,9 +21,15 @@ pub enum PendulumVariant {
 
 pub const VARIANT_HELP: &str = "light (m=0.2), heavy (m=1.5), mass=<m>, inverted, quadrant";
 
+/// The named variants (all but `mass=<m>`), as `pendulum:<name>` takes them.
+pub const VARIANT_NAMES: [&str; 4] = ["light", "heavy", "inverted", "quadrant"];
+
 impl PendulumVariant {
     pub fn parse(text: &str) -> Result<Self> {
-        let bad = || Error::config(format!("unknown pendulum variant '{text}'; expected one of: {VARIANT_HELP}"));
+        let bad = || {
+            let hint = did_you_mean(text, VARIANT_NAMES.into_iter().chain(["standard"]));
+            Error::config(format!("unknown pendulum variant '{text}'{hint}; expected one of: {VARIANT_HELP}"))
+        };
         match text {
             "" | "standard" => Ok(PendulumVariant::Standard),
             "light" => Ok(PendulumVariant::Mass(0.2)),

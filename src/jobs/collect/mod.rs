@@ -71,7 +71,7 @@ episode from a uniformly scrambled board and a reset manipulator. --actions: one
 angles in rad (|wrist| <= 160 deg) and their velocities; default: a reset drawn from --seed).
 Ball shots: launcher settings drawn as in thesis 6.5.1, 180 Hz camera with ~1 mm noise and dropouts.")]
 pub struct CollectOptions {
-    #[arg(long, help = concat!("Environment: ", crate::known_envs!()))]
+    #[arg(long, value_parser = crate::jobs::names::envs(), hide_possible_values = true, help = concat!("Environment: ", crate::known_envs!()))]
     env: String,
     /// Number of rollouts, each in its own instance of a parametrized env.
     #[arg(long, default_value_t = 100)]
@@ -116,7 +116,7 @@ pub struct CollectOptions {
     #[arg(long)]
     trajectories: Option<usize>,
     /// For the ball: launcher pose, default or unseen-1..unseen-5 (thesis 6.5.1).
-    #[arg(long, default_value = "default", requires = "trajectories")]
+    #[arg(long, default_value = "default", requires = "trajectories", value_parser = crate::jobs::names::orientations(), hide_possible_values = true)]
     orientation: String,
     /// For the ball: rotated copies added per shot, about z through its lowest point (19 in the thesis).
     #[arg(long, default_value_t = 0, requires = "trajectories")]

@@ -40,7 +40,7 @@ pub fn boards(options: BoardsOptions, invocation: &Invocation) -> Result<Job<'st
 #[derive(Args, Debug)]
 pub struct EmbodiedOptions {
     /// Game: lightsout (5x5) or tileswap.
-    #[arg(long, required_unless_present = "config")]
+    #[arg(long, required_unless_present = "config", value_parser = crate::jobs::names::games(), hide_possible_values = true)]
     game: Option<String>,
     /// Manipulator.
     #[arg(long, value_enum, required_unless_present = "config")]

@@ -75,7 +75,7 @@ pub struct ContextOptions {
     #[arg(long, required_unless_present = "config")]
     model: Option<PathBuf>,
     /// The env the model was trained on.
-    #[arg(long, required_unless_present = "config")]
+    #[arg(long, required_unless_present = "config", value_parser = crate::jobs::names::envs(), hide_possible_values = true)]
     env: Option<String>,
     /// Unseen contexts (instances) to calibrate in (thesis: 50).
     #[arg(long, default_value_t = 20)]

@@ -48,7 +48,7 @@ pub struct SwingupOptions {
     /// Number of episodes (each with its own start state).
     #[arg(long, default_value_t = 10)]
     episodes: usize,
-    #[arg(long, default_value = "pendulum", help = concat!("Environment variant: ", crate::pendulum_envs!()))]
+    #[arg(long, default_value = "pendulum", value_parser = crate::jobs::names::pendulum_envs(), hide_possible_values = true, help = concat!("Environment variant: ", crate::pendulum_envs!()))]
     env: String,
     /// Steps per episode.
     #[arg(long, default_value_t = 150)]
@@ -136,7 +136,7 @@ pub struct DlgpdOptions {
     model: Option<PathBuf>,
     /// Settings to swing up (repeatable; default: the thesis' pendulum, pendulum:inverted, pendulum:light,
     /// pendulum:heavy).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::jobs::names::pendulum_envs(), hide_possible_values = true)]
     env: Vec<String>,
     /// Evidence sizes in rollouts of 30 frames (thesis: 10, 20, 30, 50, 70, 100, 200).
     #[arg(long, value_delimiter = ',', default_value = "5,10,20")]

@@ -44,7 +44,7 @@ success means a final distance of at most 5 cm. The robot is the one --instance-
 or the nominal robot (mass 2.5, gains 750 and 3π/16) without it. `--model true` plans on the simulator
 itself (an oracle); a TRADYN model plans with the mean of q(β | --context), the prior's mean without it.")]
 pub struct PlanOptions {
-    #[arg(long, help = concat!("Environment: ", crate::pendulum_envs!(), " or unicycle"))]
+    #[arg(long, value_parser = crate::jobs::names::plan_envs(), hide_possible_values = true, help = concat!("Environment: ", crate::pendulum_envs!(), " or unicycle"))]
     env: String,
     #[command(flatten)]
     model: ModelOptions,

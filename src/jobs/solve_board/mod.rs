@@ -36,7 +36,7 @@ Boards are comma-separated field values, row-major: 0/1 lights for LightsOut (n*
 number 0-8 on each field for TileSwap (solved: 0,1,2,...,8).")]
 pub struct SolveBoardOptions {
     /// Game: lightsout (5x5), lightsout:<n>x<n> (n = 2..13), tileswap (default with a SEADS --model: its game).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::jobs::names::games(), hide_possible_values = true)]
     game: Option<String>,
     /// The board to solve.
     #[arg(long, conflicts_with = "random_depth", required_unless_present = "random_depth")]

@@ -48,7 +48,7 @@ pub struct ContextOptions {
     #[arg(long)]
     data: PathBuf,
     /// The env the data must come from (default: the dataset's env).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::jobs::names::envs(), hide_possible_values = true)]
     env: Option<String>,
     #[command(flatten)]
     model: ContextModelOptions,

@@ -31,7 +31,7 @@ pub struct DlgpdOptions {
     #[arg(long, required = true)]
     data: Vec<PathBuf>,
     /// The env the data must come from (default: the dataset's env).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::jobs::names::envs(), hide_possible_values = true)]
     env: Option<String>,
     /// Hyperparameters from a TOML file (keys of config.json's `config` table), over the preset's.
     #[arg(long)]

@@ -27,7 +27,7 @@ pub struct PetsOptions {
     #[arg(long, required = true)]
     data: Vec<PathBuf>,
     /// The env the data must come from (default: the dataset's env).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::jobs::names::envs(), hide_possible_values = true)]
     env: Option<String>,
     /// Hyperparameters from a TOML file (keys of config.json's `config` table), over the preset's.
     #[arg(long)]

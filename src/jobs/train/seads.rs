@@ -26,7 +26,7 @@ Learning rates and batch sizes are keys of the --config file."
 )]
 pub struct SeadsOptions {
     /// The embodied board game: lightsout:cursor, tileswap:cursor, lightsout:reacher or tileswap:reacher.
-    #[arg(long)]
+    #[arg(long, value_parser = crate::jobs::names::embodied_envs(), hide_possible_values = true)]
     env: Option<String>,
     /// Hyperparameters from a TOML file (keys of config.json's `config` table), over the preset's.
     #[arg(long)]

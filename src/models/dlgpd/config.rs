@@ -22,7 +22,10 @@ impl std::str::FromStr for Preset {
             "small" => Ok(Preset::Small),
             "medium" => Ok(Preset::Medium),
             "paper" => Ok(Preset::Paper),
-            _ => Err(Error::config(format!("unknown preset '{s}'; presets: small, medium, paper"))),
+            _ => Err(Error::config(format!(
+                "unknown preset '{s}'{}; presets: small, medium, paper",
+                crate::util::suggest::did_you_mean(s, ["small", "medium", "paper"])
+            ))),
         }
     }
 }

@@ -57,7 +57,10 @@ impl std::str::FromStr for Preset {
         match s {
             "small" => Ok(Preset::Small),
             "medium" => Ok(Preset::Medium),
-            _ => Err(Error::config(format!("unknown preset '{s}'; presets: small, medium"))),
+            _ => Err(Error::config(format!(
+                "unknown preset '{s}'{}; presets: small, medium",
+                crate::util::suggest::did_you_mean(s, ["small", "medium"])
+            ))),
         }
     }
 }

@@ -39,7 +39,10 @@ impl std::str::FromStr for Propagation {
             "ts1" => Ok(Propagation::Ts1),
             "tsinf" => Ok(Propagation::TsInf),
             "expectation" => Ok(Propagation::Expectation),
-            _ => Err(Error::config(format!("unknown propagation '{s}'; supported: ts1, tsinf, expectation"))),
+            _ => Err(Error::config(format!(
+                "unknown propagation '{s}'{}; supported: ts1, tsinf, expectation",
+                crate::util::suggest::did_you_mean(s, ["ts1", "tsinf", "expectation"])
+            ))),
         }
     }
 }

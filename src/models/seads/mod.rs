@@ -43,7 +43,12 @@ pub struct EmbodiedGame {
 impl EmbodiedGame {
     /// The registry's embodied env names, restricted to the games SEADS plays.
     pub fn parse(name: &str) -> Result<Self> {
-        let bad = || Error::config(format!("'{name}' is not an embodied board game; supported: {ENV_HELP}"));
+        let bad = || {
+            let embodied =
+                crate::envs::ENV_NAMES.into_iter().filter(|n| n.ends_with(":cursor") || n.ends_with(":reacher"));
+            let hint = crate::util::suggest::did_you_mean(name, embodied);
+            Error::config(format!("'{name}' is not an embodied board game{hint}; supported: {ENV_HELP}"))
+        };
         let Ok(EnvName::Embodied(game, embodiment)) = crate::envs::parse_env(name) else {
             return Err(bad());
         };
