@@ -12,10 +12,7 @@ use crate::{refuse, Result};
 /// Convert a dataset, board set, ball recording or filter-estimate file to CSV or NumPy `.npz`.
 #[derive(Args, Debug)]
 #[command(after_help = "\
-The file's kind is read from its metadata. CSV holds one row per step (per board, per camera frame, per
-estimate); missing values (lost ball frames) are empty cells, booleans 0/1. The .npz archive holds the same
-columns as arrays plus what does not fit a table: rendered frames (N × H × W × 3, uint8), filter
-covariances (N × 11 × 11), per-recording launcher side information. Keys: datasets/README.md.
+The file's kind is read from its metadata. CSV holds one row per step (per board, per camera frame, per estimate); missing values (lost ball frames) are empty cells, booleans 0/1. The .npz archive holds the same columns as arrays plus what does not fit a table: rendered frames (N × H × W × 3, uint8), filter covariances (N × 11 × 11), per-recording launcher side information. Keys: datasets/README.md.
 
 Examples:
   mbrl export --input datasets/pendulum.mcap --out pendulum.npz

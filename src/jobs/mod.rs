@@ -15,6 +15,7 @@ pub mod eval;
 pub mod export;
 pub mod filter;
 pub mod model_options;
+pub mod overrides;
 pub mod plan;
 pub mod predict;
 pub mod solve_board;

@@ -18,6 +18,7 @@ mod export;
 mod foxglove_schemas;
 mod kill;
 mod outputs;
+mod overrides;
 mod pendulum_plan;
 mod pendulum_reference;
 mod pets;
