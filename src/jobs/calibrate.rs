@@ -30,12 +30,7 @@ Examples:
   mbrl plan --env pendulum:quadrant --model models/context-pendulum-quadrant --context calib.mcap --instance-seed 3
   mbrl calibrate --model models/tradyn-terrain --env unicycle --map datasets/terrain/map050.png --instance-seed 4 --strategy random --init-state 0.2,0.3,0,1.57 --out calib-uni.mcap
 
-The instance (hidden parameters) is the one --instance-seed names in every command. Starts: toy and
-MountainCar at x = 0 (thesis), pendulum from its reset draw (--seed), or --init-state. The thesis uses
-CEM 1000 candidates / 100 elites / 10 iterations and 20 β samples; pendulum N = 30, H_max = 20;
-MountainCar N = 50, H_max = 30. The command prints the entropy of q(β | transitions) before and after.
-A TRADYN model calibrates with random colored actions (as its data were collected), 10 transitions by
-default, on the --map the robot drives on; the instance is the robot (mass, throttle and steering gains).")]
+The instance (hidden parameters) is the one --instance-seed names in every command. Starts: toy and MountainCar at x = 0 (thesis), pendulum from its reset draw (--seed), or --init-state. The thesis uses CEM 1000 candidates / 100 elites / 10 iterations and 20 β samples; pendulum N = 30, H_max = 20; MountainCar N = 50, H_max = 30. The command prints the entropy of q(β | transitions) before and after. A TRADYN model calibrates with random colored actions (as its data were collected), 10 transitions by default, on the --map the robot drives on; the instance is the robot (mass, throttle and steering gains).")]
 pub struct CalibrateOptions {
     /// A context-model checkpoint (`mbrl train context`, or `mbrl train tradyn` for the unicycle).
     #[arg(long)]

@@ -16,10 +16,7 @@ use crate::{refuse, Result};
 /// metrics to CSV.
 #[derive(Args, Debug)]
 #[command(after_help = "\
-The file's kind is read from its metadata. CSV holds one row per step (per board, per camera frame, per
-estimate); missing values (lost ball frames) are empty cells, booleans 0/1. The .npz archive holds the same
-columns as arrays plus what does not fit a table: rendered frames (N × H × W × 3, uint8), filter
-covariances (N × 11 × 11), per-recording launcher side information. Keys: datasets/README.md.
+The file's kind is read from its metadata. CSV holds one row per step (per board, per camera frame, per estimate); missing values (lost ball frames) are empty cells, booleans 0/1. The .npz archive holds the same columns as arrays plus what does not fit a table: rendered frames (N × H × W × 3, uint8), filter covariances (N × 11 × 11), per-recording launcher side information. Keys: datasets/README.md.
 
 A run directory (train, eval, plan --out) or its metrics.jsonl exports every metric the run recorded (training
 loss terms, validation, returns, planner costs) as one long CSV table: columns step,metric,value, one row per

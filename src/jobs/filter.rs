@@ -21,8 +21,7 @@ Examples:
   mbrl filter --model thesis --input datasets/ball-default.mcap --out filtered.csv --mcap filtered.mcap
   mbrl filter --model models/ball-ekf --input recording.csv
 
---model is `thesis` (learned values of eq. 6.26 / Table C.2), `initial` (Table C.1) or a directory
-written by training. CSV input: header frame (or t), x, y, z; empty x,y,z cells are lost frames.")]
+--model is `thesis` (learned values of eq. 6.26 / Table C.2), `initial` (Table C.1) or a directory written by training. CSV input: header frame (or t), x, y, z; empty x,y,z cells are lost frames.")]
 pub struct FilterOptions {
     /// Ball model: thesis, initial, or a checkpoint directory.
     #[arg(long)]

@@ -17,6 +17,7 @@ pub mod filter;
 pub mod list;
 pub mod model_options;
 pub mod names;
+pub mod overrides;
 pub mod plan;
 pub mod predict;
 pub mod solve_board;

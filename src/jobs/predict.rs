@@ -22,9 +22,7 @@ Examples:
   mbrl predict --model thesis --input datasets/ball-default.mcap --horizon 1s --out predicted.csv
   mbrl predict --model thesis --input recording.csv --from-frame 40 --horizon 0.5s --plane-y 0.2
 
-By default each trajectory is filtered until one horizon before its last frame (at least ten
-measurements, thesis 6.5.2) and predicted from there; the error is the largest distance over the last
-five prediction-measurement pairs. --plane-y reports where the ball crosses that vertical plane.")]
+By default each trajectory is filtered until one horizon before its last frame (at least ten measurements, thesis 6.5.2) and predicted from there; the error is the largest distance over the last five prediction-measurement pairs. --plane-y reports where the ball crosses that vertical plane.")]
 pub struct PredictOptions {
     /// Ball model: thesis, initial, or a checkpoint directory.
     #[arg(long)]

@@ -9,6 +9,7 @@ pub mod fit;
 pub mod job;
 pub mod method;
 pub mod run_dir;
+pub mod settings;
 pub mod state;
 pub mod tensors;
 

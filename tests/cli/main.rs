@@ -19,6 +19,7 @@ mod foxglove_schemas;
 mod kill;
 mod list;
 mod outputs;
+mod overrides;
 mod pendulum_plan;
 mod pendulum_reference;
 mod pets;

@@ -15,7 +15,7 @@ const TINY_PETS: &str = "hidden_layers = 2\nhidden_units = 16\nvalidate_every = 
 /// Each method, a flag it takes that others do not, and flags it must not list.
 const METHODS: &[(&str, &str, &[&str])] = &[
     ("pets", "--ensemble", &["--skills", "--launcher-prior", "--no-terrain", "--chunk", "--env-steps"]),
-    ("ball-ekf", "--launcher-prior", &["--preset", "--config", "--env", "--ensemble", "--reward", "--skills"]),
+    ("ball-ekf", "--launcher-prior", &["--preset", "--env", "--ensemble", "--reward", "--skills"]),
     ("context", "--batch", &["--ensemble", "--reward", "--no-terrain", "--launcher-prior", "--skills"]),
     ("tradyn", "--no-terrain", &["--ensemble", "--reward", "--launcher-prior", "--skills", "--chunk"]),
     ("seads", "--env-steps", &["--data", "--steps", "--batch", "--lr", "--ensemble", "--launcher-prior"]),

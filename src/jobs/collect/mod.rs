@@ -49,26 +49,16 @@ Examples:
   mbrl collect --env unicycle --maps datasets/terrain --split train --instances 10000 --steps 100
   mbrl collect --env unicycle --map datasets/terrain/map050.png --actions actions.csv --init-state 0.2,0.3,0,1.57
 
-Start states: θ ~ U[-π, π], θ̇ ~ U[-8, 8] (pendulum); s ~ N(0, I) (toy); x ~ U[-0.8, 0.8],
-ẋ ~ U[-2, 2] (mountaincar). Actions uniform in the env's bounds. Parametrized envs (pendulum:quadrant,
-toy:*, mountaincar) draw a new instance per rollout, or per pair with --instances (rollouts 2k and 2k+1
-share instance k); the parameters go into the metadata.
---actions replays a CSV (one row per step, one column per action dimension, optional header) from
---init-state or a reset state drawn from --seed, in the instance --instance-seed names (default: --seed);
-actions beyond the bounds are clipped by the env.
+Start states: θ ~ U[-π, π], θ̇ ~ U[-8, 8] (pendulum); s ~ N(0, I) (toy); x ~ U[-0.8, 0.8], ẋ ~ U[-2, 2] (mountaincar). Actions uniform in the env's bounds. Parametrized envs (pendulum:quadrant, toy:*, mountaincar) draw a new instance per rollout, or per pair with --instances (rollouts 2k and 2k+1 share instance k); the parameters go into the metadata.
+
+--actions replays a CSV (one row per step, one column per action dimension, optional header) from --init-state or a reset state drawn from --seed, in the instance --instance-seed names (default: --seed); actions beyond the bounds are clipped by the env.
+
 Board sets (lightsout 5x5, tileswap) hold every board of depth 1..D with its train/test split.
-Terrain: --maps N writes N random 460 × 460 PNG maps (background colour and Bézier patches) and a
-manifest, terrain.json, into the new directory --out (default datasets/terrain): maps 0..N/2 train, the
-rest test. Unicycle: on one --map PNG (any 8-bit RGB image, resized to 460 × 460; x runs down its rows,
-y along its columns) or on the --split of a map set --maps DIR, a map drawn per instance with the robot
-(mass, throttle and steer gains of Table 5.1); x, y ~ U[0, 1], v ~ U[-5, 5], φ ~ U[0, 2π); actions
-colored noise (β 0.5, std 0.5, clipped to [-1, 1]); --init-state x,y,v,φ.
-Embodied boards (<game>:cursor|reacher) are recorded as skill episodes, one rollout each: an episode ends
-when the board changes or after 10 (cursor) / 50 (reacher) steps. --episodes N: random actions, each
-episode from a uniformly scrambled board and a reset manipulator. --actions: one run through the CSV
-(3 columns: dx,dy,push for cursor; two torques,push for reacher), split into episodes the same way, from
---board (default: the solved board) and --init-state (cursor: x,y in [0,1]; reacher: shoulder,wrist
-angles in rad (|wrist| <= 160 deg) and their velocities; default: a reset drawn from --seed).
+
+Terrain: --maps N writes N random 460 × 460 PNG maps (background colour and Bézier patches) and a manifest, terrain.json, into the new directory --out (default datasets/terrain): maps 0..N/2 train, the rest test. Unicycle: on one --map PNG (any 8-bit RGB image, resized to 460 × 460; x runs down its rows, y along its columns) or on the --split of a map set --maps DIR, a map drawn per instance with the robot (mass, throttle and steer gains of Table 5.1); x, y ~ U[0, 1], v ~ U[-5, 5], φ ~ U[0, 2π); actions colored noise (β 0.5, std 0.5, clipped to [-1, 1]); --init-state x,y,v,φ.
+
+Embodied boards (<game>:cursor|reacher) are recorded as skill episodes, one rollout each: an episode ends when the board changes or after 10 (cursor) / 50 (reacher) steps. --episodes N: random actions, each episode from a uniformly scrambled board and a reset manipulator. --actions: one run through the CSV (3 columns: dx,dy,push for cursor; two torques,push for reacher), split into episodes the same way, from --board (default: the solved board) and --init-state (cursor: x,y in [0,1]; reacher: shoulder,wrist angles in rad (|wrist| <= 160 deg) and their velocities; default: a reset drawn from --seed).
+
 Ball shots: launcher settings drawn as in thesis 6.5.1, 180 Hz camera with ~1 mm noise and dropouts.")]
 pub struct CollectOptions {
     #[arg(long, value_parser = crate::jobs::names::envs(), hide_possible_values = true, help = concat!("Environment: ", crate::known_envs!()))]

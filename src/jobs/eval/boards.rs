@@ -12,6 +12,7 @@ use crate::eval::seads::{
 use crate::eval::summary::Summary;
 use crate::jobs::choices::{EmbodimentChoice, SplitChoice};
 use crate::jobs::model_options::{accepting, report_unfinished};
+use crate::jobs::overrides::Overrides;
 use crate::jobs::{output_dir, Invocation, Job};
 use crate::Result;
 
@@ -57,9 +58,11 @@ pub struct EmbodiedOptions {
     /// Report directory (default: reports/embodied; when that exists, the first free reports/embodied-2, -3, …).
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Rerun the settings and seed an embodied report recorded (its config.json); no other flag but --out.
+    /// Rerun the settings and seed an embodied report recorded (its config.json); no other flag but --out, KEY=VALUE may change its settings.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["game", "embodiment", "max_depth", "boards", "split"])]
     config: Option<PathBuf>,
+    #[command(flatten)]
+    set: Overrides,
 }
 
 pub fn embodied(options: EmbodiedOptions, invocation: &Invocation) -> Result<Job<'static, EvalSummary>> {
@@ -78,6 +81,7 @@ pub fn embodied(options: EmbodiedOptions, invocation: &Invocation) -> Result<Job
             invocation.provenance(),
         ),
     };
+    let config = options.set.apply(config)?;
     config.validate()?;
     Ok(report_job(
         "eval embodied",
@@ -117,9 +121,11 @@ pub struct SeadsOptions {
     /// Take runs still in training (the weights of their last checkpoint); the report says how far each got.
     #[arg(long)]
     allow_incomplete: bool,
-    /// Rerun the settings and seed a seads report recorded (its config.json); no other flag but --out.
+    /// Rerun the settings and seed a seads report recorded (its config.json); no other flag but --out, KEY=VALUE may change its settings.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["model", "max_depth", "boards", "coverage_boards", "max_replans", "split", "max_nodes", "allow_incomplete"])]
     config: Option<PathBuf>,
+    #[command(flatten)]
+    set: Overrides,
 }
 
 /// One report per checkpoint; with several, each goes in a subdirectory named for its run and the top
@@ -143,6 +149,7 @@ pub fn seads(options: SeadsOptions, invocation: &Invocation) -> Result<Job<'stat
             invocation.provenance(),
         ),
     };
+    let config = options.set.apply(config)?;
     config.validate()?;
     let out = output_dir("--out", options.out.as_deref(), || config.default_out(), invocation)?;
     let loaded: Vec<_> = config

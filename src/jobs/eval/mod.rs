@@ -19,18 +19,18 @@ use crate::{refuse, Result};
 /// Run an evaluation protocol and write a report directory (report.md, CSV, PNG, summary.json, config.json).
 #[derive(Args, Debug)]
 #[command(after_help = "\
-Every report directory holds summary.json (the report's figures) and config.json (the protocol's settings and
-seed). `mbrl eval render DIR` redraws report.md, the CSVs and the PNGs from DIR/summary.json alone;
-`mbrl eval <protocol> --config DIR/config.json` reruns the protocol with the recorded settings and seed. With
---config only --out (and the global flags) may be given: any other flag of the protocol is rejected, and --seed,
-when given, must equal the recorded seed.
+Every report directory holds summary.json (the report's figures) and config.json (the protocol's settings and seed). `mbrl eval render DIR` redraws report.md, the CSVs and the PNGs from DIR/summary.json alone; `mbrl eval <protocol> --config DIR/config.json` reruns the protocol with the recorded settings and seed. With --config only --out, KEY=VALUE arguments and the global flags may be given: any other flag of the protocol is rejected, and --seed, when given, must equal the recorded seed.
 
-Examples:
+KEY=VALUE arguments set any key of the `settings` table of the protocol's config.json (nested keys joined by '.', e.g. `settings.boards_per_depth=50` for embodied), after --config or the flags, so they win over both; an unknown key lists the valid ones.
+
+Examples (in order: each uses what the ones before it wrote):
   mbrl eval quick
+  mbrl collect --env pendulum --rollouts 200 --steps 30 --out datasets/pendulum-random.mcap
   mbrl eval dataset --input datasets/pendulum-random.mcap
   mbrl eval boards
   mbrl eval ball --model thesis --model initial
-  mbrl eval embodied --game lightsout --embodiment cursor --max-depth 5 --boards 200
+  mbrl eval embodied --game lightsout --embodiment cursor --max-depth 5 --boards 200 --out reports/embodied
+  mbrl eval embodied --config reports/embodied/config.json settings.boards_per_depth=50 --out reports/embodied-50
   mbrl eval pendulum-swingup --model true --episodes 10 --out reports/swingup
   mbrl eval render reports/swingup
   mbrl eval pendulum-swingup --config reports/swingup/config.json --out reports/swingup-again")]
@@ -53,21 +53,22 @@ enum Protocol {
     )]
     Quick(QuickOptions),
     /// Summarise a dataset: rollouts, returns, state ranges, plots.
-    #[command(after_help = "Examples:\n  mbrl eval dataset --input datasets/pendulum-random.mcap\n  \
+    #[command(after_help = "Examples:\n  \
+                            mbrl collect --env pendulum:heavy --rollouts 50 --steps 30 --out datasets/pendulum-heavy-random.mcap\n  \
                             mbrl eval dataset --input datasets/pendulum-heavy-random.mcap --out reports/heavy-data")]
     Dataset(pendulum::DatasetOptions),
     /// Depth and train/test split tables of LightsOut 5x5 and TileSwap (thesis Tables 7.1, 7.2).
     #[command(after_help = "Example:\n  mbrl eval boards --out reports/boards")]
     Boards(boards::BoardsOptions),
     /// A manipulator's scripted controller plays optimal plans of boards of depth 1..D.
-    #[command(
-        after_help = "Examples:\n  mbrl eval embodied --game lightsout --embodiment cursor --max-depth 5 --boards 200\n  \
-                            mbrl eval embodied --game tileswap --embodiment reacher --max-depth 5 --boards 100"
-    )]
+    #[command(after_help = "Examples:\n  \
+                            mbrl eval embodied --game lightsout --embodiment cursor --max-depth 5 --boards 200 --out reports/embodied\n  \
+                            mbrl eval embodied --config reports/embodied/config.json settings.boards_per_depth=50 --out reports/embodied-50\n  \
+                            mbrl eval embodied --game tileswap --embodiment reacher --max-depth 5 --boards 100")]
     Embodied(boards::EmbodiedOptions),
     /// Ball prediction error vs horizon on simulated shots, default and unseen launcher poses (thesis 6.5).
-    #[command(after_help = "Examples:\n  mbrl eval ball --model thesis --model initial\n  \
-                            mbrl eval ball --model models/ball-ekf --train-shots 108 --test-shots 163 --unseen-shots 30")]
+    #[command(after_help = "Examples:\n  mbrl eval ball --model thesis --model initial --out reports/ball\n  \
+                            mbrl eval ball --config reports/ball/config.json settings.test_shots_unseen=10 --out reports/ball-unseen-10")]
     Ball(models::BallOptions),
     /// Explore the Context (thesis 4.5): calibration strategies compared by prediction error after calibration.
     #[command(
@@ -96,8 +97,8 @@ enum Protocol {
     Dlgpd(pendulum::DlgpdOptions),
     /// Pendulum swing-up with MPC: success rate, returns, angle plots.
     #[command(
-        after_help = "Example:\n  mbrl eval pendulum-swingup --model true --episodes 10 --out reports/swingup\n  \
-                            mbrl eval pendulum-swingup --model models/pets-pendulum --episodes 10"
+        after_help = "Examples:\n  mbrl eval pendulum-swingup --model true --episodes 10 --out reports/swingup\n  \
+                            mbrl eval pendulum-swingup --config reports/swingup/config.json episodes=3 --out reports/swingup-3"
     )]
     PendulumSwingup(pendulum::SwingupOptions),
     /// Redraw a report (report.md, CSVs, PNGs) from its summary.json, without rerunning anything.

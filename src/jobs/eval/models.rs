@@ -13,6 +13,7 @@ use crate::eval::swingup::SwingupSettings;
 use crate::eval::tradyn::{TradynEvalConfig, TradynEvalModels};
 use crate::jobs::choices::StrategyChoice;
 use crate::jobs::model_options::{accepting, report_unfinished};
+use crate::jobs::overrides::Overrides;
 use crate::jobs::{output_dir, Invocation, Job};
 use crate::models::ball::checkpoint::{load_ball_model, report_name};
 use crate::models::context::calibration::{CalibrationSettings, Strategy};
@@ -38,9 +39,11 @@ pub struct BallOptions {
     /// Report directory (default: reports/ball; when that exists, the first free reports/ball-2, -3, …).
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Rerun the settings and seed a ball report recorded (its config.json); no other flag but --out.
+    /// Rerun the settings and seed a ball report recorded (its config.json); no other flag but --out, KEY=VALUE may change its settings.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["model", "train_shots", "augment_rotations", "test_shots", "unseen_shots"])]
     config: Option<PathBuf>,
+    #[command(flatten)]
+    set: Overrides,
 }
 
 pub fn ball(options: BallOptions, invocation: &Invocation) -> Result<Job<'static, EvalSummary>> {
@@ -60,6 +63,7 @@ pub fn ball(options: BallOptions, invocation: &Invocation) -> Result<Job<'static
             invocation.provenance(),
         ),
     };
+    let config = options.set.apply(config)?;
     let models = config.models.iter().map(|m| Ok((report_name(m), load_ball_model(m)?))).collect::<Result<Vec<_>>>()?;
     config.validate()?;
     Ok(report_job(
@@ -123,9 +127,11 @@ pub struct ContextOptions {
     /// Report directory (default: reports/context; when that exists, the first free reports/context-2, -3, …).
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Rerun the settings and seed a context report recorded (its config.json); no other flag but --out.
+    /// Rerun the settings and seed a context report recorded (its config.json); no other flag but --out, KEY=VALUE may change its settings.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["model", "env", "contexts", "validation_rollouts", "validation_steps", "transitions", "horizon", "strategy", "candidates", "elites", "iters", "beta_samples", "swingup", "swingup_steps", "swingup_candidates", "allow_incomplete"])]
     config: Option<PathBuf>,
+    #[command(flatten)]
+    set: Overrides,
 }
 
 impl ContextOptions {
@@ -180,6 +186,7 @@ pub fn context(options: ContextOptions, invocation: &Invocation) -> Result<Job<'
             invocation.provenance(),
         ),
     };
+    let config = options.set.apply(config)?;
     let env = crate::envs::parse_env(&config.env)?;
     if !config.model.is_dir() {
         refuse!("--model {}: no such checkpoint directory", config.model.display());
@@ -237,9 +244,11 @@ pub struct TradynOptions {
     /// Take runs still in training (their best-validation weights so far); the report says how far each got.
     #[arg(long)]
     allow_incomplete: bool,
-    /// Rerun the settings and seed a tradyn report recorded (its config.json); no other flag but --out.
+    /// Rerun the settings and seed a tradyn report recorded (its config.json); no other flag but --out, KEY=VALUE may change its settings.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["model_terrain", "model_no_terrain", "maps", "tasks", "transitions", "steps", "horizon", "candidates", "elites", "iters", "prediction_steps", "allow_incomplete"])]
     config: Option<PathBuf>,
+    #[command(flatten)]
+    set: Overrides,
 }
 
 pub fn tradyn(options: TradynOptions, invocation: &Invocation) -> Result<Job<'static, EvalSummary>> {
@@ -264,6 +273,7 @@ pub fn tradyn(options: TradynOptions, invocation: &Invocation) -> Result<Job<'st
             invocation.provenance(),
         ),
     };
+    let config = options.set.apply(config)?;
     config.settings()?;
     for (flag, dir) in [("--model-terrain", &config.model_terrain), ("--model-no-terrain", &config.model_no_terrain)] {
         if !dir.is_dir() {

@@ -10,6 +10,7 @@ use crate::eval::summary::Summary;
 use crate::eval::swingup::{self, ModelSpec, SwingupConfig, SwingupSettings};
 use crate::jobs::cem_options::CemOptions;
 use crate::jobs::model_options::{accepting, report_unfinished, ModelOptions, PropagationChoice};
+use crate::jobs::overrides::Overrides;
 use crate::jobs::{output_dir, pendulum_variant, Invocation, Job, STEP_RECORD_BYTES};
 use crate::{refuse, Result};
 
@@ -58,9 +59,11 @@ pub struct SwingupOptions {
     /// Report directory (default: reports/pendulum-swingup; when that exists, the first free reports/pendulum-swingup-2, -3, …).
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Rerun the settings and seed a swing-up report recorded (its config.json); no other flag but --out.
+    /// Rerun the settings and seed a swing-up report recorded (its config.json); no other flag but --out, KEY=VALUE may change its settings.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["model", "particles", "propagation", "context", "allow_incomplete", "episodes", "env", "steps", "horizon", "candidates", "elites", "iters", "noise", "beta", "no_warm_start"])]
     config: Option<PathBuf>,
+    #[command(flatten)]
+    set: Overrides,
 }
 
 impl SwingupOptions {
@@ -113,6 +116,7 @@ pub fn swingup(options: SwingupOptions, invocation: &Invocation) -> Result<Job<'
         Some(path) => recorded(invocation, path)?,
         None => (options.config()?, invocation.provenance()),
     };
+    let config = options.set.apply(config)?;
     let model = model_options(&config.model)?.load(&crate::envs::parse_env(&config.env)?)?;
     config.validate()?;
     crate::util::budget::check(
@@ -166,9 +170,11 @@ pub struct DlgpdOptions {
     /// Report directory (default: reports/dlgpd; when that exists, the first free reports/dlgpd-2, -3, …).
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Rerun the settings and seed a dlgpd report recorded (its config.json); no other flag but --out.
+    /// Rerun the settings and seed a dlgpd report recorded (its config.json); no other flag but --out, KEY=VALUE may change its settings.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["model", "env", "evidence_rollouts", "runs", "steps", "candidates", "elites", "iters", "prediction_only", "allow_incomplete"])]
     config: Option<PathBuf>,
+    #[command(flatten)]
+    set: Overrides,
 }
 
 pub fn dlgpd(options: DlgpdOptions, invocation: &Invocation) -> Result<Job<'static, EvalSummary>> {
@@ -194,6 +200,7 @@ pub fn dlgpd(options: DlgpdOptions, invocation: &Invocation) -> Result<Job<'stat
             (config, invocation.provenance())
         }
     };
+    let config = options.set.apply(config)?;
     config.settings()?;
     let trained = crate::models::dlgpd::job::load(&config.model, accepting(config.allow_incomplete))?;
     report_unfinished(&config.model, &trained.progress);

@@ -30,19 +30,11 @@ Examples:
   mbrl plan --env unicycle --model models/tradyn-terrain --map datasets/terrain/map050.png --start 0.2,0.3,1.57 --goal 0.7,0.6 --context calib-uni.mcap --instance-seed 4
   mbrl plan --env unicycle --model true --map datasets/terrain/map050.png --start 0.2,0.3,1.57 --goal 0.7,0.6
 
-A DLGPD model plans from its observations (rendered frames, or pole angles for the small preset) in its
-latent space, on GPs conditioned on --evidence: rollouts of the system at hand (`collect --rollouts N`,
-with --images for image models), encoded without retraining. Its CEM also stops once the first action's
-std is ≤ 0.01; `--iters 30 --no-warm-start` is the authors' planner.
+A DLGPD model plans from its observations (rendered frames, or pole angles for the small preset) in its latent space, on GPs conditioned on --evidence: rollouts of the system at hand (`collect --rollouts N`, with --images for image models), encoded without retraining. Its CEM also stops once the first action's std is ≤ 0.01; `--iters 30 --no-warm-start` is the authors' planner.
 
-The pendulum starts hanging (θ ~ U[π-0.05, π+0.05], θ̇ ~ U[-0.05, 0.05]); success means each of the
-last 25 rewards is above -1 (thesis 3.5.2).
+The pendulum starts hanging (θ ~ U[π-0.05, π+0.05], θ̇ ~ U[-0.05, 0.05]); success means each of the last 25 rewards is above -1 (thesis 3.5.2).
 
-The unicycle (TRADYN, thesis 5.4.3) drives from --start x,y,φ at rest to --goal x,y on --map for 50 steps,
-minimizing ½Σ throttle² plus the terminal squared distance normalized over the candidates (eq. 5.13);
-success means a final distance of at most 5 cm. The robot is the one --instance-seed draws (Table 5.1),
-or the nominal robot (mass 2.5, gains 750 and 3π/16) without it. `--model true` plans on the simulator
-itself (an oracle); a TRADYN model plans with the mean of q(β | --context), the prior's mean without it.")]
+The unicycle (TRADYN, thesis 5.4.3) drives from --start x,y,φ at rest to --goal x,y on --map for 50 steps, minimizing ½Σ throttle² plus the terminal squared distance normalized over the candidates (eq. 5.13); success means a final distance of at most 5 cm. The robot is the one --instance-seed draws (Table 5.1), or the nominal robot (mass 2.5, gains 750 and 3π/16) without it. `--model true` plans on the simulator itself (an oracle); a TRADYN model plans with the mean of q(β | --context), the prior's mean without it.")]
 pub struct PlanOptions {
     #[arg(long, value_parser = crate::jobs::names::plan_envs(), hide_possible_values = true, help = concat!("Environment: ", crate::pendulum_envs!(), " or unicycle"))]
     env: String,

@@ -28,12 +28,9 @@ Examples:
   mbrl solve-board --game tileswap --random-depth 5 --model true --embodiment reacher
   mbrl solve-board --model models/seads-tileswap-cursor --random-depth 3 --split test
 
-With a SEADS checkpoint as --model, the game and embodiment are the checkpoint's: its forward model plans
-(bidirectional search where the model proves self-inverse on every state it expands, else one-sided) and
-its skill policies play the plan, replanning when the board differs from the prediction.
+With a SEADS checkpoint as --model, the game and embodiment are the checkpoint's: its forward model plans (bidirectional search where the model proves self-inverse on every state it expands, else one-sided) and its skill policies play the plan, replanning when the board differs from the prediction.
 
-Boards are comma-separated field values, row-major: 0/1 lights for LightsOut (n*n values), the chip
-number 0-8 on each field for TileSwap (solved: 0,1,2,...,8).")]
+Boards are comma-separated field values, row-major: 0/1 lights for LightsOut (n*n values), the chip number 0-8 on each field for TileSwap (solved: 0,1,2,...,8).")]
 pub struct SolveBoardOptions {
     /// Game: lightsout (5x5), lightsout:<n>x<n> (n = 2..13), tileswap (default with a SEADS --model: its game).
     #[arg(long, value_parser = crate::jobs::names::games(), hide_possible_values = true)]

@@ -2,10 +2,10 @@
 
 use std::path::PathBuf;
 
-use clap::Args;
+use clap::{Args, ValueEnum};
 
 use super::shared::{check_steps, train, RunOptions, TrainSummary};
-use super::ScalePreset;
+use crate::jobs::overrides::Overrides;
 use crate::jobs::{Invocation, Job};
 use crate::models::context::options::ContextOptions as ContextSettings;
 use crate::models::context::{self, Context};
@@ -13,15 +13,12 @@ use crate::models::tradyn::{self, Tradyn};
 use crate::train::Request;
 use crate::Result;
 
-/// The flags context and TRADYN share: the model and its training are the same.
+/// The flags context and TRADYN share: the model and its training are the same; their presets differ.
 #[derive(Args, Debug)]
 pub struct ContextModelOptions {
-    /// Hyperparameters from a TOML file (keys of config.json's `config` table), over the preset's.
+    /// Hyperparameters over the preset's: a TOML file of config keys, or a run's config.json to rerun it.
     #[arg(long)]
     config: Option<PathBuf>,
-    /// Network size and training length (default: small; paper: Table B.1).
-    #[arg(long, value_enum)]
-    preset: Option<ScalePreset>,
     /// Optimizer steps (default: the preset's); the p_ctx schedule keeps its shares of the run.
     #[arg(long)]
     steps: Option<u64>,
@@ -31,6 +28,40 @@ pub struct ContextModelOptions {
     /// Adam learning rate (default: the preset's).
     #[arg(long, value_parser = crate::jobs::finite_f64)]
     lr: Option<f64>,
+    #[command(flatten)]
+    set: Overrides,
+}
+
+/// Explore the Context's sizes (Table B.1 has a toy column and a pendulum/MountainCar column).
+#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ContextPreset {
+    /// Toy: 32 units, 20-state chunks, lr 3e-3, 1200 steps (about 25 s; what `eval quick` trains). Pendulum
+    /// and MountainCar: 64 units, 5000 steps (minutes).
+    Small,
+    /// The thesis networks (200 units) for a tenth of its steps: toy 5000, pendulum and MountainCar 10 000.
+    Medium,
+    /// Table B.1: 200 units; toy 50 000 steps at batch 64, pendulum and MountainCar 100 000 at batch 512 (days
+    /// on 2 cores).
+    Paper,
+}
+
+/// TRADYN's sizes: the context model's pendulum/MountainCar column, on the unicycle.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
+pub enum TradynPreset {
+    /// 64 units, 5000 steps at batch 64 (minutes on 2 cores; what `eval quick` trains).
+    Small,
+    /// 200 units, 10 000 steps at batch 128.
+    Medium,
+    /// 200 units, 100 000 steps at batch 512 (days on 2 cores).
+    Paper,
+}
+
+fn context_preset(preset: ContextPreset) -> context::Preset {
+    match preset {
+        ContextPreset::Small => context::Preset::Small,
+        ContextPreset::Medium => context::Preset::Medium,
+        ContextPreset::Paper => context::Preset::Paper,
+    }
 }
 
 #[derive(Args, Debug)]
@@ -41,7 +72,10 @@ pub struct ContextModelOptions {
 Examples:
   mbrl collect --env toy:inner --instances 1000 --steps 100 --out datasets/toy-inner.mcap
   mbrl train context --data datasets/toy-inner.mcap --preset small --out models/context-toy-inner
-  mbrl calibrate --model models/context-toy-inner --env toy:inner --instance-seed 3"
+  mbrl train context --data datasets/toy-inner.mcap --preset small steps=2400 kl_weight=2 --out models/context-toy-long
+  mbrl calibrate --model models/context-toy-inner --env toy:inner --instance-seed 3
+
+Settings apply in this order, each over the one before: the preset, the --config file, the flags, then KEY=VALUE arguments. --config takes TOML (keys of config.json's `config` table, nested ones as tables or dotted keys) or JSON: a run's own config.json reruns that run's config. An unknown KEY lists the valid keys of the method."
 )]
 pub struct ContextOptions {
     /// An instance-pair dataset (.mcap) from `mbrl collect --instances N`.
@@ -50,6 +84,9 @@ pub struct ContextOptions {
     /// The env the data must come from (default: the dataset's env).
     #[arg(long, value_parser = crate::jobs::names::envs(), hide_possible_values = true)]
     env: Option<String>,
+    /// Network size and training length (default: small).
+    #[arg(long, value_enum)]
+    preset: Option<ContextPreset>,
     #[command(flatten)]
     model: ContextModelOptions,
     #[command(flatten)]
@@ -65,7 +102,9 @@ Examples:
   mbrl collect --env terrain --maps 100 --out datasets/terrain
   mbrl collect --env unicycle --maps datasets/terrain --split train --instances 10000 --steps 100 --out datasets/unicycle-train.mcap
   mbrl train tradyn --data datasets/unicycle-train.mcap --preset small --out models/tradyn-terrain
-  mbrl train tradyn --no-terrain --data datasets/unicycle-train.mcap --preset small --out models/tradyn-no-terrain"
+  mbrl train tradyn --no-terrain --data datasets/unicycle-train.mcap --preset small --out models/tradyn-no-terrain
+
+Settings apply in this order, each over the one before: the preset, the --config file, the flags, then KEY=VALUE arguments. --config takes TOML (keys of config.json's `config` table, nested ones as tables or dotted keys) or JSON: a run's own config.json reruns that run's config. An unknown KEY lists the valid keys of the method."
 )]
 pub struct TradynOptions {
     /// A unicycle instance-pair dataset (.mcap): `collect --env unicycle --maps DIR --split train --instances N`.
@@ -77,6 +116,9 @@ pub struct TradynOptions {
     /// Ablation (thesis "−T"): no terrain lookup; the terrain features become part of the predicted state.
     #[arg(long)]
     no_terrain: bool,
+    /// Network size and training length (default: small).
+    #[arg(long, value_enum)]
+    preset: Option<TradynPreset>,
     #[command(flatten)]
     model: ContextModelOptions,
     #[command(flatten)]
@@ -84,17 +126,14 @@ pub struct TradynOptions {
 }
 
 impl ContextModelOptions {
-    fn settings(&self) -> ContextSettings {
+    fn settings(&self, preset: Option<context::Preset>) -> ContextSettings {
         ContextSettings {
-            preset: self.preset.map(|p| match p {
-                ScalePreset::Small => context::Preset::Small,
-                ScalePreset::Medium => context::Preset::Medium,
-                ScalePreset::Paper => context::Preset::Paper,
-            }),
+            preset,
             config_file: self.config.clone(),
             steps: self.steps,
             batch_size: self.batch,
             learning_rate: self.lr,
+            overrides: self.set.set.clone(),
         }
     }
 }
@@ -102,7 +141,7 @@ impl ContextModelOptions {
 pub fn prepare_context(options: ContextOptions, invocation: &Invocation) -> Result<Job<'static, TrainSummary>> {
     check_steps(options.model.steps)?;
     let data = &options.data;
-    let planned = options.model.settings().plan(
+    let planned = options.model.settings(options.preset.map(context_preset)).plan(
         data,
         options.env.as_deref(),
         || Ok(crate::data::read_dataset(data)?.meta.env),
@@ -125,7 +164,11 @@ pub fn prepare_tradyn(options: TradynOptions, invocation: &Invocation) -> Result
     let data_env = crate::data::read_dataset(data)?.meta.env;
     let terrain = !options.no_terrain;
     let planned = tradyn::options::plan(
-        &options.model.settings(),
+        &options.model.settings(options.preset.map(|p| match p {
+            TradynPreset::Small => context::Preset::Small,
+            TradynPreset::Medium => context::Preset::Medium,
+            TradynPreset::Paper => context::Preset::Paper,
+        })),
         data,
         &data_env,
         options.env.as_deref(),

@@ -10,13 +10,13 @@ mod shared;
 
 use std::path::PathBuf;
 
-use clap::{Args, Subcommand, ValueEnum};
+use clap::{Args, Subcommand};
 
 pub use self::ball::BallOptions;
-pub use self::context::{ContextModelOptions, ContextOptions, TradynOptions};
-pub use self::dlgpd::DlgpdOptions;
+pub use self::context::{ContextModelOptions, ContextOptions, ContextPreset, TradynOptions, TradynPreset};
+pub use self::dlgpd::{DlgpdOptions, DlgpdPresetChoice};
 pub use self::pets::{PetsOptions, PetsPreset, RewardChoice};
-pub use self::seads::SeadsOptions;
+pub use self::seads::{SeadsOptions, SeadsPreset};
 pub use self::shared::{RunOptions, TrainSummary};
 use super::{Invocation, Job};
 use crate::eval::training::write_loss_report;
@@ -29,31 +29,25 @@ use crate::{refuse, Result};
 #[command(
     args_conflicts_with_subcommands = true,
     after_help = "\
-Examples:
+Examples (in order: each uses what the ones before it wrote):
   mbrl collect --env pendulum --rollouts 200 --steps 30 --out datasets/pendulum-random.mcap
-  mbrl train pets --env pendulum --data datasets/pendulum-random.mcap --out models/pets-pendulum
-  mbrl train pets --data a.mcap --data b.mcap --preset medium --config pets.toml --out models/pets-big
-  mbrl train --resume models/pets-big
-  mbrl train --resume models/pets-big --steps 8000
+  mbrl train pets --data datasets/pendulum-random.mcap --out models/pets-pendulum
+  mbrl train pets --data datasets/pendulum-random.mcap --preset medium steps=3000 optimizer.learning_rate=3e-4 --out models/pets-medium
+  mbrl train pets --data datasets/pendulum-random.mcap --config models/pets-medium/config.json --out models/pets-medium-again
+  mbrl train --resume models/pets-medium --steps 8000
   mbrl collect --env ball --trajectories 108 --augment-rotations 19 --out datasets/ball-train.mcap
   mbrl train ball-ekf --data datasets/ball-train.mcap --out models/ball-ekf --steps 2000
   mbrl collect --env toy:inner --instances 1000 --steps 100 --out datasets/toy-inner.mcap
   mbrl train context --data datasets/toy-inner.mcap --preset small --out models/context-toy-inner
   mbrl train seads --env tileswap:cursor --preset small --out models/seads-tileswap-cursor
-  mbrl train seads --env lightsout:cursor --preset medium --no-novelty --out models/seads-lo-nonov
+  mbrl train seads --env lightsout:cursor --preset medium --no-novelty --out models/seads-lo-no-novelty
   mbrl collect --env pendulum --rollouts 500 --steps 29 --out datasets/pendulum-dlgpd.mcap
   mbrl train dlgpd --data datasets/pendulum-dlgpd.mcap --preset small --out models/dlgpd-small
-  mbrl collect --env pendulum --images --rollouts 500 --steps 29 --out datasets/pendulum-frames.mcap
-  mbrl train dlgpd --data datasets/pendulum-frames.mcap --preset medium --out models/dlgpd-medium
-  mbrl train dlgpd --help                # the flags one method takes
+  mbrl train dlgpd --help                # one method's flags, presets and examples
 
-A config file (TOML) sets any key of the method's config.json `config` table; unknown keys are errors.
-Flags given explicitly override the file. `--resume DIR` continues a stopped run from its last checkpoint
-with the config and data it was started with, and ends with the same bytes as an uninterrupted run.
-`--resume DIR --steps N` trains a pets or dlgpd run, finished or not, on to N steps in total; its weights
-end as those of a run started with N steps, when the old total was a multiple of the validation interval.
-`mbrl train METHOD … --out DIR --resume-if-stopped` resumes DIR's stopped run of the same command instead
-of refusing it, so a re-run script loses none of an interrupted run's training."
+Each method's settings apply in this order, each over the one before: its preset, the --config file, its flags, then KEY=VALUE arguments (any key of config.json's `config` table, e.g. steps=500 or optimizer.learning_rate=3e-4). --config takes TOML or JSON: a run's own config.json reruns that run's config. An unknown KEY lists the method's valid keys.
+
+`--resume DIR` continues a stopped run from its last checkpoint with the config and data it was started with, and ends with the same bytes as an uninterrupted run. `--resume DIR --steps N` trains a pets or dlgpd run, finished or not, on to N steps in total; its weights end as those of a run started with N steps, when the old total was a multiple of the validation interval. `mbrl train METHOD … --out DIR --resume-if-stopped` resumes DIR's stopped run of the same command instead of refusing it, so a re-run script loses none of an interrupted run's training."
 )]
 pub struct TrainOptions {
     #[command(subcommand)]
@@ -86,17 +80,6 @@ pub enum MethodOptions {
     /// DLGPD (thesis ch. 3): a VAE on pendulum frames (`collect --images`) with Gaussian-process latent
     /// dynamics and reward; plan with `mbrl plan --model DIR --evidence E.mcap`.
     Dlgpd(DlgpdOptions),
-}
-
-/// The presets of context, TRADYN, SEADS and DLGPD; what each sets is in the method's config.
-#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
-pub enum ScalePreset {
-    /// Minutes on 2 cores: what `eval quick` and the tests train.
-    Small,
-    /// The largest scale the README's reproductions run on 2 cores.
-    Medium,
-    /// The paper's networks and training budgets (days on 2 cores for most methods).
-    Paper,
 }
 
 /// The usage error of `mbrl train` with neither a method nor `--resume`: the binary raises it as clap's own,

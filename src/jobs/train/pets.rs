@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use clap::{Args, ValueEnum};
 
 use super::shared::{check_steps, train, RunOptions, TrainSummary};
+use crate::jobs::overrides::Overrides;
 use crate::jobs::{Invocation, Job};
 use crate::models::pets::options as pets_options;
 use crate::models::pets::{Pets, Preset, RewardSource};
@@ -18,9 +19,12 @@ use crate::Result;
     after_help = "\
 Examples:
   mbrl collect --env pendulum --rollouts 200 --steps 30 --out datasets/pendulum-random.mcap
-  mbrl train pets --env pendulum --data datasets/pendulum-random.mcap --out models/pets-pendulum
-  mbrl train pets --data a.mcap --data b.mcap --preset medium --config pets.toml --out models/pets-big
-  mbrl train --resume models/pets-big --steps 8000"
+  mbrl train pets --data datasets/pendulum-random.mcap --out models/pets-pendulum
+  mbrl train pets --data datasets/pendulum-random.mcap --preset medium steps=3000 optimizer.learning_rate=3e-4 --out models/pets-medium
+  mbrl train pets --data datasets/pendulum-random.mcap --config models/pets-medium/config.json --out models/pets-medium-again
+  mbrl train --resume models/pets-medium --steps 8000
+
+Settings apply in this order, each over the one before: the preset, the --config file, the flags, then KEY=VALUE arguments. --config takes TOML (keys of config.json's `config` table, nested ones as tables or dotted keys) or JSON: a run's own config.json reruns that run's config. An unknown KEY lists the valid keys of the method."
 )]
 pub struct PetsOptions {
     /// Rollout datasets (.mcap) of one env, merged (repeatable).
@@ -29,7 +33,7 @@ pub struct PetsOptions {
     /// The env the data must come from (default: the dataset's env).
     #[arg(long, value_parser = crate::jobs::names::envs(), hide_possible_values = true)]
     env: Option<String>,
-    /// Hyperparameters from a TOML file (keys of config.json's `config` table), over the preset's.
+    /// Hyperparameters over the preset's: a TOML file of config keys, or a run's config.json to rerun it.
     #[arg(long)]
     config: Option<PathBuf>,
     /// Network size and training length (default: small).
@@ -52,6 +56,8 @@ pub struct PetsOptions {
     reward: Option<RewardChoice>,
     #[command(flatten)]
     run: RunOptions,
+    #[command(flatten)]
+    set: Overrides,
 }
 
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
@@ -86,6 +92,7 @@ impl PetsOptions {
                 RewardChoice::Known => RewardSource::Known,
                 RewardChoice::Learned => RewardSource::Learned,
             }),
+            overrides: self.set.set.clone(),
         }
     }
 }

@@ -1,13 +1,15 @@
-//! What `mbrl train pets` may ask for, and the defaults that turn it into a run: the preset's config, a TOML
-//! file over it, then each setting given; the reward and the output directory follow the data's env.
+//! What `mbrl train pets` may ask for, and the defaults that turn it into a run: the preset's config, a config
+//! file over it, then each flag given, then each `KEY=VALUE`; the reward and the output directory follow the
+//! data's env.
 
 use std::path::PathBuf;
 
 use super::{PetsConfig, Preset, RewardSource};
 use crate::envs::parse_env;
 use crate::error::Result;
-use crate::train::config::apply_toml_file;
+use crate::train::config::apply_config_file;
 use crate::train::run_dir::default_out;
+use crate::train::settings::{apply_overrides, Override};
 
 #[derive(Clone, Debug, Default)]
 pub struct PetsOptions {
@@ -18,6 +20,7 @@ pub struct PetsOptions {
     pub batch_size: Option<usize>,
     pub learning_rate: Option<f64>,
     pub reward: Option<RewardSource>,
+    pub overrides: Vec<Override>,
 }
 
 /// A new run's config and directory.
@@ -28,8 +31,8 @@ pub struct Planned {
 
 impl PetsOptions {
     /// The config for data of `data_env` (the dataset's env, asked only when the default needs it) written to
-    /// `out` (default `models/pets-<env>`). A reward neither asked for nor set by the file is the env's closed
-    /// form where it has one, else learned.
+    /// `out` (default `models/pets-<env>`). A reward neither asked for (flag or `reward=`) nor set by a file is
+    /// the env's closed form where it has one, else learned.
     pub fn plan(
         &self,
         env: Option<&str>,
@@ -41,7 +44,8 @@ impl PetsOptions {
             Some(env) => env.to_string(),
             None => data_env()?,
         };
-        if self.reward.is_none() && self.config_file.is_none() && parse_env(&env)?.known_reward().is_none() {
+        let asked = self.reward.is_some() || self.overrides.iter().any(|o| o.sets("reward"));
+        if !asked && self.config_file.is_none() && parse_env(&env)?.known_reward().is_none() {
             config.reward = RewardSource::Learned;
         }
         let out = out.unwrap_or_else(|| default_out(&format!("pets-{env}")));
@@ -51,7 +55,7 @@ impl PetsOptions {
     fn config(&self) -> Result<PetsConfig> {
         let mut config = PetsConfig::preset(self.preset.unwrap_or(Preset::Small));
         if let Some(path) = &self.config_file {
-            config = apply_toml_file(&config, path)?;
+            config = apply_config_file(&config, path, &[super::METHOD])?;
         }
         if let Some(n) = self.ensemble {
             config.ensemble = n;
@@ -68,6 +72,7 @@ impl PetsOptions {
         if let Some(reward) = self.reward {
             config.reward = reward;
         }
+        config = apply_overrides(config, &self.overrides)?;
         config.validate()?;
         Ok(config)
     }

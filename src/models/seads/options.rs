@@ -1,13 +1,14 @@
-//! What `mbrl train seads` may ask for: the preset for the game (its move count, its embodiment), a TOML file
-//! over it, then each setting given.
+//! What `mbrl train seads` may ask for: the preset for the game (its move count, its embodiment), a config
+//! file over it, then each flag given, then each `KEY=VALUE`.
 
 use std::path::PathBuf;
 
 use super::{EmbodiedGame, Preset, SeadsConfig};
 use crate::envs::embodiments::Embodiment;
 use crate::error::Result;
-use crate::train::config::apply_toml_file;
+use crate::train::config::apply_config_file;
 use crate::train::run_dir::default_out;
+use crate::train::settings::{apply_overrides, Override};
 
 #[derive(Clone, Debug, Default)]
 pub struct SeadsOptions {
@@ -18,6 +19,7 @@ pub struct SeadsOptions {
     pub no_relabel: bool,
     pub no_second_best: bool,
     pub no_novelty: bool,
+    pub overrides: Vec<Override>,
 }
 
 impl SeadsOptions {
@@ -25,7 +27,7 @@ impl SeadsOptions {
         let cursor = game.embodiment == Embodiment::Cursor;
         let mut config = SeadsConfig::preset(self.preset.unwrap_or(Preset::Small), game.moves(), cursor);
         if let Some(path) = &self.config_file {
-            config = apply_toml_file(&config, path)?;
+            config = apply_config_file(&config, path, &[super::METHOD])?;
         }
         if let Some(k) = self.skills {
             config.skills = k;
@@ -42,6 +44,7 @@ impl SeadsOptions {
         if self.no_novelty {
             config.reward.novelty = false;
         }
+        config = apply_overrides(config, &self.overrides)?;
         config.validate()?;
         Ok(config)
     }
