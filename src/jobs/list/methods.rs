@@ -4,7 +4,7 @@
 use clap::{Command, Subcommand, ValueEnum};
 
 use super::Table;
-use crate::jobs::train::{MethodOptions, PetsPreset, ScalePreset};
+use crate::jobs::train::{ContextPreset, DlgpdPresetChoice, MethodOptions, PetsPreset, SeadsPreset, TradynPreset};
 use crate::models::registry::METHODS;
 
 pub fn table() -> Table {
@@ -35,14 +35,16 @@ pub fn trains_on(method: &str) -> &'static str {
 
 /// The `--preset` values `mbrl train METHOD` takes.
 pub fn presets(method: &str) -> String {
-    let names = |values: Vec<clap::builder::PossibleValue>| {
-        values.iter().map(|v| v.get_name().to_string()).collect::<Vec<_>>().join(", ")
-    };
+    fn names<E: ValueEnum>() -> String {
+        let values = E::value_variants().iter().filter_map(ValueEnum::to_possible_value);
+        values.map(|v| v.get_name().to_string()).collect::<Vec<_>>().join(", ")
+    }
     match method {
-        "pets" => names(PetsPreset::value_variants().iter().filter_map(ValueEnum::to_possible_value).collect()),
-        "context" | "tradyn" | "dlgpd" | "seads" => {
-            names(ScalePreset::value_variants().iter().filter_map(ValueEnum::to_possible_value).collect())
-        }
+        "pets" => names::<PetsPreset>(),
+        "context" => names::<ContextPreset>(),
+        "tradyn" => names::<TradynPreset>(),
+        "dlgpd" => names::<DlgpdPresetChoice>(),
+        "seads" => names::<SeadsPreset>(),
         _ => "— (the thesis' settings)".into(),
     }
 }

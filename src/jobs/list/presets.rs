@@ -2,7 +2,7 @@
 //! its cost: the work it does (derived from the preset) and, for the small presets, a measured wall time.
 
 use super::Table;
-use crate::jobs::train::{PetsPreset, ScalePreset};
+use crate::jobs::train::PetsPreset;
 use crate::models::ball::learn::TrainSettings;
 use crate::models::context_net::{ContextConfig, EnvFamily, Preset as ContextPreset};
 use crate::models::dlgpd::config::{DlgpdConfig, Preset as DlgpdPreset};
@@ -40,9 +40,9 @@ pub fn table() -> Table {
     }
     for (preset, name) in scale_presets() {
         let engine = match preset {
-            ScalePreset::Small => ContextPreset::Small,
-            ScalePreset::Medium => ContextPreset::Medium,
-            ScalePreset::Paper => ContextPreset::Paper,
+            Scale::Small => ContextPreset::Small,
+            Scale::Medium => ContextPreset::Medium,
+            Scale::Paper => ContextPreset::Paper,
         };
         for (family, label) in [(EnvFamily::Toy, "toy"), (EnvFamily::Control, "pendulum, mountaincar, unicycle")] {
             let c = ContextConfig::preset(engine, family);
@@ -63,9 +63,9 @@ pub fn table() -> Table {
     }
     for (preset, name) in scale_presets() {
         let c = DlgpdConfig::preset(match preset {
-            ScalePreset::Small => DlgpdPreset::Small,
-            ScalePreset::Medium => DlgpdPreset::Medium,
-            ScalePreset::Paper => DlgpdPreset::Paper,
+            Scale::Small => DlgpdPreset::Small,
+            Scale::Medium => DlgpdPreset::Medium,
+            Scale::Paper => DlgpdPreset::Paper,
         });
         let network = match c.images {
             true => format!("conv VAE on 64×64 frames, latent {}", c.latent_dim),
@@ -76,9 +76,9 @@ pub fn table() -> Table {
     }
     for (preset, name) in scale_presets() {
         let engine = match preset {
-            ScalePreset::Small => SeadsPreset::Small,
-            ScalePreset::Medium => SeadsPreset::Medium,
-            ScalePreset::Paper => SeadsPreset::Paper,
+            Scale::Small => SeadsPreset::Small,
+            Scale::Medium => SeadsPreset::Medium,
+            Scale::Paper => SeadsPreset::Paper,
         };
         for (cursor, family) in [(true, "<game>:cursor"), (false, "<game>:reacher")] {
             // The skill count (the game's moves) changes no size listed here.
@@ -103,8 +103,16 @@ pub fn table() -> Table {
     table
 }
 
-fn scale_presets() -> [(ScalePreset, &'static str); 3] {
-    [(ScalePreset::Small, "small"), (ScalePreset::Medium, "medium"), (ScalePreset::Paper, "paper")]
+/// The three scales every method but PETS offers (each method's own `--preset` enum names them alike).
+#[derive(Clone, Copy)]
+enum Scale {
+    Small,
+    Medium,
+    Paper,
+}
+
+fn scale_presets() -> [(Scale, &'static str); 3] {
+    [(Scale::Small, "small"), (Scale::Medium, "medium"), (Scale::Paper, "paper")]
 }
 
 /// 2560000 → "2.56M": counts to three significant digits.
@@ -136,9 +144,16 @@ mod tests {
         let listed = |method: &str| -> Vec<String> {
             table.rows().iter().filter(|r| r[0] == method).map(|r| r[1].clone()).collect()
         };
-        for method in ["context", "dlgpd", "seads"] {
-            for value in ScalePreset::value_variants() {
-                let name = value.to_possible_value().unwrap().get_name().to_string();
+        fn names<E: ValueEnum>() -> Vec<String> {
+            E::value_variants().iter().map(|v| v.to_possible_value().unwrap().get_name().to_string()).collect()
+        }
+        let methods = [
+            ("context", names::<crate::jobs::train::ContextPreset>()),
+            ("dlgpd", names::<crate::jobs::train::DlgpdPresetChoice>()),
+            ("seads", names::<crate::jobs::train::SeadsPreset>()),
+        ];
+        for (method, presets) in methods {
+            for name in presets {
                 assert!(listed(method).contains(&name), "{method} {name}");
             }
         }
