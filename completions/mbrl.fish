@@ -42,8 +42,8 @@ complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "filter" -d 'Filter table-
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "predict" -d 'Predict table-tennis ball trajectories: filter until a horizon before the end, then predict ahead'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "solve-board" -d 'Find a shortest solution of a LightsOut or TileSwap board and optionally play it with a manipulator'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "eval" -d 'Run an evaluation protocol and write a report directory (report.md, CSV, PNG, summary.json, config.json)'
-complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "watch" -d 'Follow a running or finished run (training or eval) in the live view'
-complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "export" -d 'Convert a dataset, board set, ball recording or filter-estimate file to CSV or NumPy `.npz`'
+complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "watch" -d 'Follow running or finished runs (training or eval) in the live view; several runs are overlaid'
+complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "export" -d 'Convert a dataset, board set, ball recording or filter-estimate file to CSV or NumPy `.npz`, or a run\'s metrics to CSV'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "completions" -d 'Print a shell completion script'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l env -d 'Environment: pendulum[:light|heavy|mass=<m>|inverted|quadrant], toy:inner|outer, mountaincar, unicycle (with --map or --maps), terrain (map sets), lightsout[:<n>x<n>], tileswap, <game>:cursor|reacher (a board game played by a manipulator, e.g. lightsout:cursor), ball' -r
@@ -598,9 +598,9 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -l force -d 'Replace an
 complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -s V -l version -d 'Print version'
-complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l input -d 'An mbrl MCAP file: a dataset (`collect`), board set, ball recording or `filter --out *.mcap` output' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l out -d 'Output file; its extension (.csv or .npz) chooses the format unless --format is given' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l format -d 'csv or npz; must agree with --out\'s extension when that names a format' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l input -d 'An mbrl MCAP file (a dataset from `collect`, board set, ball recording or `filter --out *.mcap` output), or a run directory (or its metrics.jsonl) whose metrics to export' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l out -d 'Output file; its extension (.csv or .npz) chooses the format unless --format is given. Default: beside the input (see below)' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l format -d 'csv or npz (metrics: csv only); must agree with --out\'s extension when that names a format' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
@@ -629,8 +629,8 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subc
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "predict" -d 'Predict table-tennis ball trajectories: filter until a horizon before the end, then predict ahead'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "solve-board" -d 'Find a shortest solution of a LightsOut or TileSwap board and optionally play it with a manipulator'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "eval" -d 'Run an evaluation protocol and write a report directory (report.md, CSV, PNG, summary.json, config.json)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "watch" -d 'Follow a running or finished run (training or eval) in the live view'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "export" -d 'Convert a dataset, board set, ball recording or filter-estimate file to CSV or NumPy `.npz`'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "watch" -d 'Follow running or finished runs (training or eval) in the live view; several runs are overlaid'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "export" -d 'Convert a dataset, board set, ball recording or filter-estimate file to CSV or NumPy `.npz`, or a run\'s metrics to CSV'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "completions" -d 'Print a shell completion script'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export completions help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and __fish_seen_subcommand_from train" -f -a "pets" -d 'Probabilistic ensemble of MLPs on (state, action) → state change (PETS, Chua et al. 2018), for any env that `collect` rolls out; plan with it via `mbrl plan --model DIR`'
