@@ -91,7 +91,11 @@ impl WatchedRun {
 /// Follows `runs` until every one has finished, `stop` is set, or `send` returns false (its receiver is gone),
 /// sending each new event and each change of a run's lock. The backlog each run has at the start comes with
 /// only its latest progress (see [`latest_progress_only`]).
-pub fn follow_runs(mut runs: Vec<WatchedRun>, stop: &AtomicBool, mut send: impl FnMut(RunUpdate) -> bool) -> Result<()> {
+pub fn follow_runs(
+    mut runs: Vec<WatchedRun>,
+    stop: &AtomicBool,
+    mut send: impl FnMut(RunUpdate) -> bool,
+) -> Result<()> {
     let mut backlog = true;
     while !stop.load(Ordering::Relaxed) {
         for (run, watched) in runs.iter_mut().enumerate().filter(|(_, w)| !w.finished) {
@@ -184,7 +188,8 @@ mod tests {
             std::fs::write(run.join("metrics.jsonl"), lines.concat()).unwrap();
             WatchedRun::open(&run).unwrap()
         };
-        let a = write("a", &[Event::progress("train", 1, 9), Event::progress("train", 2, 9), Event::Finished { ok: true }]);
+        let a =
+            write("a", &[Event::progress("train", 1, 9), Event::progress("train", 2, 9), Event::Finished { ok: true }]);
         let b = write("b", &[Event::scalar("loss", 4, 1.0), Event::Finished { ok: false }]);
         let mut updates = Vec::new();
         follow_runs(vec![a, b], &AtomicBool::new(false), |u| {

@@ -226,7 +226,10 @@ mod tests {
         assert!(screen.contains("┌ m4 ") && !screen.contains("┌ m5 "), "{screen}");
         overlay.handle_key(KeyEvent::new(crossterm::event::KeyCode::Right, crossterm::event::KeyModifiers::NONE));
         let screen = draw(&overlay, 80, 24);
-        assert!(screen.contains("metrics 2-5 of 5") && screen.contains("┌ m5 ") && !screen.contains("┌ m1 "), "{screen}");
+        assert!(
+            screen.contains("metrics 2-5 of 5") && screen.contains("┌ m5 ") && !screen.contains("┌ m1 "),
+            "{screen}"
+        );
     }
 
     #[test]

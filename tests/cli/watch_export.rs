@@ -53,8 +53,7 @@ fn a_runs_metrics_export_as_one_long_table_and_several_runs_watch_as_status_line
     let last: serde_json::Value = jsonl
         .lines()
         .filter_map(|l| serde_json::from_str::<serde_json::Value>(l).ok())
-        .filter(|v| v["name"] == "train/loss")
-        .last()
+        .rfind(|v| v["name"] == "train/loss")
         .unwrap();
     assert_eq!(train.last().unwrap().1, last["value"].as_f64().unwrap());
 
@@ -68,6 +67,10 @@ fn a_runs_metrics_export_as_one_long_table_and_several_runs_watch_as_status_line
     assert_eq!(metric_rows(&d.join("a.csv")).len(), 10 + 2);
     let npz = mbrl(d).args(["export", "--input", "runs/a", "--out", "a.npz"]).output().unwrap();
     assert_one_line_error(&npz, &["--format npz", "csv only", "runs/a"]);
+
+    // A data file's default goes beside it, with the format's extension.
+    ok(d, &["export", "--input", "roll.mcap"]);
+    assert!(d.join("roll.csv").is_file());
 
     // Two directories named `a`: their legends keep the parent that tells them apart.
     let watch = ok(d, &["watch", "runs/a", "other/a"]);
