@@ -2116,13 +2116,17 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__train__subcmd__ball__subcmd__ekf)
-            opts="-q -h -V --data --steps --batch --chunk --lr --launcher-prior --resume-if-stopped --out --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --data --config --steps --batch --chunk --lr --launcher-prior --resume-if-stopped --out --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
             fi
             case "${prev}" in
                 --data)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --config)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
@@ -2166,7 +2170,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__train__subcmd__context)
-            opts="-q -h -V --data --env --config --preset --steps --batch --lr --resume-if-stopped --out --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --data --env --preset --config --steps --batch --lr --resume-if-stopped --out --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -2180,12 +2184,12 @@ _mbrl() {
                     COMPREPLY=($(compgen -W "pendulum pendulum:light pendulum:heavy pendulum:inverted pendulum:quadrant toy:inner toy:outer mountaincar unicycle terrain lightsout tileswap lightsout:cursor lightsout:reacher tileswap:cursor tileswap:reacher ball" -- "${cur}"))
                     return 0
                     ;;
-                --config)
-                    COMPREPLY=($(compgen -f "${cur}"))
-                    return 0
-                    ;;
                 --preset)
                     COMPREPLY=($(compgen -W "small medium paper" -- "${cur}"))
+                    return 0
+                    ;;
+                --config)
+                    COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
                 --steps)
@@ -2510,7 +2514,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__train__subcmd__tradyn)
-            opts="-q -h -V --data --env --no-terrain --config --preset --steps --batch --lr --resume-if-stopped --out --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --data --env --no-terrain --preset --config --steps --batch --lr --resume-if-stopped --out --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -2524,12 +2528,12 @@ _mbrl() {
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
-                --config)
-                    COMPREPLY=($(compgen -f "${cur}"))
-                    return 0
-                    ;;
                 --preset)
                     COMPREPLY=($(compgen -W "small medium paper" -- "${cur}"))
+                    return 0
+                    ;;
+                --config)
+                    COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
                 --steps)
