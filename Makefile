@@ -112,7 +112,7 @@ repro-context: build $(CONTEXT_DATA)/toy-inner.mcap $(CONTEXT_DATA)/toy-outer.mc
 # Thesis 4.5.4 / Fig. 4.7 (MountainCar) at the scale measured on 2 cores: 10 000 instance pairs, the small
 # preset (64 units, batch 64) for 30 000 steps (≈ 25 min), then 50 unseen contexts of 50 calibration
 # transitions with EIG CEM 300 × 30 elites × 4 iterations and 10 β samples on one thread (≈ 25 min; the
-# figures in the README are this run's, seed 0).
+# figures in RESULTS.md are this run's, seed 0).
 repro-context-mountaincar: build $(CONTEXT_DATA)/mountaincar-10k.mcap
 	$(call train_or_resume,models/context/mountaincar-small,context --data $(CONTEXT_DATA)/mountaincar-10k.mcap --preset small --steps 30000 --seed $(SEED))
 	$(RUN) eval context --model models/context/mountaincar-small --env mountaincar --transitions 50 --horizon 30 --contexts 50 \
@@ -159,7 +159,7 @@ repro-seads: build
 # matching evidence, Wilcoxon over 6 pairs: ≈ 75 min on one core). The Figs. 3.4/3.5 analogues (5/10/20
 # evidence rollouts; standard, inverted, light, heavy) are DLGPD_EVAL="--evidence-rollouts 5,10,20 --runs 2
 # --candidates 300 --elites 30 --iters 10" (hours). The medium preset's 3000 steps reconstruct the pole but
-# do not swing up; DLGPD_STEPS=30000 (about 12 h of one core) is the length of the run the README reports,
+# do not swing up; DLGPD_STEPS=30000 (about 12 h of one core) is the length of the run RESULTS.md reports,
 # with one thread as there; an interrupted make resumes the stopped run. A finished run is trained further
 # with `mbrl train --resume DIR --steps N`.
 DLGPD_PRESET ?= medium
