@@ -47,16 +47,23 @@ pub fn compare(summary: &BallEvalSummary, ekf: &str, baseline: &str, oracle: &st
     horizons.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
     for group in &summary.groups {
         for &h in &horizons {
-            let per_shot = |method: &str| -> HashMap<&str, f64> {
+            // A pose set pools several launcher poses whose shots are numbered from 0 each, so a shot is its id
+            // and how often that id came before it; every method scores the shots in the same order.
+            let per_shot = |method: &str| -> HashMap<(&str, usize), f64> {
+                let mut seen: HashMap<&str, usize> = HashMap::new();
                 summary
                     .errors
                     .iter()
                     .filter(|e| e.method == method && &e.group == group && (e.horizon_s - h).abs() < 1e-9)
-                    .map(|e| (e.trajectory.as_str(), if e.error_m.is_finite() { e.error_m } else { FAILED_M }))
+                    .map(|e| {
+                        let k = seen.entry(e.trajectory.as_str()).or_insert(0);
+                        *k += 1;
+                        ((e.trajectory.as_str(), *k), if e.error_m.is_finite() { e.error_m } else { FAILED_M })
+                    })
                     .collect()
             };
             let (a, b) = (per_shot(ekf), per_shot(baseline));
-            let mut shots: Vec<&str> = a.keys().filter(|k| b.contains_key(*k)).copied().collect();
+            let mut shots: Vec<(&str, usize)> = a.keys().filter(|k| b.contains_key(*k)).copied().collect();
             shots.sort_unstable();
             let (Some(ekf_median), Some(baseline_median)) =
                 (summary.median_at(ekf, group, h), summary.median_at(baseline, group, h))
@@ -87,7 +94,8 @@ mod tests {
     use crate::eval::stats::quantile_counting_failures;
     use crate::run::dir::Provenance;
 
-    fn summary(ekf: &[f64], ridge: &[f64]) -> BallEvalSummary {
+    /// `ids[i]` names shot i (the unseen pose set repeats ids, one run of them per pose).
+    fn summary_with_ids(ekf: &[f64], ridge: &[f64], ids: &[usize]) -> BallEvalSummary {
         let mut errors = Vec::new();
         let mut rows = Vec::new();
         for (method, errs) in [("ekf", ekf), ("ridge", ridge)] {
@@ -96,7 +104,7 @@ mod tests {
                     method: method.into(),
                     group: "unseen".into(),
                     horizon_s: 1.0,
-                    trajectory: i.to_string(),
+                    trajectory: ids[i].to_string(),
                     error_m: e,
                 });
             }
@@ -128,6 +136,20 @@ mod tests {
             rows,
             side_view: Vec::new(),
         }
+    }
+
+    fn summary(ekf: &[f64], ridge: &[f64]) -> BallEvalSummary {
+        summary_with_ids(ekf, ridge, &(0..ekf.len()).collect::<Vec<_>>())
+    }
+
+    #[test]
+    fn shots_of_different_poses_with_the_same_id_stay_separate_pairs() {
+        let ekf = [0.10, 0.11, 0.12, 0.13, 0.14, 0.15];
+        let ridge = [0.20, 0.22, 0.25, 0.29, 0.34, 0.40];
+        // Three poses of two shots each: ids 0, 1, 0, 1, 0, 1.
+        let c = compare(&summary_with_ids(&ekf, &ridge, &[0, 1, 0, 1, 0, 1]), "ekf", "ridge", "oracle");
+        assert_eq!(c[0].n, 6);
+        assert_eq!(c[0].p_value, Some(1.0 / 64.0));
     }
 
     #[test]
