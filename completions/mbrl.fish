@@ -42,8 +42,8 @@ complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "filter" -d 'Filter table-
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "predict" -d 'Predict table-tennis ball trajectories: filter until a horizon before the end, then predict ahead'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "solve-board" -d 'Find a shortest solution of a LightsOut or TileSwap board and optionally play it with a manipulator'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "eval" -d 'Run an evaluation protocol and write a report directory (report.md, CSV, PNG, summary.json, config.json)'
-complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "watch" -d 'Follow a running or finished run (training or eval) in the live view'
-complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "export" -d 'Convert a dataset, board set, ball recording or filter-estimate file to CSV or NumPy `.npz`'
+complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "watch" -d 'Follow running or finished runs (training or eval) in the live view; several runs are overlaid'
+complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "export" -d 'Convert a dataset, board set, ball recording or filter-estimate file to CSV or NumPy `.npz`, or a run\'s metrics to CSV'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "list" -d 'List envs, methods, presets or embodiments with their parameters'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "completions" -d 'Print a shell completion script'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
@@ -174,7 +174,7 @@ lightsout:reacher\t''
 tileswap:cursor\t''
 tileswap:reacher\t''
 ball\t''"
-complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -l config -d 'Hyperparameters from a TOML file (keys of config.json\'s `config` table), over the preset\'s' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -l config -d 'Hyperparameters over the preset\'s: a TOML file of config keys, or a run\'s config.json to rerun it' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -l preset -d 'Network size and training length (default: small)' -r -f -a "small\t'3 hidden layers × 64 SiLU units, 2000 steps (≈ 10 s on 2 cores)'
 medium\t'4 × 200 SiLU units, 5000 steps: mbrl-lib\'s PETS pendulum network'"
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -l ensemble -d 'Ensemble members (default 5)' -r
@@ -196,6 +196,7 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcomm
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -s V -l version -d 'Print version'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from ball-ekf" -l data -d 'A ball dataset (.mcap) or a .csv recording' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from ball-ekf" -l config -d 'Training settings over the thesis\': a TOML file of config keys, or a run\'s config.json to rerun it' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from ball-ekf" -l steps -d 'Optimizer steps (default 1000)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from ball-ekf" -l batch -d 'Chunks in a batch (thesis: 64)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from ball-ekf" -l chunk -d 'Frames per chunk (thesis: 50)' -r
@@ -231,10 +232,10 @@ lightsout:reacher\t''
 tileswap:cursor\t''
 tileswap:reacher\t''
 ball\t''"
-complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -l config -d 'Hyperparameters from a TOML file (keys of config.json\'s `config` table), over the preset\'s' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -l preset -d 'Network size and training length (default: small; paper: Table B.1)' -r -f -a "small\t'Minutes on 2 cores: what `eval quick` and the tests train'
-medium\t'The largest scale the README\'s reproductions run on 2 cores'
-paper\t'The paper\'s networks and training budgets (days on 2 cores for most methods)'"
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -l preset -d 'Network size and training length (default: small)' -r -f -a "small\t'Toy: 32 units, 20-state chunks, lr 3e-3, 1200 steps (about 25 s; what `eval quick` trains). Pendulum and MountainCar: 64 units, 5000 steps (minutes)'
+medium\t'The thesis networks (200 units) for a tenth of its steps: toy 5000, pendulum and MountainCar 10 000'
+paper\t'Table B.1: 200 units; toy 50 000 steps at batch 64, pendulum and MountainCar 100 000 at batch 512 (days on 2 cores)'"
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -l config -d 'Hyperparameters over the preset\'s: a TOML file of config keys, or a run\'s config.json to rerun it' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -l steps -d 'Optimizer steps (default: the preset\'s); the p_ctx schedule keeps its shares of the run' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -l batch -d 'Chunks of consecutive states in a batch (default: the preset\'s)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -l lr -d 'Adam learning rate (default: the preset\'s)' -r
@@ -252,10 +253,10 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcomm
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -s V -l version -d 'Print version'
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -l data -d 'A unicycle instance-pair dataset (.mcap): `collect --env unicycle --maps DIR --split train --instances N`' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -l env -d 'The env: TRADYN models the unicycle, the only value taken' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -l config -d 'Hyperparameters from a TOML file (keys of config.json\'s `config` table), over the preset\'s' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -l preset -d 'Network size and training length (default: small; paper: Table B.1)' -r -f -a "small\t'Minutes on 2 cores: what `eval quick` and the tests train'
-medium\t'The largest scale the README\'s reproductions run on 2 cores'
-paper\t'The paper\'s networks and training budgets (days on 2 cores for most methods)'"
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -l preset -d 'Network size and training length (default: small)' -r -f -a "small\t'64 units, 5000 steps at batch 64 (minutes on 2 cores; what `eval quick` trains)'
+medium\t'200 units, 10 000 steps at batch 128'
+paper\t'200 units, 100 000 steps at batch 512 (days on 2 cores)'"
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -l config -d 'Hyperparameters over the preset\'s: a TOML file of config keys, or a run\'s config.json to rerun it' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -l steps -d 'Optimizer steps (default: the preset\'s); the p_ctx schedule keeps its shares of the run' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -l batch -d 'Chunks of consecutive states in a batch (default: the preset\'s)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from tradyn" -l lr -d 'Adam learning rate (default: the preset\'s)' -r
@@ -276,10 +277,10 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcomm
 lightsout:reacher\t''
 tileswap:cursor\t''
 tileswap:reacher\t''"
-complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -l config -d 'Hyperparameters from a TOML file (keys of config.json\'s `config` table), over the preset\'s' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -l preset -d 'Network sizes and budget (default: small; paper: 500k env steps on the Cursor, 10M on the Reacher)' -r -f -a "small\t'Minutes on 2 cores: what `eval quick` and the tests train'
-medium\t'The largest scale the README\'s reproductions run on 2 cores'
-paper\t'The paper\'s networks and training budgets (days on 2 cores for most methods)'"
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -l config -d 'Hyperparameters over the preset\'s: a TOML file of config keys, or a run\'s config.json to rerun it' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -l preset -d 'Network sizes and budget of environment steps (default: small)' -r -f -a "small\t'A short budget for tests and `eval quick` (about a minute for a Cursor game on 2 cores): SAC of 64 units and the paper\'s forward model (256 units) with 16 Adam steps per epoch instead of 4'
+medium\t'The paper\'s networks (256 units) on a fifth of the Cursor budget'
+paper\t'The paper\'s networks and budgets: 500k environment steps on the Cursor, 10M on the Reacher'"
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -l skills -d 'Number of skills K (default: the game\'s move count, 25 LightsOut, 12 TileSwap)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -l env-steps -d 'Budget of environment steps (default: the preset\'s)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from seads" -l out -d 'Checkpoint directory (default: models/seads-<env>)' -r -F
@@ -315,10 +316,10 @@ lightsout:reacher\t''
 tileswap:cursor\t''
 tileswap:reacher\t''
 ball\t''"
-complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l config -d 'Hyperparameters from a TOML file (keys of config.json\'s `config` table), over the preset\'s' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l preset -d 'Model and training size (default: small, which learns from the pole angle instead of frames)' -r -f -a "small\t'Minutes on 2 cores: what `eval quick` and the tests train'
-medium\t'The largest scale the README\'s reproductions run on 2 cores'
-paper\t'The paper\'s networks and training budgets (days on 2 cores for most methods)'"
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l config -d 'Hyperparameters over the preset\'s: a TOML file of config keys, or a run\'s config.json to rerun it' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l preset -d 'Model and training size (default: small, which learns from the pole angle instead of frames)' -r -f -a "small\t'An MLP VAE on the pole direction (cos θ, sin θ) instead of frames, batch 256, 3000 steps: minutes on 2 cores; any pendulum data'
+medium\t'The paper\'s conv VAE on 64 × 64 frames at batch 128 for 3000 steps (about an hour on 2 cores)'
+paper\t'The paper: batch 1024, 28 000 steps (2000 epochs of 14 000 transitions; days on 2 cores)'"
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l steps -d 'Optimizer steps (default: the preset\'s)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l batch -d 'Transitions in a batch (default: the preset\'s; the paper 1024)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l lr -d 'Adam learning rate (default 1e-3)' -r
@@ -507,7 +508,7 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l split -d 'Split the boards come from' -r -f -a "train\t''
 test\t''"
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l out -d 'Report directory (default: reports/embodied; when that exists, the first free reports/embodied-2, -3, …)' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l config -d 'Rerun the settings and seed an embodied report recorded (its config.json); no other flag but --out' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l config -d 'Rerun the settings and seed an embodied report recorded (its config.json); no other flag but --out, KEY=VALUE may change its settings' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
@@ -524,7 +525,7 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -l test-shots -d 'Default-pose test shots' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -l unseen-shots -d 'Test shots per unseen pose (5 poses)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -l out -d 'Report directory (default: reports/ball; when that exists, the first free reports/ball-2, -3, …)' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -l config -d 'Rerun the settings and seed a ball report recorded (its config.json); no other flag but --out' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -l config -d 'Rerun the settings and seed a ball report recorded (its config.json); no other flag but --out, KEY=VALUE may change its settings' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from ball" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
@@ -568,7 +569,7 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l swingup-steps -d 'Agent steps of each swing-up (thesis 50; the quadrant pendulum repeats each action twice)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l swingup-candidates -d 'CEM candidates of the swing-up planner (thesis 1000; elites are a tenth, 10 iterations, horizon 20)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l out -d 'Report directory (default: reports/context; when that exists, the first free reports/context-2, -3, …)' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l config -d 'Rerun the settings and seed a context report recorded (its config.json); no other flag but --out' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l config -d 'Rerun the settings and seed a context report recorded (its config.json); no other flag but --out, KEY=VALUE may change its settings' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
@@ -593,7 +594,7 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -l iters -d 'CEM iterations (thesis 20)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -l prediction-steps -d 'Length of the random rollout per task whose open-loop prediction is scored (thesis 50)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -l out -d 'Report directory (default: reports/tradyn; when that exists, the first free reports/tradyn-2, -3, …)' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -l config -d 'Rerun the settings and seed a tradyn report recorded (its config.json); no other flag but --out' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -l config -d 'Rerun the settings and seed a tradyn report recorded (its config.json); no other flag but --out, KEY=VALUE may change its settings' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from tradyn" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
@@ -614,7 +615,7 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 test\t''"
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l max-nodes -d 'A search storing more states than this counts as a failure (a model lacking a move can make the goal unreachable)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l out -d 'Report directory (default: reports/seads-<checkpoint name>)' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l config -d 'Rerun the settings and seed a seads report recorded (its config.json); no other flag but --out' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l config -d 'Rerun the settings and seed a seads report recorded (its config.json); no other flag but --out, KEY=VALUE may change its settings' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from seads" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
@@ -639,7 +640,7 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l elites -d 'CEM elites (the authors\': 100)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l iters -d 'At most this many CEM iterations per step (the authors\': 30, stopping at first-action std ≤ 0.01)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l out -d 'Report directory (default: reports/dlgpd; when that exists, the first free reports/dlgpd-2, -3, …)' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l config -d 'Rerun the settings and seed a dlgpd report recorded (its config.json); no other flag but --out' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l config -d 'Rerun the settings and seed a dlgpd report recorded (its config.json); no other flag but --out, KEY=VALUE may change its settings' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from dlgpd" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
@@ -673,7 +674,7 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 colored\t'Power spectral density ∝ 1/f^β along time (iCEM)'"
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l beta -d 'Exponent β of colored noise (0.5; used with --noise colored)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l out -d 'Report directory (default: reports/pendulum-swingup; when that exists, the first free reports/pendulum-swingup-2, -3, …)' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l config -d 'Rerun the settings and seed a swing-up report recorded (its config.json); no other flag but --out' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l config -d 'Rerun the settings and seed a swing-up report recorded (its config.json); no other flag but --out, KEY=VALUE may change its settings' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l threads -d 'Worker threads (0 = one per core)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from pendulum-swingup" -l max-memory-gib -d 'Refuse work whose flags ask for more memory than this (estimated before it starts)' -r
@@ -718,9 +719,9 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -l force -d 'Replace an
 complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -s q -l quiet -d 'Print only results and errors'
 complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -s h -l help -d 'Print help'
 complete -c mbrl -n "__fish_mbrl_using_subcommand watch" -s V -l version -d 'Print version'
-complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l input -d 'An mbrl MCAP file: a dataset (`collect`), board set, ball recording or `filter --out *.mcap` output' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l out -d 'Output file; its extension (.csv or .npz) chooses the format unless --format is given' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l format -d 'csv or npz; must agree with --out\'s extension when that names a format' -r -f -a "csv\t''
+complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l input -d 'An mbrl MCAP file (a dataset from `collect`, board set, ball recording or `filter --out *.mcap` output), or a run directory (or its metrics.jsonl) whose metrics to export' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l out -d 'Output file; its extension (.csv or .npz) chooses the format unless --format is given. Default: beside the input (see below)' -r -F
+complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l format -d 'csv or npz (metrics: csv only); must agree with --out\'s extension when that names a format' -r -f -a "csv\t''
 npz\t''"
 complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l seed -d 'Seed for every random choice; the same seed and thread count give the same output bytes' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand export" -l threads -d 'Worker threads (0 = one per core)' -r
@@ -760,8 +761,8 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subc
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export list completions help" -f -a "predict" -d 'Predict table-tennis ball trajectories: filter until a horizon before the end, then predict ahead'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export list completions help" -f -a "solve-board" -d 'Find a shortest solution of a LightsOut or TileSwap board and optionally play it with a manipulator'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export list completions help" -f -a "eval" -d 'Run an evaluation protocol and write a report directory (report.md, CSV, PNG, summary.json, config.json)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export list completions help" -f -a "watch" -d 'Follow a running or finished run (training or eval) in the live view'
-complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export list completions help" -f -a "export" -d 'Convert a dataset, board set, ball recording or filter-estimate file to CSV or NumPy `.npz`'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export list completions help" -f -a "watch" -d 'Follow running or finished runs (training or eval) in the live view; several runs are overlaid'
+complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export list completions help" -f -a "export" -d 'Convert a dataset, board set, ball recording or filter-estimate file to CSV or NumPy `.npz`, or a run\'s metrics to CSV'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export list completions help" -f -a "list" -d 'List envs, methods, presets or embodiments with their parameters'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export list completions help" -f -a "completions" -d 'Print a shell completion script'
 complete -c mbrl -n "__fish_mbrl_using_subcommand help; and not __fish_seen_subcommand_from collect plan train calibrate filter predict solve-board eval watch export list completions help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
