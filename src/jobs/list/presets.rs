@@ -44,7 +44,7 @@ pub fn table() -> Table {
             Scale::Medium => ContextPreset::Medium,
             Scale::Paper => ContextPreset::Paper,
         };
-        for (family, label) in [(EnvFamily::Toy, "toy"), (EnvFamily::Control, "pendulum, mountaincar, unicycle")] {
+        for (family, label) in [(EnvFamily::Toy, "toy"), (EnvFamily::Control, "control")] {
             let c = ContextConfig::preset(engine, family);
             let network = format!("GRU {}, MLPs {}, D_β {}", c.embedding, c.hidden_units, c.latent_dim);
             let transitions = c.steps * (c.batch_size * (c.chunk_states - 1)) as u64;
@@ -71,7 +71,7 @@ pub fn table() -> Table {
             true => format!("conv VAE on 64×64 frames, latent {}", c.latent_dim),
             false => format!("MLP VAE {} on (cos θ, sin θ), latent {}", c.hidden_units, c.latent_dim),
         };
-        let work = format!("{} transitions; GPs on {} points a step", si(c.steps * c.batch_size as u64), c.batch_size);
+        let work = format!("{} transitions", si(c.steps * c.batch_size as u64));
         add("dlgpd", name, "pendulum", network, c.steps.to_string(), c.batch_size.to_string(), work);
     }
     for (preset, name) in scale_presets() {
@@ -87,7 +87,7 @@ pub fn table() -> Table {
             let network = format!("SAC {sac}, model {}", c.model_hidden);
             let batch = format!("SAC {}, model {}", c.sac_batch, c.model_batch);
             let work = format!("{} env steps", si(c.env_steps));
-            add("seads", name, family, network, "until the env steps".into(), batch, work);
+            add("seads", name, family, network, "—".into(), batch, work);
         }
     }
     let ball = TrainSettings::default();
@@ -98,7 +98,8 @@ pub fn table() -> Table {
     table.note(
         "WORK = steps × batch (× ensemble members for pets): the samples a run processes, from the preset alone.",
     );
-    table.note("tradyn trains the context model with the pendulum/mountaincar/unicycle column of its presets.");
+    table.note("control = pendulum, mountaincar and unicycle; tradyn trains the context model with these rows.");
+    table.note("dlgpd fits its GPs on the batch's points every step; seads steps until its env-step budget is spent.");
     table.note("Measured: release build, 2-core machine with other builds running; the dataset is in brackets.");
     table
 }
