@@ -26,8 +26,10 @@ use crate::{refuse, Result};
 #[command(after_help = "\
 Examples:
   mbrl calibrate --model models/context-toy-inner --env toy:inner --instance-seed 7 --strategy open-loop --transitions 1 --out calib.mcap
-  mbrl calibrate --model models/context-pendulum-quadrant --env pendulum:quadrant --instance-seed 3 --strategy mpc --transitions 30 --horizon 20
-  mbrl plan --env pendulum:quadrant --model models/context-pendulum-quadrant --context calib.mcap --instance-seed 3
+  mbrl collect --env pendulum:quadrant --instances 2000 --steps 100 --out datasets/quadrant-pairs.mcap
+  mbrl train context --data datasets/quadrant-pairs.mcap --preset small --out models/context-pendulum-quadrant
+  mbrl calibrate --model models/context-pendulum-quadrant --env pendulum:quadrant --instance-seed 3 --strategy mpc --transitions 30 --horizon 20 --out calib-quadrant.mcap
+  mbrl plan --env pendulum:quadrant --model models/context-pendulum-quadrant --context calib-quadrant.mcap --instance-seed 3
   mbrl calibrate --model models/tradyn-terrain --env unicycle --map datasets/terrain/map050.png --instance-seed 4 --strategy random --init-state 0.2,0.3,0,1.57 --out calib-uni.mcap
 
 The instance (hidden parameters) is the one --instance-seed names in every command. Starts: toy and MountainCar at x = 0 (thesis), pendulum from its reset draw (--seed), or --init-state. The thesis uses CEM 1000 candidates / 100 elites / 10 iterations and 20 β samples; pendulum N = 30, H_max = 20; MountainCar N = 50, H_max = 30. The command prints the entropy of q(β | transitions) before and after. A TRADYN model calibrates with random colored actions (as its data were collected), 10 transitions by default, on the --map the robot drives on; the instance is the robot (mass, throttle and steering gains).")]

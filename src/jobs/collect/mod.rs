@@ -38,16 +38,18 @@ Examples:
   mbrl collect --env pendulum:inverted --images --rollouts 500 --steps 29 --out datasets/pendulum-inverted-images.mcap
   mbrl collect --env toy:inner --instances 5000 --steps 100 --out datasets/toy-inner-train.mcap
   mbrl collect --env mountaincar --instances 1000 --steps 100 --seed 1
+  printf '2\n2\n-2\n-2\n' > actions.csv        # one action per row; two columns for two action dimensions
+  printf '0.5,0\n0.5,0.2\n' > actions-2d.csv
   mbrl collect --env pendulum --actions actions.csv --init-state 3.14,0 --out datasets/replay.mcap
   mbrl collect --env mountaincar --actions actions.csv --instance-seed 7 --seed 2
   mbrl collect --env lightsout --boards --max-depth 5 --split test --out datasets/lightsout-test.mcap
   mbrl collect --env ball --trajectories 100 --augment-rotations 19 --out datasets/ball-train.mcap
   mbrl collect --env ball --trajectories 30 --orientation unseen-3 --out datasets/ball-unseen-3.mcap
   mbrl collect --env lightsout:cursor --episodes 1000 --seed 1 --out datasets/lightsout-cursor-random.mcap
-  mbrl collect --env tileswap:reacher --actions actions.csv --init-state 0.5,1.2,0,0 --board 1,0,2,3,4,5,6,7,8
+  mbrl collect --env tileswap:reacher --actions actions-2d.csv --init-state 0.5,1.2,0,0 --board 1,0,2,3,4,5,6,7,8
   mbrl collect --env terrain --maps 100 --out datasets/terrain
   mbrl collect --env unicycle --maps datasets/terrain --split train --instances 10000 --steps 100
-  mbrl collect --env unicycle --map datasets/terrain/map050.png --actions actions.csv --init-state 0.2,0.3,0,1.57
+  mbrl collect --env unicycle --map datasets/terrain/map050.png --actions actions-2d.csv --init-state 0.2,0.3,0,1.57
 
 Start states: θ ~ U[-π, π], θ̇ ~ U[-8, 8] (pendulum); s ~ N(0, I) (toy); x ~ U[-0.8, 0.8], ẋ ~ U[-2, 2] (mountaincar). Actions uniform in the env's bounds. Parametrized envs (pendulum:quadrant, toy:*, mountaincar) draw a new instance per rollout, or per pair with --instances (rollouts 2k and 2k+1 share instance k); the parameters go into the metadata.
 

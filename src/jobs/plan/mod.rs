@@ -24,7 +24,7 @@ Examples:
   mbrl plan --env pendulum --model true --horizon 20 --candidates 1000 --elites 100 --iters 10 --steps 150
   mbrl plan --env pendulum:heavy --model true --noise colored --beta 0.5 --out datasets/heavy-plan.mcap
   mbrl plan --env pendulum --model models/pets-pendulum --particles 20 --propagation tsinf
-  mbrl plan --env pendulum:quadrant --model models/context-pendulum-quadrant --context calib.mcap --instance-seed 3
+  mbrl plan --env pendulum:quadrant --model models/context-pendulum-quadrant --context calib-quadrant.mcap --instance-seed 3   # models and calibration: see `mbrl calibrate --help`
   mbrl collect --env pendulum:inverted --rollouts 20 --steps 29 --images --out datasets/evidence-inverted.mcap
   mbrl plan --env pendulum:inverted --model models/dlgpd-medium --evidence datasets/evidence-inverted.mcap
   mbrl plan --env unicycle --model models/tradyn-terrain --map datasets/terrain/map050.png --start 0.2,0.3,1.57 --goal 0.7,0.6 --context calib-uni.mcap --instance-seed 4
