@@ -10,7 +10,12 @@ pub enum Event {
     /// Sent once at the start: names the job and the method-specific panels the TUI should draw.
     Layout { title: String, panels: Vec<PanelSpec> },
     /// A scalar metric at a step. Names are slash-separated paths such as `cem/best_cost`.
-    Scalar { name: String, step: u64, value: f64 },
+    Scalar {
+        name: String,
+        step: u64,
+        #[serde(deserialize_with = "null_as_nan")]
+        value: f64,
+    },
     /// Progress of the current phase: `done` of `total` units.
     Progress { phase: String, done: u64, total: u64 },
     /// A human-readable note (a result line, a warning).
@@ -19,6 +24,12 @@ pub enum Event {
     Text { panel: String, text: String },
     /// The job ended; `ok` is false when it failed.
     Finished { ok: bool },
+}
+
+/// JSON has no NaN: serde_json writes a NaN (or infinite) metric as `null`, and a diverged loss must still
+/// read back, as the value it stands for, not as a broken line.
+fn null_as_nan<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(deserializer)?.unwrap_or(f64::NAN))
 }
 
 /// A method-specific plot: several scalar series drawn against their step.
@@ -102,6 +113,17 @@ mod tests {
         let line = serde_json::to_string(&event).expect("serialize");
         assert!(line.starts_with(r#"{"kind":"text","panel":"board","#), "{line}");
         assert_eq!(serde_json::from_str::<Event>(&line).expect("deserialize"), event);
+    }
+
+    #[test]
+    fn a_nan_metric_is_written_as_null_and_read_back_as_nan() {
+        let line = serde_json::to_string(&Event::scalar("train/loss", 3, f64::NAN)).expect("serialize");
+        assert!(line.contains(r#""value":null"#), "{line}");
+        match serde_json::from_str::<Event>(&line).expect("deserialize") {
+            Event::Scalar { step: 3, value, .. } => assert!(value.is_nan()),
+            other => panic!("{other:?}"),
+        }
+        assert!(serde_json::from_str::<Event>(r#"{"kind":"scalar","name":"a","step":1}"#).is_err());
     }
 
     #[test]
