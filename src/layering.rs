@@ -22,7 +22,8 @@ const FLOORS: &[(&str, u8)] = &[
     ("models", 9),
     ("eval", 10),
     ("tui", 10),
-    ("jobs", 11),
+    ("sweep", 11),
+    ("jobs", 12),
 ];
 
 /// Folders of `models/` that are one learning method each; shared pieces (`gp`, `context_net`) are not.

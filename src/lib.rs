@@ -13,6 +13,7 @@ pub mod nn;
 pub mod planning;
 pub mod rl;
 pub mod run;
+pub mod sweep;
 pub mod train;
 pub mod tui;
 pub mod util;

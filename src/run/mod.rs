@@ -3,6 +3,7 @@
 pub mod dir;
 pub mod event;
 pub mod follow;
+pub mod job_record;
 pub mod lock;
 pub mod monitor;
 pub mod watched;
