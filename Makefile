@@ -7,7 +7,7 @@ MBRL := target/release/mbrl
 RUN := $(MBRL) --force
 SEED ?= 0
 
-.PHONY: build test bench completions repro-quick repro-swingup repro-pendulum-data repro-boards repro-ball repro-pets repro-pets-loop repro-context repro-context-mountaincar repro-tradyn repro-seads repro-dlgpd clean-reports
+.PHONY: build test bench completions repro-quick repro-swingup repro-pendulum-data repro-boards repro-ball repro-pets repro-pets-loop repro-context repro-context-toy repro-context-mountaincar repro-tradyn repro-seads repro-dlgpd clean-reports
 
 build:
 	cargo build --release
@@ -45,24 +45,23 @@ repro-pendulum-data: build
 			--out datasets/$$(echo $$env | tr ':' '-')-random.mcap || exit 1; \
 	done
 
-# The basic model-based loop with PETS: 200 random rollouts of 30 steps, an ensemble of 5 trained on them,
-# and swing-ups planned on the learned model at the thesis' CEM settings (1000 candidates, 100 elites,
-# 10 iterations, horizon 20; 20 TS-inf particles). Each of 10 seeds trains its own ensemble on its own data
-# and plans one episode; the ground-truth model plans the same 10 episodes for comparison.
-PETS_SEEDS ?= 0 1 2 3 4 5 6 7 8 9
-datasets/pets/random-%.mcap: | $(MBRL)
-	$(RUN) collect --env pendulum --rollouts 200 --steps 30 --seed $* --no-tui -q --out $@
-repro-pets: build $(PETS_SEEDS:%=datasets/pets/random-%.mcap)
-	for s in $(PETS_SEEDS); do \
-		$(RUN) train pets --env pendulum --data datasets/pets/random-$$s.mcap --seed $$s --no-tui -q --out models/pets/seed-$$s || exit 1; \
-		$(RUN) eval pendulum-swingup --model models/pets/seed-$$s --episodes 1 --seed $$s --no-tui -q --out reports/pets/seed-$$s || exit 1; \
-		$(RUN) eval pendulum-swingup --model true --episodes 1 --seed $$s --no-tui -q --out reports/pets/truth-$$s || exit 1; \
-	done
-	@echo "seed,model,return,success" > reports/pets/summary.csv
-	@for s in $(PETS_SEEDS); do for m in seed truth; do \
-		tail -n 1 reports/pets/$$m-$$s/episodes.csv | awk -F, -v s=$$s -v m=$$m '{print s "," (m=="seed"?"pets":"true") "," $$2 "," $$3}' >> reports/pets/summary.csv; \
-	done; done
-	@cat reports/pets/summary.csv
+# Sweeps (`mbrl sweep`): `$(call sweep,NAME)` plans sweeps/NAME.toml into sweeps/NAME/, runs its jobs here
+# SWEEP_JOBS at a time (a rerun skips finished jobs and resumes stopped trainings) and writes the report with
+# 95 % t intervals over seeds to sweeps/NAME/report/. The same directory goes to a Slurm cluster instead with
+# `sweeps/NAME/submit.sh --wait`, then `mbrl sweep report sweeps/NAME`.
+SWEEP_JOBS ?= 2
+sweep = $(MBRL) sweep plan sweeps/$(1).toml --out sweeps/$(1) && \
+	{ sweeps/$(1)/run-local.sh $(SWEEP_JOBS); status=$$?; $(MBRL) sweep report sweeps/$(1) && exit $$status; }
+
+# The basic model-based loop with PETS, ten seeds (sweeps/pets.toml): per seed 200 random rollouts of 30
+# steps, an ensemble of 5 trained on them and one swing-up planned on it at the thesis' CEM settings; the
+# ground-truth model plans the same seeds' episodes for comparison.
+repro-pets: build
+	$(call sweep,pets)
+
+# Explore the Context on the toy problem, three seeds per square (sweeps/context-toy.toml).
+repro-context-toy: build
+	$(call sweep,context-toy)
 
 # The iterative loop users of mbrl-lib know: start from a few random rollouts, then alternate planning an
 # episode on the current model (executed in the simulator and saved) with retraining on all data so far.

@@ -36,6 +36,11 @@ pub struct GlobalArgs {
     /// Print only results and errors.
     #[arg(short, long, global = true)]
     pub quiet: bool,
+    /// Record this command's outcome in DIR/job.json (done, failed with its error, stopped) and hold DIR's
+    /// lock while it runs; when DIR records this same command as done, do nothing. What makes a job list's
+    /// lines safe to rerun (`mbrl sweep plan` adds it to every line).
+    #[arg(long, global = true, value_name = "DIR")]
+    pub job_dir: Option<std::path::PathBuf>,
     /// Refuse work whose flags ask for more memory than this (estimated before it starts).
     #[arg(long, global = true, value_name = "GIB", default_value_t = mbrl::util::budget::DEFAULT_LIMIT_GIB, value_parser = memory_gib)]
     pub max_memory_gib: f64,

@@ -36,7 +36,8 @@ Examples:
   mbrl predict --model thesis --input datasets/ball.mcap --horizon 1s
   mbrl watch reports/quick/pendulum-swingup
   mbrl export --input datasets/heavy.mcap --out heavy.npz
-  mbrl list envs                       # also: methods, presets, embodiments";
+  mbrl list envs                       # also: methods, presets, embodiments
+  mbrl sweep plan sweep.toml --out sweeps/s  # seeds × settings as Slurm job arrays or local job lists";
 
 #[derive(Parser)]
 #[command(name = "mbrl", version, about = ABOUT, after_help = AFTER_HELP, propagate_version = true)]
@@ -60,6 +61,7 @@ enum Command {
     Watch(watch::WatchArgs),
     Export(mbrl::jobs::export::ExportOptions),
     List(mbrl::jobs::list::ListOptions),
+    Sweep(mbrl::jobs::sweep::SweepOptions),
     Completions(completions::CompletionsArgs),
 }
 
@@ -73,6 +75,7 @@ fn main() {
         .try_get_matches_from(&args)
         .and_then(|matches| Cli::from_arg_matches(&matches))
         .unwrap_or_else(|err| exit_on_usage_error(err));
+    let job = cli.global.job_dir.as_deref().and_then(start_job);
     let outcome = common::init_threads(&cli.global).and_then(|()| match cli.command {
         Command::Collect(args) => match mbrl::jobs::collect::prepare(args, &cli.global.invocation())? {
             mbrl::jobs::collect::Collection::Now(job) => {
@@ -116,13 +119,66 @@ fn main() {
             mbrl::jobs::export::run(args, &cli.global.invocation()).map(|summary| say!("{summary}")).map_err(Into::into)
         }
         Command::List(args) => mbrl::jobs::list::run(args).map(|table| say!("{table}")).map_err(Into::into),
+        Command::Sweep(args) => {
+            let outcome = mbrl::jobs::sweep::run(args, &validate_job_line)?;
+            say!("{outcome}");
+            match outcome.exit_status() {
+                0 => Ok(()),
+                status => std::process::exit(status),
+            }
+        }
         Command::Completions(args) => completions::run(args),
     });
-    if let Err(err) = outcome {
+    let failure = outcome.as_ref().err().map(|err| {
         let cancelled = err.downcast_ref::<mbrl::Error>().is_some_and(|e| e.is_cancelled());
-        eprintln!("error: {}", one_line(&format!("{err:#}")));
+        (format!("error: {}", one_line(&format!("{err:#}"))), cancelled)
+    });
+    if let Some(job) = job {
+        if let Err(e) = job.finish(failure.clone().map_or(Ok(()), Err)) {
+            eprintln!("warning: the job record was not written: {}", one_line(&e.to_string()));
+        }
+    }
+    if let Some((line, cancelled)) = failure {
+        eprintln!("{line}");
         std::process::exit(if cancelled { 130 } else { 1 });
     }
+}
+
+/// `--job-dir`: the command's arguments (after the binary) are the job's identity; a job recorded done with
+/// the same arguments ends here, successfully, with nothing done.
+fn start_job(dir: &std::path::Path) -> Option<mbrl::run::job_record::JobGuard> {
+    let args: Vec<String> = std::env::args_os().skip(1).map(|a| a.to_string_lossy().into_owned()).collect();
+    let command = shlex::try_join(args.iter().map(String::as_str)).unwrap_or_else(|_| args.join(" "));
+    match mbrl::run::job_record::begin(dir, &command) {
+        Ok(mbrl::run::job_record::Begin::Run(guard)) => Some(guard),
+        Ok(mbrl::run::job_record::Begin::AlreadyDone) => {
+            say!(
+                "done already: {} records this command as finished",
+                dir.join(mbrl::run::job_record::RECORD_FILE).display()
+            );
+            std::process::exit(0);
+        }
+        Err(e) => {
+            eprintln!("error: --job-dir {}", one_line(&e.to_string()));
+            std::process::exit(1);
+        }
+    }
+}
+
+/// A planned sweep line parses as this command line would parse it, so a typo in a spec fails at planning.
+fn validate_job_line(args: &[String]) -> Result<(), String> {
+    let mut argv = vec![std::ffi::OsString::from("mbrl")];
+    argv.extend(args.iter().map(std::ffi::OsString::from));
+    let argv = train::alias::rewrite(argv, &Cli::command());
+    match accept_negative_numbers(Cli::command()).try_get_matches_from(&argv) {
+        Ok(matches) => Cli::from_arg_matches(&matches).map(drop).map_err(|e| first_line(&e.to_string())),
+        Err(e) => Err(first_line(&e.to_string())),
+    }
+}
+
+fn first_line(message: &str) -> String {
+    let line = message.lines().find(|l| !l.trim().is_empty()).unwrap_or("").trim();
+    one_line(line.strip_prefix("error: ").unwrap_or(line))
 }
 
 /// Negative values reach each flag's own check (`--lr -1` → "--lr must be positive") instead of clap's

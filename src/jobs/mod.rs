@@ -21,6 +21,7 @@ pub mod overrides;
 pub mod plan;
 pub mod predict;
 pub mod solve_board;
+pub mod sweep;
 pub mod train;
 
 pub use common::{

@@ -67,10 +67,19 @@ pub struct JobGuard {
 /// Where an interruption records "stopped" (the signal handler runs plain functions).
 static INTERRUPTIBLE: Mutex<Option<(PathBuf, String)>> = Mutex::new(None);
 
+/// Runs inside the interrupt handler, which holds the registry of temporary files until exit: so the record
+/// goes through a plain temporary file and a rename, not through `write_atomic` (which registers its file).
 fn record_interruption() {
     let taken = INTERRUPTIBLE.lock().unwrap_or_else(|p| p.into_inner()).take();
     if let Some((dir, command)) = taken {
-        let _ = JobRecord { state: JobState::Stopped, command, error: None }.write(&dir);
+        let record = JobRecord { state: JobState::Stopped, command, error: None };
+        if let Ok(mut bytes) = serde_json::to_vec_pretty(&record) {
+            bytes.push(b'\n');
+            let tmp = dir.join(".job.json.stopping");
+            if std::fs::write(&tmp, &bytes).is_ok() {
+                let _ = std::fs::rename(&tmp, dir.join(RECORD_FILE));
+            }
+        }
     }
 }
 

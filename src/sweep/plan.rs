@@ -74,8 +74,12 @@ pub struct JobPlan {
 impl JobPlan {
     /// The grid values without the seed: runs that differ only in seed form one cell of the report.
     pub fn cell_label(&self) -> String {
-        let parts: Vec<String> =
-            self.cell.iter().filter(|(k, _)| k != "seed").map(|(k, v)| format!("{}={v}", k.trim_start_matches('-'))).collect();
+        let parts: Vec<String> = self
+            .cell
+            .iter()
+            .filter(|(k, _)| k != "seed")
+            .map(|(k, v)| format!("{}={v}", k.trim_start_matches('-')))
+            .collect();
         if parts.is_empty() {
             "all".to_string()
         } else {
@@ -96,13 +100,19 @@ impl Plan {
     pub fn read(dir: &Path) -> Result<Plan> {
         let path = dir.join(PLAN_FILE);
         if !path.is_file() {
-            return Err(Error::bad_file(dir, format!("holds no {PLAN_FILE}; expected a directory made by `mbrl sweep plan`")));
+            return Err(Error::bad_file(
+                dir,
+                format!("holds no {PLAN_FILE}; expected a directory made by `mbrl sweep plan`"),
+            ));
         }
         let bytes = crate::util::bounded_read::read_bounded(&path, 1 << 30)?;
-        let plan: Plan = serde_json::from_slice(&bytes)
-            .map_err(|e| Error::bad_file(&path, format!("is not a sweep plan: {e}")))?;
+        let plan: Plan =
+            serde_json::from_slice(&bytes).map_err(|e| Error::bad_file(&path, format!("is not a sweep plan: {e}")))?;
         if plan.version != PLAN_VERSION {
-            return Err(Error::bad_file(&path, format!("version {} is not {PLAN_VERSION}, the one this mbrl reads", plan.version)));
+            return Err(Error::bad_file(
+                &path,
+                format!("version {} is not {PLAN_VERSION}, the one this mbrl reads", plan.version),
+            ));
         }
         Ok(plan)
     }
@@ -130,11 +140,15 @@ fn count_jobs(spec: &Spec, allow_large: bool) -> Result<()> {
         let upstream = stage.after.as_deref().map_or(Some(1), |after| counts.get(after).copied());
         let count = own.zip(upstream).and_then(|(a, b)| a.checked_mul(b)).filter(|&n| n <= MAX_JOBS);
         let Some(count) = count else {
-            return Err(Error::config(format!("stage[{i}].grid: expands to more than {MAX_JOBS} jobs; no sweep this large is planned")));
+            return Err(Error::config(format!(
+                "stage[{i}].grid: expands to more than {MAX_JOBS} jobs; no sweep this large is planned"
+            )));
         };
         total = total.saturating_add(count);
         if total > MAX_JOBS {
-            return Err(Error::config(format!("stage[{i}].grid: the sweep expands to more than {MAX_JOBS} jobs; no sweep this large is planned")));
+            return Err(Error::config(format!(
+                "stage[{i}].grid: the sweep expands to more than {MAX_JOBS} jobs; no sweep this large is planned"
+            )));
         }
         if total > LARGE_SWEEP && !allow_large {
             return Err(Error::config(format!(
@@ -249,7 +263,7 @@ fn expand_stage(
             let output = run_dir.join(&output_name);
             let mut args: Vec<String> = Vec::with_capacity(tokens.len() + 16);
             for token in head {
-                args.push(substitute(token, &at, stage, earlier, spec, parent.map(|(i, _)| i))?);
+                args.push(substitute(token, &at, stage, earlier, spec, parent.map(|(i, _)| i), &cell)?);
             }
             for (key, value) in combo {
                 if key == "seed" || !key.starts_with("--") {
@@ -275,7 +289,7 @@ fn expand_stage(
             args.extend(["--threads".to_string(), spec.sweep.threads.to_string()]);
             args.extend(["--job-dir".to_string(), run_dir.display().to_string(), "--force".into(), "--no-tui".into()]);
             for token in trailing {
-                args.push(substitute(token, &at, stage, earlier, spec, parent.map(|(i, _)| i))?);
+                args.push(substitute(token, &at, stage, earlier, spec, parent.map(|(i, _)| i), &cell)?);
             }
             for (key, value) in combo {
                 if key != "seed" && !key.starts_with("--") {
@@ -288,7 +302,9 @@ fn expand_stage(
             let line = shlex::try_join(line_tokens.iter().map(String::as_str))
                 .map_err(|_| Error::config(format!("{at}.command: a value holds a NUL byte")))?;
             if line.contains('\n') {
-                return Err(Error::config(format!("{at}: a value or path holds a line break; a job list has one job per line")));
+                return Err(Error::config(format!(
+                    "{at}: a value or path holds a line break; a job list has one job per line"
+                )));
             }
             jobs.push(JobPlan { name, cell, seed, run_dir, output, upstream: parent.map(|(i, _)| i), line });
         }
@@ -308,19 +324,24 @@ fn job_name(cell: &[(String, String)]) -> String {
         return "run".to_string();
     }
     let clean = |s: &str| -> String {
-        s.trim_start_matches('-').chars().map(|c| if c.is_ascii_alphanumeric() || c == '.' || c == '-' { c } else { '_' }).collect()
+        s.trim_start_matches('-')
+            .chars()
+            .map(|c| if c.is_ascii_alphanumeric() || c == '.' || c == '-' { c } else { '_' })
+            .collect()
     };
     let name = cell.iter().map(|(k, v)| format!("{}-{}", clean(k), clean(v))).collect::<Vec<_>>().join("_");
     if name.len() > 200 {
         // Long names pass the file system's 255-byte limit once suffixed; keep their start and a digest.
-        let digest = name.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| (h ^ u64::from(b)).wrapping_mul(0x100_0000_01b3));
+        let digest =
+            name.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| (h ^ u64::from(b)).wrapping_mul(0x100_0000_01b3));
         format!("{}-{digest:016x}", &name[..120])
     } else {
         name
     }
 }
 
-/// Replaces `{stage}` with the output of that earlier stage's run this job descends from.
+/// Replaces `{stage}` with the output of that earlier stage's run this job descends from, and `{axis}` with
+/// this job's value on that grid axis (`{env}` for a `--env` axis of an earlier stage).
 fn substitute(
     token: &str,
     at: &str,
@@ -328,6 +349,7 @@ fn substitute(
     earlier: &[StagePlan],
     spec: &Spec,
     parent: Option<usize>,
+    cell: &[(String, String)],
 ) -> Result<String> {
     let mut out = String::with_capacity(token.len());
     let mut rest = token;
@@ -338,14 +360,21 @@ fn substitute(
             return Err(Error::config(format!("{at}.command: '{token}' opens a {{ that does not close")));
         };
         let name = &after_open[..close];
-        let path = ancestor_output(name, stage, earlier, spec, parent).ok_or_else(|| {
-            let chain = ancestors(stage, spec);
+        let axis = cell.iter().find(|(k, _)| k.trim_start_matches('-') == name).map(|(_, v)| v.clone());
+        let value = ancestor_output(name, stage, earlier, spec, parent).map(|p| p.display().to_string()).or(axis);
+        let value = value.ok_or_else(|| {
+            let mut names: Vec<String> = ancestors(stage, spec).into_iter().map(str::to_string).collect();
+            names.extend(cell.iter().map(|(k, _)| k.trim_start_matches('-').to_string()));
             Error::config(format!(
-                "{at}.command: {{{name}}} names no stage this one follows; expected one of: {}",
-                if chain.is_empty() { "none (the stage has no `after`)".to_string() } else { chain.join(", ") }
+                "{at}.command: {{{name}}} names no stage this one follows and no grid axis; expected one of: {}",
+                if names.is_empty() {
+                    "none (the stage has no `after` and no grid)".to_string()
+                } else {
+                    names.join(", ")
+                }
             ))
         })?;
-        out.push_str(&path.display().to_string());
+        out.push_str(&value);
         rest = &after_open[close + 1..];
     }
     out.push_str(rest);
@@ -362,7 +391,13 @@ fn ancestors<'a>(stage: &'a StageSpec, spec: &'a Spec) -> Vec<&'a str> {
     chain
 }
 
-fn ancestor_output(name: &str, stage: &StageSpec, earlier: &[StagePlan], spec: &Spec, parent: Option<usize>) -> Option<PathBuf> {
+fn ancestor_output(
+    name: &str,
+    stage: &StageSpec,
+    earlier: &[StagePlan],
+    spec: &Spec,
+    parent: Option<usize>,
+) -> Option<PathBuf> {
     let mut stage_name = stage.after.as_deref()?;
     let mut index = parent?;
     loop {
@@ -429,7 +464,10 @@ command = "eval context --model {train} --env toy:inner"
         let unknown = SPEC.replace("{train}", "{trian}");
         let err = expand(&Spec::parse(&unknown).unwrap(), Path::new("/s"), Path::new("m"), &accept, false).unwrap_err();
         assert!(err.to_string().contains("{trian}") && err.to_string().contains("train"), "{err}");
-        let big = SPEC.replace("seed = [0, 1, 2]", &format!("seed = [{}]", (0..6000).map(|i| i.to_string()).collect::<Vec<_>>().join(",")));
+        let big = SPEC.replace(
+            "seed = [0, 1, 2]",
+            &format!("seed = [{}]", (0..6000).map(|i| i.to_string()).collect::<Vec<_>>().join(",")),
+        );
         let err = expand(&Spec::parse(&big).unwrap(), Path::new("/s"), Path::new("m"), &accept, false).unwrap_err();
         assert!(err.to_string().contains("--allow-large"), "{err}");
     }
@@ -437,7 +475,8 @@ command = "eval context --model {train} --env toy:inner"
     #[test]
     fn validation_failures_name_the_stage_and_job() {
         let spec = Spec::parse(SPEC).unwrap();
-        let refuse = |args: &[String]| if args[0] == "eval" { Err("unexpected argument '--bogus'".to_string()) } else { Ok(()) };
+        let refuse =
+            |args: &[String]| if args[0] == "eval" { Err("unexpected argument '--bogus'".to_string()) } else { Ok(()) };
         let err = expand(&spec, Path::new("/s"), Path::new("m"), &refuse, false).unwrap_err();
         assert!(err.to_string().contains("stage[1].command (job preset-medium_seed-0)"), "{err}");
     }

@@ -177,7 +177,8 @@ pub enum Direction {
 impl Spec {
     pub fn read(path: &Path) -> Result<Spec> {
         let bytes = crate::util::bounded_read::read_bounded(path, MAX_SPEC_BYTES)?;
-        let text = String::from_utf8(bytes).map_err(|_| Error::bad_file(path, "is not UTF-8 text; expected a TOML sweep spec"))?;
+        let text = String::from_utf8(bytes)
+            .map_err(|_| Error::bad_file(path, "is not UTF-8 text; expected a TOML sweep spec"))?;
         Spec::parse(&text).map_err(|e| e.at(path))
     }
 
@@ -203,15 +204,24 @@ impl Spec {
             return field("sweep.name".into(), "expected letters, digits, '-', '_' or '.'".into());
         }
         if self.sweep.threads == 0 || self.sweep.threads > 1024 {
-            return field("sweep.threads".into(), format!("{} is out of range; expected 1 to 1024", self.sweep.threads));
+            return field(
+                "sweep.threads".into(),
+                format!("{} is out of range; expected 1 to 1024", self.sweep.threads),
+            );
         }
         for (i, stage) in self.stages.iter().enumerate() {
             let at = format!("stage[{i}]");
             if !is_name(&stage.name) {
-                return field(format!("{at}.name"), format!("'{}': expected letters, digits, '-', '_' or '.'", stage.name));
+                return field(
+                    format!("{at}.name"),
+                    format!("'{}': expected letters, digits, '-', '_' or '.'", stage.name),
+                );
             }
             if self.stages[..i].iter().any(|s| s.name == stage.name) {
-                return field(format!("{at}.name"), format!("'{}' names two stages; stage names must differ", stage.name));
+                return field(
+                    format!("{at}.name"),
+                    format!("'{}' names two stages; stage names must differ", stage.name),
+                );
             }
             if let Some(after) = &stage.after {
                 if !self.stages[..i].iter().any(|s| &s.name == after) {
@@ -264,12 +274,18 @@ impl Spec {
         }
         for (i, option) in slurm.options.iter().enumerate() {
             if !option.starts_with("--") || option.contains('\n') {
-                return field(format!("slurm.options[{i}]"), format!("'{option}': expected one sbatch option like --qos=normal"));
+                return field(
+                    format!("slurm.options[{i}]"),
+                    format!("'{option}': expected one sbatch option like --qos=normal"),
+                );
             }
         }
         for (i, compare) in self.compares.iter().enumerate() {
             if !self.stages.iter().any(|s| s.name == compare.stage) {
-                return field(format!("compare[{i}].stage"), format!("'{}' is not a stage of this spec", compare.stage));
+                return field(
+                    format!("compare[{i}].stage"),
+                    format!("'{}' is not a stage of this spec", compare.stage),
+                );
             }
         }
         Ok(())

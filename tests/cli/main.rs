@@ -25,6 +25,8 @@ mod pendulum_reference;
 mod pets;
 mod seads;
 mod surface;
+mod sweep;
+mod sweep_slurm;
 mod tradyn;
 mod train_methods;
 mod unicycle;
