@@ -4,6 +4,7 @@
 //! each line safe to rerun (`--job-dir`), and reads the outcomes back.
 
 pub mod plan;
+pub mod report;
 pub mod spec;
 
 pub use plan::{expand, JobPlan, Plan, StagePlan, PLAN_FILE};
