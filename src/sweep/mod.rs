@@ -5,6 +5,7 @@
 
 pub mod files;
 pub mod plan;
+pub mod report;
 pub mod spec;
 pub mod status;
 
