@@ -49,6 +49,9 @@ _mbrl() {
             mbrl,solve-board)
                 cmd="mbrl__subcmd__solve__subcmd__board"
                 ;;
+            mbrl,sweep)
+                cmd="mbrl__subcmd__sweep"
+                ;;
             mbrl,train)
                 cmd="mbrl__subcmd__train"
                 ;;
@@ -160,6 +163,9 @@ _mbrl() {
             mbrl__subcmd__help,solve-board)
                 cmd="mbrl__subcmd__help__subcmd__solve__subcmd__board"
                 ;;
+            mbrl__subcmd__help,sweep)
+                cmd="mbrl__subcmd__help__subcmd__sweep"
+                ;;
             mbrl__subcmd__help,train)
                 cmd="mbrl__subcmd__help__subcmd__train"
                 ;;
@@ -199,6 +205,15 @@ _mbrl() {
             mbrl__subcmd__help__subcmd__eval,tradyn)
                 cmd="mbrl__subcmd__help__subcmd__eval__subcmd__tradyn"
                 ;;
+            mbrl__subcmd__help__subcmd__sweep,plan)
+                cmd="mbrl__subcmd__help__subcmd__sweep__subcmd__plan"
+                ;;
+            mbrl__subcmd__help__subcmd__sweep,report)
+                cmd="mbrl__subcmd__help__subcmd__sweep__subcmd__report"
+                ;;
+            mbrl__subcmd__help__subcmd__sweep,status)
+                cmd="mbrl__subcmd__help__subcmd__sweep__subcmd__status"
+                ;;
             mbrl__subcmd__help__subcmd__train,ball-ekf)
                 cmd="mbrl__subcmd__help__subcmd__train__subcmd__ball__subcmd__ekf"
                 ;;
@@ -216,6 +231,30 @@ _mbrl() {
                 ;;
             mbrl__subcmd__help__subcmd__train,tradyn)
                 cmd="mbrl__subcmd__help__subcmd__train__subcmd__tradyn"
+                ;;
+            mbrl__subcmd__sweep,help)
+                cmd="mbrl__subcmd__sweep__subcmd__help"
+                ;;
+            mbrl__subcmd__sweep,plan)
+                cmd="mbrl__subcmd__sweep__subcmd__plan"
+                ;;
+            mbrl__subcmd__sweep,report)
+                cmd="mbrl__subcmd__sweep__subcmd__report"
+                ;;
+            mbrl__subcmd__sweep,status)
+                cmd="mbrl__subcmd__sweep__subcmd__status"
+                ;;
+            mbrl__subcmd__sweep__subcmd__help,help)
+                cmd="mbrl__subcmd__sweep__subcmd__help__subcmd__help"
+                ;;
+            mbrl__subcmd__sweep__subcmd__help,plan)
+                cmd="mbrl__subcmd__sweep__subcmd__help__subcmd__plan"
+                ;;
+            mbrl__subcmd__sweep__subcmd__help,report)
+                cmd="mbrl__subcmd__sweep__subcmd__help__subcmd__report"
+                ;;
+            mbrl__subcmd__sweep__subcmd__help,status)
+                cmd="mbrl__subcmd__sweep__subcmd__help__subcmd__status"
                 ;;
             mbrl__subcmd__train,ball-ekf)
                 cmd="mbrl__subcmd__train__subcmd__ball__subcmd__ekf"
@@ -266,7 +305,7 @@ _mbrl() {
 
     case "${cmd}" in
         mbrl)
-            opts="-q -h -V --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version collect plan train calibrate filter predict solve-board eval watch export list completions help"
+            opts="-q -h -V --seed --threads --tui --hold --no-tui --force --quiet --job-dir --max-memory-gib --help --version collect plan train calibrate filter predict solve-board eval watch export list sweep completions help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 1 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -277,6 +316,10 @@ _mbrl() {
                     return 0
                     ;;
                 --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --job-dir)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
@@ -292,7 +335,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__calibrate)
-            opts="-q -h -V --model --env --map --instance-seed --strategy --transitions --horizon --candidates --elites --iters --beta-samples --init-state --out --allow-incomplete --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --model --env --map --instance-seed --strategy --transitions --horizon --candidates --elites --iters --beta-samples --init-state --out --allow-incomplete --seed --threads --tui --hold --no-tui --force --quiet --job-dir --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -358,6 +401,10 @@ _mbrl() {
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
+                --job-dir)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 --max-memory-gib)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
@@ -370,7 +417,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__collect)
-            opts="-q -h -V --env --rollouts --instances --actions --init-state --instance-seed --board --episodes --steps --images --policy --out --trajectories --orientation --augment-rotations --boards --max-depth --split --maps --map --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --env --rollouts --instances --actions --init-state --instance-seed --board --episodes --steps --images --policy --out --trajectories --orientation --augment-rotations --boards --max-depth --split --maps --map --seed --threads --tui --hold --no-tui --force --quiet --job-dir --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -456,6 +503,10 @@ _mbrl() {
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
+                --job-dir)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 --max-memory-gib)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
@@ -468,7 +519,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__completions)
-            opts="-q -h -V --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version bash zsh fish"
+            opts="-q -h -V --seed --threads --tui --hold --no-tui --force --quiet --job-dir --max-memory-gib --help --version bash zsh fish"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -479,6 +530,10 @@ _mbrl() {
                     return 0
                     ;;
                 --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --job-dir)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
@@ -494,7 +549,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval)
-            opts="-q -h -V --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version quick dataset boards embodied ball context tradyn seads dlgpd pendulum-swingup render help"
+            opts="-q -h -V --seed --threads --tui --hold --no-tui --force --quiet --job-dir --max-memory-gib --help --version quick dataset boards embodied ball context tradyn seads dlgpd pendulum-swingup render help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -505,6 +560,10 @@ _mbrl() {
                     return 0
                     ;;
                 --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --job-dir)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
@@ -520,7 +579,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__ball)
-            opts="-q -h -V --model --train-shots --augment-rotations --test-shots --unseen-shots --out --config --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --model --train-shots --augment-rotations --test-shots --unseen-shots --out --config --seed --threads --tui --hold --no-tui --force --quiet --job-dir --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -562,6 +621,10 @@ _mbrl() {
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
+                --job-dir)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 --max-memory-gib)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
@@ -574,7 +637,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__boards)
-            opts="-q -h -V --out --config --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --out --config --seed --threads --tui --hold --no-tui --force --quiet --job-dir --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -596,6 +659,10 @@ _mbrl() {
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
+                --job-dir)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 --max-memory-gib)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
@@ -608,7 +675,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__context)
-            opts="-q -h -V --model --env --contexts --validation-rollouts --validation-steps --transitions --horizon --strategy --candidates --elites --iters --beta-samples --swingup --swingup-steps --swingup-candidates --allow-incomplete --out --config --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --model --env --contexts --validation-rollouts --validation-steps --transitions --horizon --strategy --candidates --elites --iters --beta-samples --swingup --swingup-steps --swingup-candidates --allow-incomplete --out --config --seed --threads --tui --hold --no-tui --force --quiet --job-dir --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -686,6 +753,10 @@ _mbrl() {
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
+                --job-dir)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 --max-memory-gib)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
@@ -698,7 +769,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__dataset)
-            opts="-q -h -V --input --out --config --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --input --out --config --seed --threads --tui --hold --no-tui --force --quiet --job-dir --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -724,6 +795,10 @@ _mbrl() {
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
+                --job-dir)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 --max-memory-gib)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
@@ -736,7 +811,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__dlgpd)
-            opts="-q -h -V --model --env --evidence-rollouts --runs --steps --candidates --elites --iters --prediction-only --allow-incomplete --out --config --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --model --env --evidence-rollouts --runs --steps --candidates --elites --iters --prediction-only --allow-incomplete --out --config --seed --threads --tui --hold --no-tui --force --quiet --job-dir --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -790,6 +865,10 @@ _mbrl() {
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
+                --job-dir)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 --max-memory-gib)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
@@ -802,7 +881,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__embodied)
-            opts="-q -h -V --game --embodiment --max-depth --boards --split --out --config --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --game --embodiment --max-depth --boards --split --out --config --seed --threads --tui --hold --no-tui --force --quiet --job-dir --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -841,6 +920,10 @@ _mbrl() {
                     return 0
                     ;;
                 --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --job-dir)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
@@ -1038,7 +1121,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__pendulum__subcmd__swingup)
-            opts="-q -h -V --model --particles --propagation --context --allow-incomplete --episodes --env --steps --horizon --candidates --elites --iters --noise --beta --no-warm-start --out --config --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --model --particles --propagation --context --allow-incomplete --episodes --env --steps --horizon --candidates --elites --iters --noise --beta --no-warm-start --out --config --seed --threads --tui --hold --no-tui --force --quiet --job-dir --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1112,6 +1195,10 @@ _mbrl() {
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
+                --job-dir)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 --max-memory-gib)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
@@ -1124,7 +1211,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__quick)
-            opts="-q -h -V --out --config --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --out --config --seed --threads --tui --hold --no-tui --force --quiet --job-dir --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1146,6 +1233,10 @@ _mbrl() {
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
+                --job-dir)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 --max-memory-gib)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
@@ -1158,7 +1249,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__render)
-            opts="-q -h -V --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --seed --threads --tui --hold --no-tui --force --quiet --job-dir --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1169,6 +1260,10 @@ _mbrl() {
                     return 0
                     ;;
                 --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --job-dir)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
@@ -1184,7 +1279,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__seads)
-            opts="-q -h -V --model --max-depth --boards --coverage-boards --max-replans --split --max-nodes --out --allow-incomplete --config --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --model --max-depth --boards --coverage-boards --max-replans --split --max-nodes --out --allow-incomplete --config --seed --threads --tui --hold --no-tui --force --quiet --job-dir --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1234,6 +1329,10 @@ _mbrl() {
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
+                --job-dir)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 --max-memory-gib)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
@@ -1246,7 +1345,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__eval__subcmd__tradyn)
-            opts="-q -h -V --model-terrain --model-no-terrain --maps --tasks --transitions --steps --horizon --candidates --elites --iters --prediction-steps --out --allow-incomplete --config --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --model-terrain --model-no-terrain --maps --tasks --transitions --steps --horizon --candidates --elites --iters --prediction-steps --out --allow-incomplete --config --seed --threads --tui --hold --no-tui --force --quiet --job-dir --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1312,6 +1411,10 @@ _mbrl() {
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
+                --job-dir)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 --max-memory-gib)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
@@ -1324,7 +1427,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__export)
-            opts="-q -h -V --input --out --format --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --input --out --format --seed --threads --tui --hold --no-tui --force --quiet --job-dir --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1350,6 +1453,10 @@ _mbrl() {
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
+                --job-dir)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 --max-memory-gib)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
@@ -1362,7 +1469,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__filter)
-            opts="-q -h -V --model --input --out --mcap --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --model --input --out --mcap --seed --threads --tui --hold --no-tui --force --quiet --job-dir --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1392,6 +1499,10 @@ _mbrl() {
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
+                --job-dir)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 --max-memory-gib)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
@@ -1404,7 +1515,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__help)
-            opts="collect plan train calibrate filter predict solve-board eval watch export list completions help"
+            opts="collect plan train calibrate filter predict solve-board eval watch export list sweep completions help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1725,6 +1836,62 @@ _mbrl() {
             COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
             return 0
             ;;
+        mbrl__subcmd__help__subcmd__sweep)
+            opts="plan status report"
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mbrl__subcmd__help__subcmd__sweep__subcmd__plan)
+            opts=""
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 4 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mbrl__subcmd__help__subcmd__sweep__subcmd__report)
+            opts=""
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 4 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mbrl__subcmd__help__subcmd__sweep__subcmd__status)
+            opts=""
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 4 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
         mbrl__subcmd__help__subcmd__train)
             opts="pets ball-ekf context tradyn seads dlgpd"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
@@ -1838,7 +2005,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__list)
-            opts="-q -h -V --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version envs methods presets embodiments"
+            opts="-q -h -V --seed --threads --tui --hold --no-tui --force --quiet --job-dir --max-memory-gib --help --version envs methods presets embodiments"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1849,6 +2016,10 @@ _mbrl() {
                     return 0
                     ;;
                 --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --job-dir)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
@@ -1864,7 +2035,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__plan)
-            opts="-q -h -V --env --model --particles --propagation --context --allow-incomplete --steps --map --start --goal --horizon --candidates --elites --iters --noise --beta --no-warm-start --evidence --instance-seed --out --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --env --model --particles --propagation --context --allow-incomplete --steps --map --start --goal --horizon --candidates --elites --iters --noise --beta --no-warm-start --evidence --instance-seed --out --seed --threads --tui --hold --no-tui --force --quiet --job-dir --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -1950,6 +2121,10 @@ _mbrl() {
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
+                --job-dir)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 --max-memory-gib)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
@@ -1962,7 +2137,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__predict)
-            opts="-q -h -V --model --input --horizon --from-frame --plane-y --out --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --model --input --horizon --from-frame --plane-y --out --seed --threads --tui --hold --no-tui --force --quiet --job-dir --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -2000,6 +2175,10 @@ _mbrl() {
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
+                --job-dir)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 --max-memory-gib)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
@@ -2012,7 +2191,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__solve__subcmd__board)
-            opts="-q -h -V --game --board --random-depth --split --model --max-replans --allow-incomplete --embodiment --search --max-depth --max-nodes --max-memory-mib --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --game --board --random-depth --split --model --max-replans --allow-incomplete --embodiment --search --max-depth --max-nodes --max-memory-mib --seed --threads --tui --hold --no-tui --force --quiet --job-dir --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -2070,6 +2249,212 @@ _mbrl() {
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
+                --job-dir)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --max-memory-gib)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mbrl__subcmd__sweep)
+            opts="-q -h -V --seed --threads --tui --hold --no-tui --force --quiet --job-dir --max-memory-gib --help --version plan status report help"
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                --seed)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --job-dir)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --max-memory-gib)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mbrl__subcmd__sweep__subcmd__help)
+            opts="plan status report help"
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mbrl__subcmd__sweep__subcmd__help__subcmd__help)
+            opts=""
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 4 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mbrl__subcmd__sweep__subcmd__help__subcmd__plan)
+            opts=""
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 4 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mbrl__subcmd__sweep__subcmd__help__subcmd__report)
+            opts=""
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 4 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mbrl__subcmd__sweep__subcmd__help__subcmd__status)
+            opts=""
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 4 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mbrl__subcmd__sweep__subcmd__plan)
+            opts="-q -h -V --out --allow-large --mbrl --seed --threads --tui --hold --no-tui --force --quiet --job-dir --max-memory-gib --help --version"
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                --out)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --mbrl)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --seed)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --job-dir)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --max-memory-gib)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mbrl__subcmd__sweep__subcmd__report)
+            opts="-q -h -V --out --seed --threads --tui --hold --no-tui --force --quiet --job-dir --max-memory-gib --help --version"
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                --out)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --seed)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --job-dir)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --max-memory-gib)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mbrl__subcmd__sweep__subcmd__status)
+            opts="-q -h -V --seed --threads --tui --hold --no-tui --force --quiet --job-dir --max-memory-gib --help --version"
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                --seed)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --job-dir)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 --max-memory-gib)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
@@ -2082,7 +2467,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__train)
-            opts="-q -h -V --resume --steps --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version pets ball-ekf context tradyn seads dlgpd help"
+            opts="-q -h -V --resume --steps --seed --threads --tui --hold --no-tui --force --quiet --job-dir --max-memory-gib --help --version pets ball-ekf context tradyn seads dlgpd help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -2104,6 +2489,10 @@ _mbrl() {
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
+                --job-dir)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 --max-memory-gib)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
@@ -2116,7 +2505,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__train__subcmd__ball__subcmd__ekf)
-            opts="-q -h -V --data --config --steps --batch --chunk --lr --launcher-prior --resume-if-stopped --out --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --data --config --steps --batch --chunk --lr --launcher-prior --resume-if-stopped --out --seed --threads --tui --hold --no-tui --force --quiet --job-dir --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -2158,6 +2547,10 @@ _mbrl() {
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
+                --job-dir)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 --max-memory-gib)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
@@ -2170,7 +2563,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__train__subcmd__context)
-            opts="-q -h -V --data --env --preset --config --steps --batch --lr --resume-if-stopped --out --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --data --env --preset --config --steps --batch --lr --resume-if-stopped --out --seed --threads --tui --hold --no-tui --force --quiet --job-dir --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -2213,6 +2606,10 @@ _mbrl() {
                     return 0
                     ;;
                 --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --job-dir)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
@@ -2228,7 +2625,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__train__subcmd__dlgpd)
-            opts="-q -h -V --data --env --config --preset --steps --batch --lr --resume-if-stopped --out --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --data --env --config --preset --steps --batch --lr --resume-if-stopped --out --seed --threads --tui --hold --no-tui --force --quiet --job-dir --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -2271,6 +2668,10 @@ _mbrl() {
                     return 0
                     ;;
                 --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --job-dir)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
@@ -2398,7 +2799,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__train__subcmd__pets)
-            opts="-q -h -V --data --env --config --preset --ensemble --steps --batch --lr --reward --resume-if-stopped --out --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --data --env --config --preset --ensemble --steps --batch --lr --reward --resume-if-stopped --out --seed --threads --tui --hold --no-tui --force --quiet --job-dir --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -2452,6 +2853,10 @@ _mbrl() {
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
+                --job-dir)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 --max-memory-gib)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
@@ -2464,7 +2869,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__train__subcmd__seads)
-            opts="-q -h -V --env --config --preset --skills --env-steps --no-relabel --no-second-best --no-novelty --resume-if-stopped --out --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --env --config --preset --skills --env-steps --no-relabel --no-second-best --no-novelty --resume-if-stopped --out --seed --threads --tui --hold --no-tui --force --quiet --job-dir --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -2502,6 +2907,10 @@ _mbrl() {
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
+                --job-dir)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 --max-memory-gib)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
@@ -2514,7 +2923,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__train__subcmd__tradyn)
-            opts="-q -h -V --data --env --no-terrain --preset --config --steps --batch --lr --resume-if-stopped --out --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --data --env --no-terrain --preset --config --steps --batch --lr --resume-if-stopped --out --seed --threads --tui --hold --no-tui --force --quiet --job-dir --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -2560,6 +2969,10 @@ _mbrl() {
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
+                --job-dir)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 --max-memory-gib)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
@@ -2572,7 +2985,7 @@ _mbrl() {
             return 0
             ;;
         mbrl__subcmd__watch)
-            opts="-q -h -V --seed --threads --tui --hold --no-tui --force --quiet --max-memory-gib --help --version"
+            opts="-q -h -V --seed --threads --tui --hold --no-tui --force --quiet --job-dir --max-memory-gib --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -2583,6 +2996,10 @@ _mbrl() {
                     return 0
                     ;;
                 --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --job-dir)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;

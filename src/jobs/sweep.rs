@@ -9,6 +9,7 @@ use crate::error::{Error, Result};
 use crate::refuse;
 use crate::sweep::files::{self, JOBS_FILE};
 use crate::sweep::plan::{Plan, Validate, PLAN_FILE};
+use crate::sweep::report::{write_report, ReportSummary};
 use crate::sweep::status::SweepStatus;
 use crate::sweep::{expand, Spec};
 
@@ -69,11 +70,22 @@ enum SweepAction {
         /// The sweep's directory.
         dir: PathBuf,
     },
+    /// Per stage and cell (the grid values without the seed): n, mean, sd and a 95 % t interval of every
+    /// scalar of the finished runs (eval summaries; trainings' final metrics), learning curves as mean ± t
+    /// interval over seeds, and the spec's [[compare]] tests; report.md, cells.csv, compare.csv, PNGs.
+    Report {
+        /// The sweep's directory.
+        dir: PathBuf,
+        /// Where the report goes (default: DIR/report; replaced on every report).
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+    },
 }
 
 pub enum SweepOutcome {
     Planned(Planned),
     Status(SweepStatus),
+    Reported(ReportSummary),
 }
 
 pub struct Planned {
@@ -111,6 +123,7 @@ impl fmt::Display for SweepOutcome {
         match self {
             SweepOutcome::Planned(p) => p.fmt(f),
             SweepOutcome::Status(s) => s.fmt(f),
+            SweepOutcome::Reported(r) => r.fmt(f),
         }
     }
 }
@@ -120,7 +133,7 @@ impl SweepOutcome {
     /// when one failed, 3 when some are unfinished.
     pub fn exit_status(&self) -> i32 {
         match self {
-            SweepOutcome::Planned(_) => 0,
+            SweepOutcome::Planned(_) | SweepOutcome::Reported(_) => 0,
             SweepOutcome::Status(s) if s.failed() > 0 => 1,
             SweepOutcome::Status(s) if s.done() < s.total() => 3,
             SweepOutcome::Status(_) => 0,
@@ -133,6 +146,11 @@ pub fn run(options: SweepOptions, validate: Validate) -> Result<SweepOutcome> {
     match options.action {
         SweepAction::Plan { spec, out, allow_large, mbrl } => plan(&spec, &out, allow_large, mbrl, validate),
         SweepAction::Status { dir } => Ok(SweepOutcome::Status(SweepStatus::of(&Plan::read(&dir)?))),
+        SweepAction::Report { dir, out } => {
+            let plan = Plan::read(&dir)?;
+            let out = out.unwrap_or_else(|| dir.join("report"));
+            Ok(SweepOutcome::Reported(write_report(&plan, &out)?))
+        }
     }
 }
 

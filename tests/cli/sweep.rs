@@ -90,6 +90,13 @@ fn a_local_sweep_runs_reruns_and_reports_failures() {
     assert!(text.contains("8/12 jobs done, 4 failed"), "{text}");
     assert!(text.contains("contexts-0_") || text.contains("_contexts-0"), "{text}");
     assert!(text.contains("failed: error:") && text.contains("--contexts"), "{text}");
+    let report = mbrl(d).args(["sweep", "report", "s"]).output().unwrap();
+    assert!(report.status.success(), "{}", stderr_of(&report));
+    assert!(stdout_of(&report).contains("eval: 4 of 8 runs done"), "{}", stdout_of(&report));
+    let markdown = std::fs::read_to_string(d.join("s/report/report.md")).unwrap();
+    assert!(markdown.contains("| hidden_units=8 | 2 |") && markdown.contains("95 % t"), "{markdown}");
+    let cells = std::fs::read_to_string(d.join("s/report/cells.csv")).unwrap();
+    assert!(cells.starts_with("stage,cell,metric,n,mean,sd,ci_low,ci_high"), "{cells}");
     let model = d.join("s/runs/train/hidden_units-8_seed-1/model");
     let weights = std::fs::read(model.join("metrics.jsonl")).unwrap();
 

@@ -73,6 +73,25 @@ fn a_two_stage_sweep_runs_as_dependent_arrays_and_matches_a_local_run() {
     for (a, b) in slurm_files.iter().zip(&local_files) {
         assert!(a == b, "{} differs between the Slurm and the local run", a.0);
     }
+    for name in ["slurm", "local"] {
+        let report = mbrl(d).args(["sweep", "report", name]).output().unwrap();
+        assert!(report.status.success(), "{}", stderr_of(&report));
+    }
+    let reports = |name: &str| {
+        let dir = d.join(name).join("report");
+        let mut files: Vec<(String, Vec<u8>)> = std::fs::read_dir(&dir)
+            .unwrap()
+            .flatten()
+            .map(|e| (e.file_name().to_string_lossy().into_owned(), std::fs::read(e.path()).unwrap()))
+            .collect();
+        files.sort();
+        files
+    };
+    let (slurm_report, local_report) = (reports("slurm"), reports("local"));
+    assert!(slurm_report.iter().any(|(n, _)| n == "report.md") && slurm_report.len() > 2);
+    assert!(slurm_report == local_report, "the Slurm and the local sweep's reports differ");
+    let markdown = String::from_utf8(slurm_report.iter().find(|(n, _)| n == "report.md").unwrap().1.clone()).unwrap();
+    assert!(markdown.contains("| hidden_units=8 | 3 |"), "three seeds per cell: {markdown}");
 }
 
 #[test]

@@ -137,9 +137,11 @@ fn read_output(output: &Path) -> Result<Read> {
     Ok((Vec::new(), BTreeMap::new()))
 }
 
-/// Every numeric leaf under `value`, named by its path (`mean_mse[0]`, `tests[1].p_value`).
+/// Every numeric leaf under `value`, named by its path (`mean_mse[0]`, `tests[1].p_value`). A true/false
+/// leaf counts as 1/0, so its mean over seeds is a rate (`episodes[0].success`: the swing-up success rate).
 fn leaves(value: &Value, path: &mut String, out: &mut Vec<(String, f64)>) {
     match value {
+        Value::Bool(flag) => out.push((path.clone(), if *flag { 1.0 } else { 0.0 })),
         Value::Number(number) => {
             if let Some(x) = number.as_f64() {
                 out.push((path.clone(), x));
