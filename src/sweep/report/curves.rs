@@ -25,8 +25,9 @@ pub struct Curves {
 pub struct Plot {
     pub metric: String,
     pub file: String,
-    /// Consecutive steps averaged into one point (1: every step drawn).
-    pub bin: usize,
+    /// Consecutive steps averaged into one point (1: every step drawn), fewest and most over the cells
+    /// (a cell with shorter runs needs smaller bins).
+    pub bins: (usize, usize),
 }
 
 /// Writes the stage's curve PNGs into `out`.
@@ -37,7 +38,7 @@ pub fn write_curves(stage: &StageRuns, out: &Path) -> Result<Curves> {
     for metric in metrics {
         let binned: Vec<(Band, usize)> =
             stage.cells.iter().filter_map(|(label, _)| band(stage, label, metric)).collect();
-        let bin = binned.iter().map(|b| b.1).max().unwrap_or(1);
+        let bins = (binned.iter().map(|b| b.1).min().unwrap_or(1), binned.iter().map(|b| b.1).max().unwrap_or(1));
         let bands: Vec<Band> = binned.into_iter().map(|b| b.0).collect();
         if bands.is_empty() {
             curves.skipped.push((metric.to_string(), "no cell has 2 steps that all its runs recorded".into()));
@@ -55,7 +56,7 @@ pub fn write_curves(stage: &StageRuns, out: &Path) -> Result<Curves> {
         }
         let title = format!("{}: {metric}, mean over seeds, 95 % t interval", stage.stage.name);
         band_plot(&out.join(&file), &title, "step", metric, &bands)?;
-        curves.plots.push(Plot { metric: metric.to_string(), file, bin });
+        curves.plots.push(Plot { metric: metric.to_string(), file, bins });
     }
     Ok(curves)
 }

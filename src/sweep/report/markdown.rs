@@ -67,12 +67,21 @@ fn stage_md(md: &mut String, stage: &StageReport, comparisons: &[Comparison]) {
         md.push_str("\n### Learning curves\n\n");
         for plot in &stage.curves.plots {
             let _ = writeln!(md, "![{}]({})\n", esc(&plot.metric), plot.file);
-            if plot.bin > 1 {
-                let _ = writeln!(
-                    md,
-                    "Each point averages {} consecutive steps of each run before the mean over seeds.\n",
-                    plot.bin
-                );
+            match plot.bins {
+                (1, 1) => {}
+                (low, high) if low == high => {
+                    let _ = writeln!(
+                        md,
+                        "Each point averages {high} consecutive steps of each run before the mean over seeds.\n"
+                    );
+                }
+                (low, high) => {
+                    let _ = writeln!(
+                        md,
+                        "Each point averages {low} to {high} consecutive steps of each run (the longer the runs, the more) \
+                         before the mean over seeds.\n"
+                    );
+                }
             }
         }
     }
