@@ -9,7 +9,7 @@ use crate::error::{Error, Result};
 use crate::refuse;
 use crate::sweep::files::{self, JOBS_FILE};
 use crate::sweep::plan::{Plan, Validate, PLAN_FILE};
-use crate::sweep::report::{write_report, ReportSummary};
+use crate::sweep::report::{write_report, ReportSummary, COMPARE_FILE};
 use crate::sweep::status::SweepStatus;
 use crate::sweep::{expand, Spec};
 
@@ -149,7 +149,9 @@ pub fn run(options: SweepOptions, validate: Validate) -> Result<SweepOutcome> {
         SweepAction::Report { dir, out } => {
             let plan = Plan::read(&dir)?;
             let out = out.unwrap_or_else(|| dir.join("report"));
-            Ok(SweepOutcome::Reported(write_report(&plan, &out)?))
+            let summary = write_report(&plan, &out)?;
+            remove_stale(&out, &summary.files)?;
+            Ok(SweepOutcome::Reported(summary))
         }
     }
 }
@@ -199,6 +201,20 @@ fn plan(
         stages: plan.stages.iter().map(|s| (s.name.clone(), s.jobs.len())).collect(),
         single_stage: plan.stages.len() == 1,
     }))
+}
+
+/// A report replaces the one before it: plots and tables the new report did not write (a metric gone, the
+/// comparisons removed from the spec) go, so the directory never mixes two reports. Other files are left.
+fn remove_stale(out: &Path, written: &[String]) -> Result<()> {
+    let entries = std::fs::read_dir(out).map_err(|e| Error::io(out, e))?;
+    for entry in entries.flatten() {
+        let name = entry.file_name().to_string_lossy().into_owned();
+        let ours = (name.starts_with("curves-") && name.ends_with(".png")) || name == COMPARE_FILE;
+        if ours && !written.contains(&name) {
+            std::fs::remove_file(entry.path()).map_err(|e| Error::io(&entry.path(), e))?;
+        }
+    }
+    Ok(())
 }
 
 /// The directory as an absolute path (resolved when it exists), so that every line works from any directory;

@@ -440,20 +440,24 @@ command = "eval context --model {train} --env toy:inner"
         let plan = expand(&spec, Path::new("/s"), Path::new("/bin/mbrl"), &accept, false).unwrap();
         let train = &plan.stages[0];
         assert_eq!(train.jobs.len(), 6);
-        assert_eq!(train.jobs[0].name, "preset-medium_seed-0");
-        assert_eq!(train.jobs[1].name, "preset-medium_seed-1");
+        assert_eq!(train.jobs[0].name, "preset-small_seed-0");
+        assert_eq!(train.jobs[1].name, "preset-small_seed-1");
         assert_eq!(
             train.jobs[0].line,
-            "/bin/mbrl train context --data d.mcap --steps 50 --preset medium --out /s/runs/train/preset-medium_seed-0/model \
-             --resume-if-stopped --seed 0 --threads 1 --job-dir /s/runs/train/preset-medium_seed-0 --force --no-tui lambda_kl=1"
+            "/bin/mbrl train context --data d.mcap --steps 50 --preset small --out /s/runs/train/preset-small_seed-0/model \
+             --resume-if-stopped --seed 0 --threads 1 --job-dir /s/runs/train/preset-small_seed-0 --force --no-tui lambda_kl=1"
         );
         let eval = &plan.stages[1];
         assert!(eval.one_to_one);
         assert_eq!(eval.jobs.len(), 6);
         assert_eq!(eval.jobs[4].upstream, Some(4));
-        assert!(eval.jobs[4].line.contains("--model /s/runs/train/preset-small_seed-1/model"), "{}", eval.jobs[4].line);
+        assert!(
+            eval.jobs[4].line.contains("--model /s/runs/train/preset-medium_seed-1/model"),
+            "{}",
+            eval.jobs[4].line
+        );
         assert!(eval.jobs[4].line.contains("--seed 1"), "the eval inherits its model's seed");
-        assert_eq!(eval.jobs[4].cell_label(), "preset=small");
+        assert_eq!(eval.jobs[4].cell_label(), "preset=medium");
     }
 
     #[test]
@@ -478,6 +482,6 @@ command = "eval context --model {train} --env toy:inner"
         let refuse =
             |args: &[String]| if args[0] == "eval" { Err("unexpected argument '--bogus'".to_string()) } else { Ok(()) };
         let err = expand(&spec, Path::new("/s"), Path::new("m"), &refuse, false).unwrap_err();
-        assert!(err.to_string().contains("stage[1].command (job preset-medium_seed-0)"), "{err}");
+        assert!(err.to_string().contains("stage[1].command (job preset-small_seed-0)"), "{err}");
     }
 }

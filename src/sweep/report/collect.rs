@@ -178,7 +178,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn numeric_leaves_are_named_by_path_and_inputs_and_long_arrays_skipped() {
+    fn numeric_and_boolean_leaves_are_named_by_path_and_inputs_and_long_arrays_skipped() {
         let value: Value = serde_json::from_str(
             r#"{"provenance": {"seed": 3}, "settings": {"contexts": 50}, "prior_entropy": 22.5,
                 "mean_mse": [0.25, 0.5], "outcomes": [1,2,3,4,5,6,7,8,9], "angular": false, "env": "x",
@@ -188,7 +188,8 @@ mod tests {
         let mut out = Vec::new();
         leaves(&value, &mut String::new(), &mut out);
         let names: Vec<&str> = out.iter().map(|(n, _)| n.as_str()).collect();
-        assert_eq!(names, ["mean_mse[0]", "mean_mse[1]", "prior_entropy", "tests[0].n", "tests[0].p_value"]);
-        assert_eq!(out[1].1, 0.5);
+        // true/false count as 1/0 (a success flag's mean is a success rate).
+        assert_eq!(names, ["angular", "mean_mse[0]", "mean_mse[1]", "prior_entropy", "tests[0].n", "tests[0].p_value"]);
+        assert_eq!((out[0].1, out[2].1), (0.0, 0.5));
     }
 }
