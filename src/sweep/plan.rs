@@ -299,8 +299,18 @@ fn expand_stage(
             validate(&args).map_err(|m| Error::config(format!("{at}.command (job {name}): {m}")))?;
             let mut line_tokens = vec![mbrl.display().to_string()];
             line_tokens.extend(args);
-            let line = shlex::try_join(line_tokens.iter().map(String::as_str))
-                .map_err(|_| Error::config(format!("{at}.command: a value holds a NUL byte")))?;
+            if line_tokens.iter().any(|t| t.contains('\0')) {
+                return Err(Error::config(format!("{at}.command: a value holds a NUL byte")));
+            }
+            // A first word with `=` would be read as a variable assignment, not as the binary.
+            let program = match line_tokens[0].contains('=') {
+                true => format!("'{}'", line_tokens[0].replace('\'', r"'\''")),
+                false => shell_word(&line_tokens[0]),
+            };
+            let line = std::iter::once(program)
+                .chain(line_tokens[1..].iter().map(|t| shell_word(t)))
+                .collect::<Vec<_>>()
+                .join(" ");
             if line.contains('\n') {
                 return Err(Error::config(format!(
                     "{at}: a value or path holds a line break; a job list has one job per line"
@@ -316,6 +326,17 @@ fn expand_stage(
         one_to_one: upstream.is_some() && combos.len() == 1,
         jobs,
     })
+}
+
+/// A word as bash reads it back: plain when every character is one the shell gives no meaning to inside a
+/// word (so `lambda_kl=1` and paths stay readable), else single-quoted.
+fn shell_word(word: &str) -> String {
+    let plain = |c: char| c.is_ascii_alphanumeric() || "_./:=,+@%-".contains(c);
+    if !word.is_empty() && word.chars().all(plain) {
+        word.to_string()
+    } else {
+        format!("'{}'", word.replace('\'', r"'\''"))
+    }
 }
 
 /// `preset-small_seed-0`: each axis as key-value, characters a path or a shell would trip on replaced.
@@ -474,6 +495,15 @@ command = "eval context --model {train} --env toy:inner"
         );
         let err = expand(&Spec::parse(&big).unwrap(), Path::new("/s"), Path::new("m"), &accept, false).unwrap_err();
         assert!(err.to_string().contains("--allow-large"), "{err}");
+    }
+
+    #[test]
+    fn words_are_quoted_only_where_bash_needs_it() {
+        assert_eq!(shell_word("lambda_kl=1"), "lambda_kl=1");
+        assert_eq!(shell_word("/a/b-c/d.mcap"), "/a/b-c/d.mcap");
+        assert_eq!(shell_word("it's here"), r"'it'\''s here'");
+        assert_eq!(shell_word(""), "''");
+        assert_eq!(shell_word("$HOME"), "'$HOME'");
     }
 
     #[test]

@@ -110,7 +110,7 @@ fn a_local_sweep_runs_reruns_and_reports_failures() {
 }
 
 /// Whether the training at `model` checkpoints step `step` or later within `timeout`.
-fn wait_for_step(model: &Path, step: u64, timeout: Duration) -> bool {
+pub(crate) fn wait_for_step(model: &Path, step: u64, timeout: Duration) -> bool {
     let start = Instant::now();
     while start.elapsed() < timeout {
         if let Ok(text) = std::fs::read_to_string(model.join("checkpoint.json")) {

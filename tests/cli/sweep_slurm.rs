@@ -6,7 +6,7 @@ use std::path::Path;
 use std::process::{Command, Output};
 use std::time::{Duration, Instant};
 
-use super::sweep::{plan, toy_inputs, two_stage_spec};
+use super::sweep::{plan, toy_inputs, two_stage_spec, wait_for_step};
 use crate::common::*;
 
 fn slurm_conf() -> Option<String> {
@@ -132,18 +132,7 @@ fn a_task_warned_of_its_time_limit_requeues_and_resumes_to_the_same_bytes() {
         .expect("submit.sh names the job")
         .to_string();
     let model = d.join("slurm/runs/train/run/model");
-    let start = Instant::now();
-    let step = || -> u64 {
-        std::fs::read_to_string(model.join("checkpoint.json"))
-            .ok()
-            .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
-            .and_then(|v| v["step"].as_u64())
-            .unwrap_or(0)
-    };
-    while step() < 20 {
-        assert!(start.elapsed() < Duration::from_secs(120), "the task never reached step 20");
-        std::thread::sleep(Duration::from_millis(50));
-    }
+    assert!(wait_for_step(&model, 20, Duration::from_secs(120)), "the task never reached step 20");
     // What Slurm sends `warning_seconds` before the time limit (--signal=B:USR1@…), sent now.
     let signalled = Command::new("scancel")
         .args(["--batch", "--signal=USR1", &format!("{job}_0")])
