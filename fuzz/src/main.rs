@@ -185,6 +185,8 @@ fn targets() -> Vec<Target> {
             text("seads-full.toml"),
             "train --method seads --env tileswap:cursor --config {in} --env-steps 20 --out {out}",
         ),
+        // A sweep spec: every stage's command is parsed, the grid expanded and the scripts written.
+        target("toml-sweep", text("sweep.toml"), "sweep plan {in} --out {out}"),
         // A training log (text panels, scalars, progress) and an evaluation log (messages, thousands of lines).
         target("metrics-watch-train", text("seads/metrics.jsonl"), "watch {in}"),
         target("metrics-watch-eval", text("swingup/metrics.jsonl"), "watch {in}"),
@@ -325,6 +327,12 @@ const RESUME_FILES: &[&str] =
 // ---------------------------------------------------------------------------------------------------------------
 
 /// Tiny PETS network (as tests/cli/pets.rs).
+const SWEEP_TOML: &str = "[sweep]\nname = \"fuzz\"\n[[stage]]\nname = \"train\"\n\
+    command = \"train context --data ctx.mcap --config context.toml --steps 2 lambda_kl=1\"\n\
+    [stage.grid]\nseed = [0, 1]\n\"--preset\" = [\"small\"]\n[[stage]]\nname = \"eval\"\nafter = \"train\"\n\
+    command = \"eval context --model {train} --env toy:inner --contexts 2\"\n[stage.grid]\n\"--transitions\" = [1, 2]\n\
+    [slurm]\nmemory = \"1G\"\ntime = \"00:05:00\"\nmax_running = 2\n[[compare]]\nstage = \"eval\"\n\
+    metric = \"mean_mse[0]\"\na = { transitions = 1 }\nb = { transitions = 2 }\n";
 const PETS_TOML: &str = "hidden_layers = 2\nhidden_units = 16\nvalidate_every = 10\ncheckpoint_every = 20\n";
 /// Tiny context model (as tests/cli/context.rs).
 const CONTEXT_TOML: &str = "embedding = 16\nhidden_units = 16\ntransition_features = 8\nchunk_states = 10\n\
@@ -401,6 +409,7 @@ fn generate_seeds(dir: &Path) -> Result<(), String> {
     write("pets.toml", PETS_TOML);
     write("context.toml", CONTEXT_TOML);
     write("seads.toml", SEADS_TOML);
+    write("sweep.toml", SWEEP_TOML);
     write("ball.csv", &falling_ball_csv());
     write("actions.csv", "u\n0.5\n-2\n1.5\n1e-3\n");
     write("cursor.csv", "dx,dy,push\n0.2,-0.2,-1\n0.1,-0.1,0.9\n0,0,-1\n");

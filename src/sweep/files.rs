@@ -67,7 +67,7 @@ fn set_executable(path: &Path) -> Result<()> {
 
 /// Single-quoted for bash (the paths are the user's; a quote in them must not end the string).
 fn quoted(path: &Path) -> String {
-    format!("'{}'", path.display().to_string().replace('\'', r"'\''"))
+    super::plan::single_quoted(&path.display().to_string())
 }
 
 fn sbatch(plan: &Plan, stage: &StagePlan) -> String {

@@ -304,7 +304,7 @@ fn expand_stage(
             }
             // A first word with `=` would be read as a variable assignment, not as the binary.
             let program = match line_tokens[0].contains('=') {
-                true => format!("'{}'", line_tokens[0].replace('\'', r"'\''")),
+                true => single_quoted(&line_tokens[0]),
                 false => shell_word(&line_tokens[0]),
             };
             let line = std::iter::once(program)
@@ -335,8 +335,13 @@ fn shell_word(word: &str) -> String {
     if !word.is_empty() && word.chars().all(plain) {
         word.to_string()
     } else {
-        format!("'{}'", word.replace('\'', r"'\''"))
+        single_quoted(word)
     }
+}
+
+/// Single-quoted for bash: a quote inside ends the string, adds an escaped quote and starts a new one.
+pub(super) fn single_quoted(text: &str) -> String {
+    format!("'{}'", text.replace('\'', r"'\''"))
 }
 
 /// `preset-small_seed-0`: each axis as key-value, characters a path or a shell would trip on replaced.

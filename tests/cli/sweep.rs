@@ -54,7 +54,7 @@ pub(crate) fn plan(dir: &Path, spec: &str, out: &str) -> std::process::Output {
     mbrl(dir).args(["sweep", "plan", "spec.toml", "--out", out]).output().unwrap()
 }
 
-fn status(dir: &Path, sweep: &str) -> (i32, String) {
+fn sweep_status(dir: &Path, sweep: &str) -> (i32, String) {
     let out = mbrl(dir).args(["sweep", "status", sweep]).output().unwrap();
     (out.status.code().unwrap_or(-1), stdout_of(&out) + &stderr_of(&out))
 }
@@ -79,7 +79,7 @@ fn a_local_sweep_runs_reruns_and_reports_failures() {
     assert!(plan(d, &two_stage_spec(&data, &config, 20, "2, 0"), "s").status.success());
     assert_eq!(before, std::fs::read(d.join("s/sweep.json")).unwrap());
 
-    let (code, text) = status(d, "s");
+    let (code, text) = sweep_status(d, "s");
     assert_eq!(code, 3, "nothing has run: {text}");
     assert!(text.contains("0/12 jobs done") && text.contains("not started"), "{text}");
 
@@ -153,15 +153,15 @@ fn a_stopped_job_line_resumes_to_the_uninterrupted_bytes() {
         .unwrap();
     assert!(wait_for_step(&model, 20, Duration::from_secs(60)), "no checkpoint at step 20");
     // SIGTERM is what Slurm's time-limit warning becomes (see the batch script).
-    unsafe_kill(child.id(), "TERM");
+    send_signal(child.id(), "TERM");
     let status = child.wait().unwrap();
     assert_eq!(status.code(), Some(130));
-    let (code, text) = status_of(d, "b");
+    let (code, text) = sweep_status(d, "b");
     assert_eq!(code, 3, "{text}");
     assert!(text.contains("stopped at step"), "{text}");
     let resumed = std::process::Command::new("bash").arg("-c").arg(line("b")).output().unwrap();
     assert!(resumed.status.success(), "{}", stderr_of(&resumed));
-    let (code, text) = status_of(d, "b");
+    let (code, text) = sweep_status(d, "b");
     assert_eq!(code, 0, "{text}");
     for file in ["model.safetensors", "metrics.jsonl"] {
         let a = std::fs::read(d.join("a/runs/train/run/model").join(file));
@@ -170,11 +170,7 @@ fn a_stopped_job_line_resumes_to_the_uninterrupted_bytes() {
     }
 }
 
-fn status_of(d: &Path, sweep: &str) -> (i32, String) {
-    status(d, sweep)
-}
-
-fn unsafe_kill(pid: u32, signal: &str) {
+fn send_signal(pid: u32, signal: &str) {
     let ok = std::process::Command::new("kill").arg(format!("-{signal}")).arg(pid.to_string()).status().unwrap();
     assert!(ok.success());
 }
