@@ -238,7 +238,8 @@ mod tests {
         assert_eq!(push.state[..2], [0.5, 0.5]);
         let lit: Vec<usize> = (0..25).filter(|&i| push.next_state[2 + i] == 1.0).collect();
         assert_eq!(lit, vec![3, 7, 8, 9, 13], "field 8 and its neighbours");
-        assert_eq!(push.next_state[27], 1.0, "a board change starts a new skill");
+        assert_eq!(push.next_state[27], 0.9, "the changing step records the time left, as the reference does");
+        assert_eq!(data.steps[1].state[27], 1.0, "the next skill starts with full time");
         assert_eq!((data.steps[1].rollout, data.steps[1].t), (1, 0), "the next episode starts");
         assert_eq!(data.steps[2].next_state[27], 0.8, "two of ten skill steps used");
         assert_eq!(data.meta.instances.len(), 2);
@@ -261,8 +262,9 @@ mod tests {
         assert_eq!(reacher("1, 0.5, 0, -2").unwrap(), vec![1.0, 0.5, 0.0, -2.0]);
         let err = reacher("1,2").unwrap_err().to_string();
         assert!(err.contains("2 value(s)") && err.contains("shoulder_angle,wrist_angle"), "{err}");
-        let err = reacher("0,3,0,0").unwrap_err().to_string();
-        assert!(err.contains("wrist_angle = 3") && err.contains("tileswap:reacher"), "{err}");
+        assert!(reacher("0,3,0,0").is_ok(), "past the stop is a state the soft limit returns from");
+        let err = reacher("0,7,0,0").unwrap_err().to_string();
+        assert!(err.contains("wrist_angle = 7") && err.contains("tileswap:reacher"), "{err}");
         let cursor = |text| parse_manipulator_state(text, GameSpec::LightsOut(5), Embodiment::Cursor);
         let err = cursor("0.5,1.2").unwrap_err().to_string();
         assert!(err.contains("cursor_y = 1.2 is off the board"), "{err}");

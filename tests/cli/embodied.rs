@@ -47,6 +47,8 @@ fn a_scripted_cursor_push_writes_the_expected_board_bits() {
     assert_eq!(lit(&s[1].next_state), vec![6, 10, 11, 12, 16], "field 11 and its neighbours");
     // The push ended the first skill episode; the idle step is the next one.
     assert_eq!((s[1].rollout, s[2].rollout, s[2].t), (0, 1, 0));
+    assert_eq!(s[1].next_state[27], 0.8, "the pushing step records the time left (the authors' time-limit wrapper)");
+    assert_eq!(s[2].state[27], 1.0, "the next skill starts with the full time");
     assert_eq!(data.meta.instances.len(), 2);
     assert_eq!(data.meta.instances[0]["embodiment"], "cursor");
 }
@@ -110,7 +112,7 @@ fn bad_input_gives_one_line_and_no_file() {
             &["--env", "lightsout:cursor", "--actions", "ok.csv", "--init-state", "0.5,-0.1"],
             &["cursor_y = -0.1", "[0, 1]"],
         ),
-        (&["--env", "tileswap:reacher", "--actions", "ok.csv", "--init-state", "0,3,0,0"], &["wrist_angle = 3", "160"]),
+        (&["--env", "tileswap:reacher", "--actions", "ok.csv", "--init-state", "0,7,0,0"], &["wrist_angle = 7", "2π"]),
         (&["--env", "tileswap:cursor", "--actions", "ok.csv", "--board", "0,1,2,3,4,5,6,7,7"], &["--board", "chip 7"]),
     ];
     for (args, needles) in cases {

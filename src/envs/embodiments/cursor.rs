@@ -5,10 +5,14 @@ use rand_chacha::ChaCha8Rng;
 
 use super::manipulator::{BoardPoint, Manipulator, ScriptedController};
 
-/// Largest move per step along each axis.
-pub const MAX_STEP: f64 = 0.2;
-/// A push happens when the third action component exceeds this.
-pub const PUSH_THRESHOLD: f64 = 0.6;
+/// Largest move per step along each axis. The authors' action space is a float32 box of ±0.2 and moves are
+/// clipped to its bounds, so the bound is 0.2 rounded to float32 (0.20000000298023224): three clipped moves
+/// from the wall end just past the third field edge, not on it.
+pub const MAX_STEP: f64 = 0.2f32 as f64;
+/// A push happens when the third action component exceeds this. The authors' code writes it as
+/// −1 + 0.8·2, which in floating point is 0.6000000000000001, so an action of exactly that value does
+/// not push.
+pub const PUSH_THRESHOLD: f64 = -1.0 + 0.8 * 2.0;
 pub const SKILL_STEP_LIMIT: usize = 10;
 
 #[derive(Clone, Debug, Default)]

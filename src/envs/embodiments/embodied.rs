@@ -12,7 +12,9 @@ pub struct EmbodiedBoard<G: BoardGame> {
     game: G,
     board: G::State,
     manipulator: Box<dyn Manipulator>,
-    /// Steps since the last board change.
+    /// Steps since the skill started: a board change ends the skill but does not reset the count, so the
+    /// step that changed the board reports the time that was left (the authors' time-limit wrapper); the
+    /// next skill starts at full time through [`start_skill`](Self::start_skill) or a reset.
     skill_step: usize,
 }
 
@@ -58,19 +60,16 @@ impl<G: BoardGame> EmbodiedBoard<G> {
 
     fn remaining_time(&self) -> f64 {
         let limit = self.manipulator.skill_step_limit() as f64;
-        (limit - self.skill_step as f64) / limit
+        (limit - self.skill_step as f64).max(0.0) / limit
     }
 
     /// One control step; returns the game move a push performed, if any.
     pub fn act(&mut self, action: &[f64]) -> Option<usize> {
         let performed = self.manipulator.step(action).and_then(|p| self.game.move_at(p));
-        match performed {
-            Some(mv) => {
-                self.board = self.game.apply(self.board, mv);
-                self.skill_step = 0;
-            }
-            None => self.skill_step += 1,
+        if let Some(mv) = performed {
+            self.board = self.game.apply(self.board, mv);
         }
+        self.skill_step += 1;
         performed
     }
 

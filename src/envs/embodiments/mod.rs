@@ -5,6 +5,10 @@ pub mod cursor;
 pub mod embodied;
 pub mod manipulator;
 pub mod reacher;
+#[cfg(test)]
+mod reference_cases;
+#[cfg(test)]
+mod reference_tests;
 
 pub use manipulator::{BoardPoint, Manipulator, ScriptedController};
 

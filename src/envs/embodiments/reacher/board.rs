@@ -6,7 +6,7 @@ use std::f64::consts::TAU;
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
-use super::{Reacher, ACTION_REPEAT, BOARD_HALF_EXTENT, PUSH_THRESHOLD, SKILL_STEP_LIMIT, TIMESTEP, WRIST_LIMIT};
+use super::{Reacher, ACTION_REPEAT, BOARD_HALF_EXTENT, PUSH_THRESHOLD, SKILL_STEP_LIMIT, TIMESTEP};
 use crate::envs::embodiments::manipulator::{BoardPoint, Manipulator};
 
 /// Arm plane → board coordinates, as the authors' `ReacherEnv._get_finger_pos` normalizes MuJoCo's world
@@ -72,12 +72,12 @@ impl Manipulator for Reacher {
         vec![self.q[0], self.q[1], self.v[0], self.v[1]]
     }
 
-    /// The shoulder turns freely; the wrist stays within its stops (radians).
+    /// The shoulder turns freely. The wrist may lie past its ±160° stops (the authors' reset leaves it
+    /// there and the soft limit brings it back), but not more than a turn from zero, where the reset draws.
     fn state_problem(&self, state: &[f64]) -> Option<String> {
         let wrist = state.get(1).copied()?;
-        (wrist.abs() > WRIST_LIMIT).then(|| {
-            format!("wrist_angle = {wrist} is beyond the wrist's stops; expected radians in [-{WRIST_LIMIT}, {WRIST_LIMIT}] (±160°)")
-        })
+        (wrist.abs() > TAU)
+            .then(|| format!("wrist_angle = {wrist} is more than a full turn; expected radians in [-2π, 2π]"))
     }
 
     fn set_state(&mut self, state: &[f64]) {
@@ -85,14 +85,13 @@ impl Manipulator for Reacher {
         self.v = [state[2], state[3]];
     }
 
-    /// Both angles U(0, 2π), zero velocity (authors' code). MuJoCo keeps the raw wrist sample and its
-    /// soft limit then drives a wrist beyond +160° (56 % of the draws, the raw value lies in (160°, 360°))
-    /// back to +160° within the first few physics steps; we clamp right away, which ends in the same
-    /// place without the transient.
+    /// Both angles U(0, 2π), zero velocity (authors' code). The wrist keeps its draw even past the stop
+    /// (56 % of draws lie in (160°, 360°)); the soft limit drives it back to 160° within about ten steps,
+    /// as in the reference.
     fn reset(&mut self, rng: &mut ChaCha8Rng) {
         let shoulder = rng.random_range(0.0..TAU);
-        let wrist: f64 = rng.random_range(0.0..TAU);
-        self.q = [shoulder, wrist.min(WRIST_LIMIT)];
+        let wrist = rng.random_range(0.0..TAU);
+        self.q = [shoulder, wrist];
         self.v = [0.0, 0.0];
     }
 

@@ -4,8 +4,8 @@
 use std::f64::consts::{PI, TAU};
 
 use super::{
-    arm_to_board, board_to_arm, min_reach, Reacher, ACTION_REPEAT, ARM_LENGTH, BOARD_HALF_EXTENT, FINGER_OFFSET, GEAR,
-    WRIST_LIMIT,
+    arm_to_board, board_to_arm, min_reach, pressed_reach, pressed_wrist_angle, Reacher, ACTION_REPEAT, ARM_LENGTH,
+    BOARD_HALF_EXTENT, FINGER_OFFSET, GEAR, WRIST_LIMIT,
 };
 use crate::envs::embodiments::manipulator::{BoardPoint, Manipulator, ScriptedController};
 
@@ -29,9 +29,10 @@ struct Plan {
 /// of the aim point and nearly at rest.
 ///
 /// Points closer than [`min_reach`] to the shoulder (a disc of radius 0.139 around the board centre)
-/// cannot be touched. For those the controller presses the wrist against its stop and pushes at the
-/// reachable point nearest to the target in the max-norm, with the push point no farther (max-norm)
-/// from the target than that point plus [`ReacherController::SHORTFALL_SLACK`]: for the centre field of a
+/// lie beyond the wrist's range. For those the controller presses the wrist into its stop, where the
+/// soft limit holds it 4.75° past (the finger then circles at [`pressed_reach`]), and heads for the
+/// reachable point nearest to the target in the max-norm; it pushes once the finger is no farther
+/// (max-norm) from the target than that point plus [`ReacherController::SHORTFALL_SLACK`]: for the centre field of a
 /// 5×5 LightsOut board this is a point on the diagonal 0.098 from its centre, just inside the field.
 #[derive(Clone, Debug)]
 pub struct ReacherController {
@@ -113,11 +114,12 @@ impl ReacherController {
         let [q1, q2] = self.model.q;
         let r_min = min_reach();
         let r_t = t[0].hypot(t[1]);
+        // Pressed at full torque the wrist rests past the stop, so the finger circles closer in.
         let (aim, press) = if r_t >= r_min {
             (t, None)
         } else {
             let f = self.model.finger();
-            (Self::max_norm_projection(t, r_min, f[1].atan2(f[0])), Some(1.0))
+            (Self::max_norm_projection(t, pressed_reach(), f[1].atan2(f[0])), Some(1.0))
         };
         let max_norm = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).abs().max((a[1] - b[1]).abs());
         let shortfall = max_norm(arm_to_board(aim), target);
@@ -126,7 +128,7 @@ impl ReacherController {
         for elbow in [1.0, -1.0] {
             let joints = match press {
                 Some(_) => {
-                    let wrist = elbow * WRIST_LIMIT;
+                    let wrist = elbow * pressed_wrist_angle();
                     let shoulder = aim[1].atan2(aim[0])
                         - (FINGER_OFFSET * wrist.sin()).atan2(ARM_LENGTH + FINGER_OFFSET * wrist.cos());
                     Some([shoulder, wrist])
@@ -203,13 +205,18 @@ impl ScriptedController for ReacherController {
         }
         let finger = next.effector();
         let aim = arm_to_board(plan.aim);
-        let close = (finger[0] - aim[0]).hypot(finger[1] - aim[1]) <= self.tolerance;
-        let within_shortfall = plan.press.is_none()
-            || (finger[0] - target[0]).abs().max((finger[1] - target[1]).abs())
-                <= plan.shortfall + Self::SHORTFALL_SLACK;
+        // Pressed into the stop, the soft limit lets the wrist sink up to 5° past 160°, which moves the
+        // finger off the aim circle towards the target: there only the distance to the target counts.
+        let close = match plan.press {
+            None => (finger[0] - aim[0]).hypot(finger[1] - aim[1]) <= self.tolerance,
+            Some(_) => {
+                (finger[0] - target[0]).abs().max((finger[1] - target[1]).abs())
+                    <= plan.shortfall + Self::SHORTFALL_SLACK
+            }
+        };
         let velocity = next.finger_velocity();
         let slow = velocity[0].hypot(velocity[1]) / (2.0 * BOARD_HALF_EXTENT) <= self.max_push_speed;
-        let push = close && within_shortfall && slow;
+        let push = close && slow;
         vec![u[0], u[1], if push { 1.0 } else { -1.0 }]
     }
 

@@ -25,14 +25,13 @@
 //! joint damping taken implicitly ((M + h·B) q̈ = gear·u − C q̇ − B q̇, as `mj_Euler` does whenever a dof has
 //! damping), then the position with the new velocity.
 //!
-//! Simplification: MuJoCo enforces the wrist range with a soft constraint (a stiff spring-damper with
-//! time constant 2·timestep that lets the wrist sink about 2° past 160° under full torque). Here the limit
-//! is a hard stop: a wrist arriving at ±160° is clamped there, and a plastic impulse at the wrist (an
-//! internal torque between the links) removes the velocity that drives into the stop, both on arrival
-//! and, before the position update, while it rests against the stop.
+//! The wrist's range is MuJoCo's soft joint limit (see [`limit`]): past ±160° a spring-damper with
+//! time constant 2·timestep pushes back, so under full torque the wrist sinks about 2° past the stop and
+//! a wrist set far beyond it returns over a few steps, as in the reference.
 
 mod board;
 mod controller;
+mod limit;
 mod physics;
 #[cfg(test)]
 mod tests;
@@ -41,7 +40,10 @@ use std::f64::consts::PI;
 
 pub use board::{arm_to_board, board_to_arm};
 pub use controller::ReacherController;
-pub use physics::{capsule_mass_inertia, finger_position, min_reach, sphere_mass_inertia, ArmInertia, Reacher};
+pub use physics::{
+    capsule_mass_inertia, finger_position, min_reach, pressed_reach, pressed_wrist_angle, sphere_mass_inertia,
+    ArmInertia, Reacher,
+};
 
 /// Physics timestep of `reacher.xml` (seconds).
 pub const TIMESTEP: f64 = 0.02;
@@ -65,8 +67,10 @@ pub const FINGER_RADIUS: f64 = 0.01;
 pub const DENSITY: f64 = 1000.0;
 /// Wrist range ±160°.
 pub const WRIST_LIMIT: f64 = 160.0 * PI / 180.0;
-/// A push happens when the third action component exceeds this (authors' code: −1 + 0.8·2).
-pub const PUSH_THRESHOLD: f64 = 0.6;
+/// A push happens when the third action component exceeds this. The authors' code writes it as
+/// −1 + 0.8·2, which in floating point is 0.6000000000000001, so an action of exactly that value does
+/// not push.
+pub const PUSH_THRESHOLD: f64 = -1.0 + 0.8 * 2.0;
 /// The board covers [−0.15, 0.15]² in the arm's plane (thesis D.1.2).
 pub const BOARD_HALF_EXTENT: f64 = 0.15;
 /// Skill step limit for Reacher (thesis 7.4.1).

@@ -1,8 +1,9 @@
 //! The arm's rigid-body model: masses and inertias from the MJCF geoms, forward kinematics, and the planar
-//! two-link dynamics stepped like MuJoCo's Euler integrator, with the wrist's hard stop.
+//! two-link dynamics stepped like MuJoCo's Euler integrator, with the wrist's soft limit.
 
 use std::f64::consts::PI;
 
+use super::limit::{resting_violation, wrist_limit_torque, WristLimitInput};
 use super::{
     ARM_LENGTH, CAPSULE_RADIUS, DAMPING, DENSITY, FINGER_OFFSET, FINGER_RADIUS, GEAR, HAND_LENGTH, TIMESTEP,
     WRIST_LIMIT,
@@ -13,6 +14,18 @@ use super::{
 pub fn min_reach() -> f64 {
     (ARM_LENGTH * ARM_LENGTH + FINGER_OFFSET * FINGER_OFFSET + 2.0 * ARM_LENGTH * FINGER_OFFSET * WRIST_LIMIT.cos())
         .sqrt()
+}
+
+/// Where full torque into a stop holds the wrist (magnitude): 4.75° past 160°, by the soft limit.
+pub fn pressed_wrist_angle() -> f64 {
+    WRIST_LIMIT + resting_violation(GEAR, Reacher::new().inverse_inertia_at_rest, TIMESTEP)
+}
+
+/// Distance of the finger from the shoulder with the wrist pressed into a stop: 0.0319, closer than
+/// [`min_reach`] because the soft limit gives way.
+pub fn pressed_reach() -> f64 {
+    let wrist = pressed_wrist_angle();
+    (ARM_LENGTH * ARM_LENGTH + FINGER_OFFSET * FINGER_OFFSET + 2.0 * ARM_LENGTH * FINGER_OFFSET * wrist.cos()).sqrt()
 }
 
 /// Mass and rotational inertia (about the centre, normal to the axis) of a capsule whose segment has
@@ -97,6 +110,8 @@ pub struct Reacher {
     inertia: ArmInertia,
     /// Joint damping of both hinges; a field so that tests can switch it off.
     pub damping: f64,
+    /// (M⁻¹)₂₂ with both joints at zero, which scales the limit's softness (MuJoCo's `dof_invweight0`).
+    inverse_inertia_at_rest: f64,
 }
 
 impl Default for Reacher {
@@ -107,7 +122,15 @@ impl Default for Reacher {
 
 impl Reacher {
     pub fn new() -> Self {
-        Reacher { q: [0.0, 0.0], v: [0.0, 0.0], inertia: ArmInertia::dm_control(), damping: DAMPING }
+        let mut arm = Reacher {
+            q: [0.0, 0.0],
+            v: [0.0, 0.0],
+            inertia: ArmInertia::dm_control(),
+            damping: DAMPING,
+            inverse_inertia_at_rest: 0.0,
+        };
+        arm.inverse_inertia_at_rest = solve2(arm.mass_matrix(0.0), [0.0, 1.0])[1];
+        arm
     }
 
     pub fn inertia(&self) -> ArmInertia {
@@ -166,7 +189,9 @@ impl Reacher {
         self.integrate(ctrl, TIMESTEP);
     }
 
-    /// One semi-implicit Euler step of length `h`.
+    /// One semi-implicit Euler step of length `h`, as `mj_Euler` takes it: the wrist limit's force is
+    /// solved with the plain inertia, then all forces go through (M + h·B) so that the damping acts
+    /// implicitly, then the position moves with the new velocity.
     pub(super) fn integrate(&mut self, ctrl: [f64; 2], h: f64) {
         let m = self.mass_matrix(self.q[1]);
         let bias = self.bias_forces();
@@ -175,34 +200,18 @@ impl Reacher {
             let u = if ctrl[j].is_finite() { ctrl[j].clamp(-1.0, 1.0) } else { 0.0 };
             force[j] = GEAR * u - bias[j] - self.damping * self.v[j];
         }
-        // Damping implicit in the velocity update, as MuJoCo's Euler integrator does.
+        let free = solve2(m, force);
+        force[1] += wrist_limit_torque(&WristLimitInput {
+            wrist_angle: self.q[1],
+            wrist_velocity: self.v[1],
+            free_acceleration: free[1],
+            inverse_inertia: solve2(m, [0.0, 1.0])[1],
+            inverse_inertia_at_rest: self.inverse_inertia_at_rest,
+            timestep: h,
+        });
         let lhs = [[m[0][0] + h * self.damping, m[0][1]], [m[1][0], m[1][1] + h * self.damping]];
         let acc = solve2(lhs, force);
         self.v = [self.v[0] + h * acc[0], self.v[1] + h * acc[1]];
-        // Resting on (or beyond) a stop: no velocity into it, before the position moves.
-        let side = self.q[1].signum();
-        if self.q[1].abs() >= WRIST_LIMIT && self.v[1] * side > 0.0 {
-            self.stop_wrist(lhs);
-        }
         self.q = [self.q[0] + h * self.v[0], self.q[1] + h * self.v[1]];
-        // Arriving at a stop within this step: clamp and stop the wrist there.
-        if self.q[1].abs() > WRIST_LIMIT {
-            self.q[1] = self.q[1].signum() * WRIST_LIMIT;
-            if self.v[1] * self.q[1] > 0.0 {
-                self.stop_wrist(lhs);
-            }
-        }
-    }
-
-    /// Plastic impulse at the wrist: the wrist velocity becomes zero. It acts through the same matrix
-    /// as the velocity update (M + h·B, like MuJoCo's constraint force, which enters the Euler update
-    /// alongside the other forces), so a torque pressing the wrist into its stop does not leak into the
-    /// shoulder, and without damping the shoulder's angular momentum is unchanged.
-    fn stop_wrist(&mut self, metric: [[f64; 2]; 2]) {
-        // Column e₂ of the inverse metric.
-        let column = solve2(metric, [0.0, 1.0]);
-        let impulse = -self.v[1] / column[1];
-        self.v[0] += column[0] * impulse;
-        self.v[1] = 0.0;
     }
 }
