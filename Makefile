@@ -7,7 +7,7 @@ MBRL := target/release/mbrl
 RUN := $(MBRL) --force
 SEED ?= 0
 
-.PHONY: build test bench completions mujoco mujoco-assets repro-quick repro-swingup repro-pendulum-data repro-boards repro-ball repro-pets repro-pets-loop repro-context repro-context-toy repro-context-mountaincar repro-tradyn repro-seads repro-dlgpd clean-reports
+.PHONY: build test bench completions mujoco mujoco-assets repro-jaco repro-quick repro-swingup repro-pendulum-data repro-boards repro-ball repro-pets repro-pets-loop repro-context repro-context-toy repro-context-mountaincar repro-tradyn repro-seads repro-dlgpd clean-reports
 
 # The Jaco arm (`--embodiment jaco`, `lightsout:jaco`) runs on MuJoCo behind the `mujoco` cargo feature; the
 # default build stays MuJoCo-free. This target fetches MuJoCo 3.17.0 (the version mujoco-rs 7 binds) from its
@@ -38,6 +38,13 @@ $(MUJOCO_DIR)/kinova/jaco_arm.xml: $(MUJOCO_DIR)/wheels/.fetched
 	rm -rf $(MUJOCO_DIR)/unpack
 mujoco: mujoco-assets
 	cargo build --release --features mujoco
+
+# Thesis 7.4.1 with the Jaco: its scripted controller (IK to each push point) on 100 boards of depth ≤ 5 per game.
+repro-jaco: mujoco
+	for game in lightsout tileswap; do \
+		$(RUN) eval embodied --game $$game --embodiment jaco --max-depth 5 --boards 100 --seed $(SEED) \
+			--no-tui --out reports/embodied-$$game-jaco || exit 1; \
+	done
 
 build:
 	cargo build --release

@@ -15,6 +15,7 @@ mod dlgpd;
 mod embodied;
 mod eval_render;
 mod export;
+mod jaco;
 mod foxglove_schemas;
 mod kill;
 mod list;

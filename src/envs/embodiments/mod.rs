@@ -56,11 +56,6 @@ impl Embodiment {
         }
     }
 
-    /// Whether this build can simulate it.
-    pub fn available(self) -> bool {
-        self != Embodiment::Jaco || cfg!(feature = "mujoco")
-    }
-
     /// The manipulator over `board` and its scripted controller. Cursor and Reacher play every board alike;
     /// the Jaco's scene holds the board, so it is built for one. Fails for the Jaco in a build without
     /// MuJoCo, or when MuJoCo cannot load its model.

@@ -21,7 +21,8 @@ fn scene_has_the_authors_board_geometry() {
     assert_eq!(field_centre(3, 1, 1), [0.0, 0.0]);
     let xml = scene_xml(5, Touch::PerField);
     assert_eq!(xml.matches("<touch ").count(), 25);
-    assert!(xml.contains(r#"size="0.035 0.035 0.005""#), "sensor sites cover 70 % of a field");
+    let half = 0.7 * 0.05;
+    assert!(xml.contains(&format!(r#"size="{half} {half} 0.005""#)), "sensor sites cover 70 % of a field");
     assert_eq!(scene_xml(3, Touch::Whole).matches("<touch ").count(), 1);
 }
 
