@@ -39,7 +39,18 @@ fn jaco_replays_target_velocities_from_a_given_state() {
     std::fs::write(dir.path().join("a.csv"), rows).unwrap();
     let start = "1.5,3.0,1.5,4.0,1.5,3.0,0.2,0.2,0.2,0,0,0,0,0,0,0,0,0";
     let out = mbrl(dir.path())
-        .args(["collect", "--env", "lightsout:jaco", "--actions", "a.csv", "--init-state", start, "--out", "j.mcap", "-q"])
+        .args([
+            "collect",
+            "--env",
+            "lightsout:jaco",
+            "--actions",
+            "a.csv",
+            "--init-state",
+            start,
+            "--out",
+            "j.mcap",
+            "-q",
+        ])
         .output()
         .unwrap();
     assert!(out.status.success(), "{}", stderr_of(&out));

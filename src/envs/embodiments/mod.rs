@@ -62,9 +62,7 @@ impl Embodiment {
     pub fn build(self, board: &BoardLayout) -> Result<(Box<dyn Manipulator>, Box<dyn ScriptedController>)> {
         match self {
             Embodiment::Cursor => Ok((Box::new(cursor::Cursor::new()), Box::new(cursor::CursorController))),
-            Embodiment::Reacher => {
-                Ok((Box::new(reacher::Reacher::new()), Box::new(reacher::ReacherController::new())))
-            }
+            Embodiment::Reacher => Ok((Box::new(reacher::Reacher::new()), Box::new(reacher::ReacherController::new()))),
             Embodiment::Jaco => build_jaco(board),
         }
     }

@@ -19,8 +19,12 @@ pub fn table() -> Table {
             .unwrap_or_default();
         // Sizes do not depend on the board; the Jaco is listed without them where this build cannot run it.
         let sizes = match embodiment.build(&BoardLayout::of(&LightsOut::new(5).expect("5x5 is a LightsOut size"))) {
-            Ok((m, _)) => [m.state_names().len(), m.action_low().len()].map(|n| n.to_string()).to_vec().into_iter()
-                .chain([m.dt().to_string(), m.skill_step_limit().to_string()]).collect(),
+            Ok((m, _)) => [m.state_names().len(), m.action_low().len()]
+                .map(|n| n.to_string())
+                .to_vec()
+                .into_iter()
+                .chain([m.dt().to_string(), m.skill_step_limit().to_string()])
+                .collect(),
             Err(_) => vec!["-".to_string(); 4],
         };
         let mut row = vec![name.to_string()];

@@ -9,8 +9,8 @@ use super::memory::{Episode, ObsLayout};
 use crate::envs::boards::BoardGame;
 use crate::envs::embodiments::embodied::EmbodiedBoard;
 use crate::envs::embodiments::{BoardLayout, Embodiment};
-use crate::error::Result;
 use crate::envs::Env;
+use crate::error::Result;
 
 /// The policy input: observation ⊕ onehot(k).
 pub fn policy_input(obs: &[f32], skill: usize, skills: usize, out: &mut Vec<f32>) {

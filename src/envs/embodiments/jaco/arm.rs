@@ -17,17 +17,56 @@ use crate::envs::embodiments::BoardLayout;
 use crate::error::Result;
 
 const STATE_NAMES: [&str; 2 * JOINTS] = [
-    "joint_1", "joint_2", "joint_3", "joint_4", "joint_5", "joint_6", "finger_1", "finger_2", "finger_3",
-    "joint_1_velocity", "joint_2_velocity", "joint_3_velocity", "joint_4_velocity", "joint_5_velocity",
-    "joint_6_velocity", "finger_1_velocity", "finger_2_velocity", "finger_3_velocity",
+    "joint_1",
+    "joint_2",
+    "joint_3",
+    "joint_4",
+    "joint_5",
+    "joint_6",
+    "finger_1",
+    "finger_2",
+    "finger_3",
+    "joint_1_velocity",
+    "joint_2_velocity",
+    "joint_3_velocity",
+    "joint_4_velocity",
+    "joint_5_velocity",
+    "joint_6_velocity",
+    "finger_1_velocity",
+    "finger_2_velocity",
+    "finger_3_velocity",
 ];
 
 const OBS_NAMES: [&str; 29] = [
-    "joint_1_sin", "joint_1_cos", "joint_2_sin", "joint_2_cos", "joint_3_sin", "joint_3_cos", "joint_4_sin",
-    "joint_4_cos", "joint_5_sin", "joint_5_cos", "joint_6_sin", "joint_6_cos", "joint_1_velocity",
-    "joint_2_velocity", "joint_3_velocity", "joint_4_velocity", "joint_5_velocity", "joint_6_velocity",
-    "finger_1", "finger_2", "finger_3", "finger_1_velocity", "finger_2_velocity", "finger_3_velocity",
-    "tcp_x", "tcp_y", "tcp_height", "tcp_down", "tcp_yaw",
+    "joint_1_sin",
+    "joint_1_cos",
+    "joint_2_sin",
+    "joint_2_cos",
+    "joint_3_sin",
+    "joint_3_cos",
+    "joint_4_sin",
+    "joint_4_cos",
+    "joint_5_sin",
+    "joint_5_cos",
+    "joint_6_sin",
+    "joint_6_cos",
+    "joint_1_velocity",
+    "joint_2_velocity",
+    "joint_3_velocity",
+    "joint_4_velocity",
+    "joint_5_velocity",
+    "joint_6_velocity",
+    "finger_1",
+    "finger_2",
+    "finger_3",
+    "finger_1_velocity",
+    "finger_2_velocity",
+    "finger_3_velocity",
+    "tcp_x",
+    "tcp_y",
+    "tcp_height",
+    "tcp_down",
+    "tcp_yaw",
 ];
 
 /// Where the touch sensing and the board's geoms are in the model.
@@ -57,9 +96,11 @@ impl Jaco {
     }
 
     pub(super) fn with_model(model: Arc<MjModel>, layout: BoardLayout) -> Self {
-        let id = |kind, name: &str| model.name_to_id(kind, name).unwrap_or_else(|| panic!("the Jaco scene has '{name}'"));
+        let id =
+            |kind, name: &str| model.name_to_id(kind, name).unwrap_or_else(|| panic!("the Jaco scene has '{name}'"));
         let side = layout.side;
-        let fields = (0..side * side).map(|k| id(MjtObjBase::mjOBJ_GEOM, &format!("field_{}_{}", k / side, k % side))).collect();
+        let fields =
+            (0..side * side).map(|k| id(MjtObjBase::mjOBJ_GEOM, &format!("field_{}_{}", k / side, k % side))).collect();
         let tcp = id(MjtObjBase::mjOBJ_SITE, &format!("{ARM_PREFIX}{HAND_PREFIX}gripsite"));
         let hand_prefix = format!("{ARM_PREFIX}{HAND_PREFIX}");
         let hand_bodies = (0..model.ffi().nbody as usize)
@@ -68,7 +109,14 @@ impl Jaco {
         let touch = if layout.field_sensors { Touch::PerField } else { Touch::Whole };
         let mut data = MjData::new(model.clone());
         data.forward();
-        Jaco { model, data, board: Board { layout, touch, fields }, tcp, hand_bodies, rng: ChaCha8Rng::seed_from_u64(0) }
+        Jaco {
+            model,
+            data,
+            board: Board { layout, touch, fields },
+            tcp,
+            hand_bodies,
+            rng: ChaCha8Rng::seed_from_u64(0),
+        }
     }
 
     pub fn model(&self) -> &Arc<MjModel> {
@@ -96,13 +144,18 @@ impl Jaco {
 
     /// The push this physics step made, judged from the sensors now and the contacts of before the step.
     fn push(&self, before: &[(i32, i32, [f64; 3])]) -> Option<BoardPoint> {
-        let contact_of = |geom: usize| before.iter().find(|c| c.0 as usize == geom || c.1 as usize == geom).map(|c| c.2);
+        let contact_of =
+            |geom: usize| before.iter().find(|c| c.0 as usize == geom || c.1 as usize == geom).map(|c| c.2);
         let readings = self.data.sensordata();
         let width = self.board_width();
         match self.board.touch {
             Touch::PerField => {
                 // numpy's argmax: the first of equal maxima.
-                let (k, &most) = readings.iter().enumerate().fold((0, &f64::NEG_INFINITY), |best, r| if *r.1 > *best.1 { r } else { best });
+                let (k, &most) =
+                    readings
+                        .iter()
+                        .enumerate()
+                        .fold((0, &f64::NEG_INFINITY), |best, r| if *r.1 > *best.1 { r } else { best });
                 if most <= TOUCH_THRESHOLD {
                     return None;
                 }
@@ -186,11 +239,15 @@ impl Manipulator for Jaco {
     }
 
     fn state_problem(&self, state: &[f64]) -> Option<String> {
-        let limited = [(1, super::ik::JOINT_LOW[1], super::ik::JOINT_HIGH[1]), (2, super::ik::JOINT_LOW[2], super::ik::JOINT_HIGH[2])];
+        let limited = [
+            (1, super::ik::JOINT_LOW[1], super::ik::JOINT_HIGH[1]),
+            (2, super::ik::JOINT_LOW[2], super::ik::JOINT_HIGH[2]),
+        ];
         limited.into_iter().chain((ARM_JOINTS..JOINTS).map(|j| (j, 0.15, 1.35))).find_map(|(j, low, high)| {
             let v = *state.get(j)?;
-            (!(low..=high).contains(&v))
-                .then(|| format!("{} = {v} is outside the joint's range; expected radians in [{low}, {high}]", STATE_NAMES[j]))
+            (!(low..=high).contains(&v)).then(|| {
+                format!("{} = {v} is outside the joint's range; expected radians in [{low}, {high}]", STATE_NAMES[j])
+            })
         })
     }
 

@@ -81,13 +81,16 @@ fn rotation_error(to: [f64; 4], from: [f64; 4]) -> [f64; 3] {
 pub fn site_jacobian(data: &Data, site: usize) -> (Vec<f64>, Vec<f64>) {
     let nv = data.model().ffi().nv as usize;
     let (p, r) = data.jac_site(true, true, site);
-    let pick = |full: Vec<f64>| (0..3).flat_map(|i| (0..ARM_JOINTS).map(move |j| (i, j))).map(|(i, j)| full[i * nv + j]).collect();
+    let pick = |full: Vec<f64>| {
+        (0..3).flat_map(|i| (0..ARM_JOINTS).map(move |j| (i, j))).map(|(i, j)| full[i * nv + j]).collect()
+    };
     (pick(p), pick(r))
 }
 
 /// Damped least squares for `J x = e` (6 × 6 over the arm joints).
 pub fn solve_dls(jp: &[f64], jr: &[f64], e: [f64; 6], rot_weight: f64, damping: f64) -> [f64; 6] {
-    let jac = Matrix6::from_fn(|i, j| if i < 3 { jp[i * ARM_JOINTS + j] } else { rot_weight * jr[(i - 3) * ARM_JOINTS + j] });
+    let jac =
+        Matrix6::from_fn(|i, j| if i < 3 { jp[i * ARM_JOINTS + j] } else { rot_weight * jr[(i - 3) * ARM_JOINTS + j] });
     let err = Vector6::from_fn(|i, _| if i < 3 { e[i] } else { rot_weight * e[i] });
     let lhs = jac.transpose() * jac + Matrix6::identity() * damping;
     let rhs = jac.transpose() * err;
@@ -123,7 +126,9 @@ fn pose_error(data: &Data, site: usize, pos: [f64; 3], quat: [f64; 4]) -> ([f64;
     let x = data.site_xpos()[site];
     let r = rotation_error(quat, mat_to_quat(&data.site_xmat()[site]));
     let e = [pos[0] - x[0], pos[1] - x[1], pos[2] - x[2], r[0], r[1], r[2]];
-    let norm = (e[..3].iter().map(|v| v * v).sum::<f64>() + ROT_WEIGHT * ROT_WEIGHT * e[3..].iter().map(|v| v * v).sum::<f64>()).sqrt();
+    let norm = (e[..3].iter().map(|v| v * v).sum::<f64>()
+        + ROT_WEIGHT * ROT_WEIGHT * e[3..].iter().map(|v| v * v).sum::<f64>())
+    .sqrt();
     (e, norm)
 }
 

@@ -44,10 +44,16 @@ pub fn scene_xml(side: usize, touch: Touch) -> String {
         for col in 0..side {
             let [x, y] = field_centre(side, row, col);
             // Board geoms keep MuJoCo's default contact parameters, as the board's own MJCF model does.
-            let _ = writeln!(fields, r#"<geom name="field_{row}_{col}" type="box" size="{FIELD_HALF} {FIELD_HALF} 0.01" pos="{x} {y} 0.01"/>"#);
+            let _ = writeln!(
+                fields,
+                r#"<geom name="field_{row}_{col}" type="box" size="{FIELD_HALF} {FIELD_HALF} 0.01" pos="{x} {y} 0.01"/>"#
+            );
             if touch == Touch::PerField {
                 let half = 0.7 * FIELD_HALF;
-                let _ = writeln!(fields, r#"<site name="touch_{row}_{col}" type="box" size="{half} {half} 0.005" pos="{x} {y} 0.02"/>"#);
+                let _ = writeln!(
+                    fields,
+                    r#"<site name="touch_{row}_{col}" type="box" size="{half} {half} 0.005" pos="{x} {y} 0.02"/>"#
+                );
                 let _ = writeln!(sensors, r#"<touch name="touch_{row}_{col}" site="touch_{row}_{col}"/>"#);
             }
         }
@@ -60,11 +66,18 @@ pub fn scene_xml(side: usize, touch: Touch) -> String {
     let mut actuators = String::new();
     for (k, (velocity, torque)) in ARM_MAX_VELOCITY.iter().zip(ARM_MAX_TORQUE).enumerate() {
         let joint = format!("{ARM_PREFIX}joint_{}", k + 1);
-        let _ = writeln!(actuators, r#"<velocity name="{joint}" joint="{joint}" kv="{ARM_KV}" ctrllimited="true" ctrlrange="{} {velocity}" forcelimited="true" forcerange="{} {torque}"/>"#, -velocity, -torque);
+        let _ = writeln!(
+            actuators,
+            r#"<velocity name="{joint}" joint="{joint}" kv="{ARM_KV}" ctrllimited="true" ctrlrange="{} {velocity}" forcelimited="true" forcerange="{} {torque}"/>"#,
+            -velocity, -torque
+        );
     }
     for k in 1..=3 {
         let joint = format!("{ARM_PREFIX}{HAND_PREFIX}finger_{k}");
-        let _ = writeln!(actuators, r#"<velocity name="{joint}" joint="{joint}" kv="{FINGER_KV}" ctrllimited="true" ctrlrange="-{FINGER_MAX_VELOCITY} {FINGER_MAX_VELOCITY}" forcelimited="true" forcerange="-{FINGER_MAX_TORQUE} {FINGER_MAX_TORQUE}"/>"#);
+        let _ = writeln!(
+            actuators,
+            r#"<velocity name="{joint}" joint="{joint}" kv="{FINGER_KV}" ctrllimited="true" ctrlrange="-{FINGER_MAX_VELOCITY} {FINGER_MAX_VELOCITY}" forcelimited="true" forcerange="-{FINGER_MAX_TORQUE} {FINGER_MAX_TORQUE}"/>"#
+        );
     }
     let [ax, ay, az] = ARM_OFFSET;
     format!(
