@@ -15,6 +15,11 @@ fn without_mujoco_naming_jaco_says_how_to_build_it() {
     let collect =
         mbrl(dir.path()).args(["collect", "--env", "lightsout:jaco", "--episodes", "1", "-q"]).output().unwrap();
     assert_one_line_error(&collect, &["Jaco", "make mujoco"]);
+    let eval = mbrl(dir.path())
+        .args(["eval", "embodied", "--game", "lightsout", "--embodiment", "jaco", "--boards", "2", "-q"])
+        .output()
+        .unwrap();
+    assert_one_line_error(&eval, &["Jaco", "make mujoco"]);
 }
 
 #[cfg(feature = "mujoco")]

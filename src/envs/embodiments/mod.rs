@@ -56,6 +56,15 @@ impl Embodiment {
         }
     }
 
+    /// Refuses the Jaco in a build without MuJoCo, so that a command fails before its work, not at its first
+    /// move.
+    pub fn ensure_buildable(self) -> Result<()> {
+        if self == Embodiment::Jaco && !cfg!(feature = "mujoco") {
+            return Err(Error::config(JACO_NEEDS_MUJOCO));
+        }
+        Ok(())
+    }
+
     /// The manipulator over `board` and its scripted controller. Cursor and Reacher play every board alike;
     /// the Jaco's scene holds the board, so it is built for one. Fails for the Jaco in a build without
     /// MuJoCo, or when MuJoCo cannot load its model.
