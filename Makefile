@@ -7,7 +7,44 @@ MBRL := target/release/mbrl
 RUN := $(MBRL) --force
 SEED ?= 0
 
-.PHONY: build test bench completions repro-quick repro-swingup repro-pendulum-data repro-boards repro-ball repro-pets repro-pets-loop repro-context repro-context-toy repro-context-mountaincar repro-tradyn repro-seads repro-dlgpd clean-reports
+.PHONY: build test bench completions mujoco mujoco-assets repro-jaco repro-quick repro-swingup repro-pendulum-data repro-boards repro-ball repro-pets repro-pets-loop repro-context repro-context-toy repro-context-mountaincar repro-tradyn repro-seads repro-dlgpd clean-reports
+
+# The Jaco arm (`--embodiment jaco`, `lightsout:jaco`) runs on MuJoCo behind the `mujoco` cargo feature; the
+# default build stays MuJoCo-free. This target fetches MuJoCo 3.17.0 (the version mujoco-rs 7 binds) from its
+# PyPI wheel and dm_control's Kinova Jaco model (with Kinova's BSD-3 licence) from the dm_control wheel into
+# .mujoco/ (git-ignored), then builds with the feature. The binary finds libmujoco through an rpath and the
+# Kinova files through a path compiled in (build.rs), so it runs without LD_LIBRARY_PATH.
+MUJOCO_DIR := .mujoco
+MUJOCO_WHEEL_VERSION := 3.17.0
+DM_CONTROL_VERSION := 1.0.50
+mujoco-assets: $(MUJOCO_DIR)/lib/libmujoco.so $(MUJOCO_DIR)/kinova/jaco_arm.xml
+$(MUJOCO_DIR)/wheels/.fetched:
+	mkdir -p $(MUJOCO_DIR)/wheels
+	pip download --no-deps --only-binary=:all: --python-version 3.11 --platform manylinux_2_28_x86_64 \
+		-d $(MUJOCO_DIR)/wheels mujoco==$(MUJOCO_WHEEL_VERSION) dm_control==$(DM_CONTROL_VERSION)
+	touch $@
+$(MUJOCO_DIR)/lib/libmujoco.so: $(MUJOCO_DIR)/wheels/.fetched
+	rm -rf $(MUJOCO_DIR)/unpack && mkdir -p $(MUJOCO_DIR)/unpack $(@D)
+	unzip -q -o $(MUJOCO_DIR)/wheels/mujoco-$(MUJOCO_WHEEL_VERSION)-*.whl 'mujoco/libmujoco.so.*' -d $(MUJOCO_DIR)/unpack
+	cp $(MUJOCO_DIR)/unpack/mujoco/libmujoco.so.$(MUJOCO_WHEEL_VERSION) $(@D)/
+	ln -sf libmujoco.so.$(MUJOCO_WHEEL_VERSION) $@
+	rm -rf $(MUJOCO_DIR)/unpack
+$(MUJOCO_DIR)/kinova/jaco_arm.xml: $(MUJOCO_DIR)/wheels/.fetched
+	rm -rf $(MUJOCO_DIR)/unpack $(@D) && mkdir -p $(MUJOCO_DIR)/unpack
+	unzip -q -o $(MUJOCO_DIR)/wheels/dm_control-$(DM_CONTROL_VERSION)-*.whl 'dm_control/third_party/kinova/*' \
+		-d $(MUJOCO_DIR)/unpack
+	mv $(MUJOCO_DIR)/unpack/dm_control/third_party/kinova $(@D)
+	cp third_party/kinova/LICENSE $(@D)/LICENSE
+	rm -rf $(MUJOCO_DIR)/unpack
+mujoco: mujoco-assets
+	cargo build --release --features mujoco
+
+# Thesis 7.4.1 with the Jaco: its scripted controller (IK to each push point) on 100 boards of depth ≤ 5 per game.
+repro-jaco: mujoco
+	for game in lightsout tileswap; do \
+		$(RUN) eval embodied --game $$game --embodiment jaco --max-depth 5 --boards 100 --seed $(SEED) \
+			--no-tui --out reports/embodied-$$game-jaco || exit 1; \
+	done
 
 build:
 	cargo build --release

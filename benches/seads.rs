@@ -74,7 +74,7 @@ fn search_depth9_once(_: &mut Criterion) {
 fn collection(c: &mut Criterion) {
     let game = LightsOut::new(5).unwrap();
     let pool = BoardPool::new(&game, 5, mbrl::envs::boards::Split::Train).unwrap();
-    let mut collector = Collector::new(&game, Embodiment::Cursor, 32, 25);
+    let mut collector = Collector::new(&game, Embodiment::Cursor, 32, 25).unwrap();
     let labels: Vec<usize> = (0..32).collect::<Vec<_>>().iter().map(|k| k % 25).collect();
     let mut group = c.benchmark_group("seads_collect_lightsout_cursor");
     group.sample_size(20);

@@ -346,7 +346,7 @@ _mbrl() {
                     return 0
                     ;;
                 --env)
-                    COMPREPLY=($(compgen -W "pendulum pendulum:light pendulum:heavy pendulum:inverted pendulum:quadrant toy:inner toy:outer mountaincar unicycle terrain lightsout tileswap lightsout:cursor lightsout:reacher tileswap:cursor tileswap:reacher ball" -- "${cur}"))
+                    COMPREPLY=($(compgen -W "pendulum pendulum:light pendulum:heavy pendulum:inverted pendulum:quadrant toy:inner toy:outer mountaincar unicycle terrain lightsout tileswap lightsout:cursor lightsout:reacher tileswap:cursor tileswap:reacher lightsout:jaco tileswap:jaco ball" -- "${cur}"))
                     return 0
                     ;;
                 --map)
@@ -424,7 +424,7 @@ _mbrl() {
             fi
             case "${prev}" in
                 --env)
-                    COMPREPLY=($(compgen -W "pendulum pendulum:light pendulum:heavy pendulum:inverted pendulum:quadrant toy:inner toy:outer mountaincar unicycle terrain lightsout tileswap lightsout:cursor lightsout:reacher tileswap:cursor tileswap:reacher ball" -- "${cur}"))
+                    COMPREPLY=($(compgen -W "pendulum pendulum:light pendulum:heavy pendulum:inverted pendulum:quadrant toy:inner toy:outer mountaincar unicycle terrain lightsout tileswap lightsout:cursor lightsout:reacher tileswap:cursor tileswap:reacher lightsout:jaco tileswap:jaco ball" -- "${cur}"))
                     return 0
                     ;;
                 --rollouts)
@@ -686,7 +686,7 @@ _mbrl() {
                     return 0
                     ;;
                 --env)
-                    COMPREPLY=($(compgen -W "pendulum pendulum:light pendulum:heavy pendulum:inverted pendulum:quadrant toy:inner toy:outer mountaincar unicycle terrain lightsout tileswap lightsout:cursor lightsout:reacher tileswap:cursor tileswap:reacher ball" -- "${cur}"))
+                    COMPREPLY=($(compgen -W "pendulum pendulum:light pendulum:heavy pendulum:inverted pendulum:quadrant toy:inner toy:outer mountaincar unicycle terrain lightsout tileswap lightsout:cursor lightsout:reacher tileswap:cursor tileswap:reacher lightsout:jaco tileswap:jaco ball" -- "${cur}"))
                     return 0
                     ;;
                 --contexts)
@@ -892,7 +892,7 @@ _mbrl() {
                     return 0
                     ;;
                 --embodiment)
-                    COMPREPLY=($(compgen -W "cursor reacher" -- "${cur}"))
+                    COMPREPLY=($(compgen -W "cursor reacher jaco" -- "${cur}"))
                     return 0
                     ;;
                 --max-depth)
@@ -2222,7 +2222,7 @@ _mbrl() {
                     return 0
                     ;;
                 --embodiment)
-                    COMPREPLY=($(compgen -W "cursor reacher" -- "${cur}"))
+                    COMPREPLY=($(compgen -W "cursor reacher jaco" -- "${cur}"))
                     return 0
                     ;;
                 --search)
@@ -2574,7 +2574,7 @@ _mbrl() {
                     return 0
                     ;;
                 --env)
-                    COMPREPLY=($(compgen -W "pendulum pendulum:light pendulum:heavy pendulum:inverted pendulum:quadrant toy:inner toy:outer mountaincar unicycle terrain lightsout tileswap lightsout:cursor lightsout:reacher tileswap:cursor tileswap:reacher ball" -- "${cur}"))
+                    COMPREPLY=($(compgen -W "pendulum pendulum:light pendulum:heavy pendulum:inverted pendulum:quadrant toy:inner toy:outer mountaincar unicycle terrain lightsout tileswap lightsout:cursor lightsout:reacher tileswap:cursor tileswap:reacher lightsout:jaco tileswap:jaco ball" -- "${cur}"))
                     return 0
                     ;;
                 --preset)
@@ -2636,7 +2636,7 @@ _mbrl() {
                     return 0
                     ;;
                 --env)
-                    COMPREPLY=($(compgen -W "pendulum pendulum:light pendulum:heavy pendulum:inverted pendulum:quadrant toy:inner toy:outer mountaincar unicycle terrain lightsout tileswap lightsout:cursor lightsout:reacher tileswap:cursor tileswap:reacher ball" -- "${cur}"))
+                    COMPREPLY=($(compgen -W "pendulum pendulum:light pendulum:heavy pendulum:inverted pendulum:quadrant toy:inner toy:outer mountaincar unicycle terrain lightsout tileswap lightsout:cursor lightsout:reacher tileswap:cursor tileswap:reacher lightsout:jaco tileswap:jaco ball" -- "${cur}"))
                     return 0
                     ;;
                 --config)
@@ -2810,7 +2810,7 @@ _mbrl() {
                     return 0
                     ;;
                 --env)
-                    COMPREPLY=($(compgen -W "pendulum pendulum:light pendulum:heavy pendulum:inverted pendulum:quadrant toy:inner toy:outer mountaincar unicycle terrain lightsout tileswap lightsout:cursor lightsout:reacher tileswap:cursor tileswap:reacher ball" -- "${cur}"))
+                    COMPREPLY=($(compgen -W "pendulum pendulum:light pendulum:heavy pendulum:inverted pendulum:quadrant toy:inner toy:outer mountaincar unicycle terrain lightsout tileswap lightsout:cursor lightsout:reacher tileswap:cursor tileswap:reacher lightsout:jaco tileswap:jaco ball" -- "${cur}"))
                     return 0
                     ;;
                 --config)

@@ -49,7 +49,7 @@ complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "list" -d 'List envs, meth
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "sweep" -d 'Plan seeds × settings of any command as Slurm job arrays or local job lists; follow and report them'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "completions" -d 'Print a shell completion script'
 complete -c mbrl -n "__fish_mbrl_needs_command" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
-complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l env -d 'Environment: pendulum[:light|heavy|mass=<m>|inverted|quadrant], toy:inner|outer, mountaincar, unicycle (with --map or --maps), terrain (map sets), lightsout[:<n>x<n>], tileswap, <game>:cursor|reacher (a board game played by a manipulator, e.g. lightsout:cursor), ball' -r -f -a "pendulum\t''
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l env -d 'Environment: pendulum[:light|heavy|mass=<m>|inverted|quadrant], toy:inner|outer, mountaincar, unicycle (with --map or --maps), terrain (map sets), lightsout[:<n>x<n>], tileswap, <game>:cursor|reacher|jaco (a board game played by a manipulator, e.g. lightsout:cursor), ball' -r -f -a "pendulum\t''
 pendulum:light\t''
 pendulum:heavy\t''
 pendulum:inverted\t''
@@ -65,14 +65,16 @@ lightsout:cursor\t''
 lightsout:reacher\t''
 tileswap:cursor\t''
 tileswap:reacher\t''
+lightsout:jaco\t''
+tileswap:jaco\t''
 ball\t''"
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l rollouts -d 'Number of rollouts, each in its own instance of a parametrized env' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l instances -d 'Instead of --rollouts: N instances with two rollouts each (ids 2k, 2k+1), for context models' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l actions -d 'Replay these actions (CSV: one row per step, one column per action dimension) instead of random ones' -r -F
-complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l init-state -d 'With --actions: the start state, comma-separated (pendulum: θ,θ̇; toy: s1,s2; mountaincar: x,ẋ; unicycle: x,y,v,φ; <game>:cursor: x,y; <game>:reacher: shoulder,wrist,shoulder velocity,wrist velocity)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l init-state -d 'With --actions: the start state, comma-separated (pendulum: θ,θ̇; toy: s1,s2; mountaincar: x,ẋ; unicycle: x,y,v,φ; <game>:cursor: x,y; <game>:reacher: shoulder,wrist,shoulder velocity,wrist velocity; <game>:jaco: 9 angles, 9 velocities)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l instance-seed -d 'With --actions: which instance of a parametrized env (default: --seed); the same seed names the same instance in every subcommand' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l board -d 'With --actions on <game>:cursor|reacher: the start board, comma-separated as solve-board takes it (default: the solved board)' -r
-complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l episodes -d 'For <game>:cursor|reacher: N skill episodes of random actions, each from a scrambled board' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l board -d 'With --actions on <game>:cursor|reacher|jaco: the start board, comma-separated as solve-board takes it (default: the solved board)' -r
+complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l episodes -d 'For <game>:cursor|reacher|jaco: N skill episodes of random actions, each from a scrambled board' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l steps -d 'Steps per rollout' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l policy -d 'Behaviour policy' -r -f -a "random\t'Random actions: uniform within the action bounds (the unicycle: colored noise, as its authors drew)'"
 complete -c mbrl -n "__fish_mbrl_using_subcommand collect" -l out -d 'Output file (default: datasets/<env>-random.mcap, <env>-pairs.mcap, <env>-replay.mcap, or <game>-boards-d<D>.mcap; when that exists, the first free name ending -2, -3, …). An existing --out is replaced only with --force' -r -F
@@ -178,6 +180,8 @@ lightsout:cursor\t''
 lightsout:reacher\t''
 tileswap:cursor\t''
 tileswap:reacher\t''
+lightsout:jaco\t''
+tileswap:jaco\t''
 ball\t''"
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -l config -d 'Hyperparameters over the preset\'s: a TOML file of config keys, or a run\'s config.json to rerun it' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from pets" -l preset -d 'Network size and training length (default: small)' -r -f -a "small\t'3 hidden layers × 64 SiLU units, 2000 steps (≈ 10 s on 2 cores)'
@@ -238,6 +242,8 @@ lightsout:cursor\t''
 lightsout:reacher\t''
 tileswap:cursor\t''
 tileswap:reacher\t''
+lightsout:jaco\t''
+tileswap:jaco\t''
 ball\t''"
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from context" -l preset -d 'Network size and training length (default: small)' -r -f -a "small\t'Toy: 32 units, 20-state chunks, lr 3e-3, 1200 steps (about 25 s; what `eval quick` trains). Pendulum and MountainCar: 64 units, 5000 steps (minutes)'
 medium\t'The thesis networks (200 units) for a tenth of its steps: toy 5000, pendulum and MountainCar 10 000'
@@ -325,6 +331,8 @@ lightsout:cursor\t''
 lightsout:reacher\t''
 tileswap:cursor\t''
 tileswap:reacher\t''
+lightsout:jaco\t''
+tileswap:jaco\t''
 ball\t''"
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l config -d 'Hyperparameters over the preset\'s: a TOML file of config keys, or a run\'s config.json to rerun it' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand train; and __fish_seen_subcommand_from dlgpd" -l preset -d 'Model and training size (default: small, which learns from the pole angle instead of frames)' -r -f -a "small\t'An MLP VAE on the pole direction (cos θ, sin θ) instead of frames, batch 256, 3000 steps: minutes on 2 cores; any pendulum data'
@@ -370,6 +378,8 @@ lightsout:cursor\t''
 lightsout:reacher\t''
 tileswap:cursor\t''
 tileswap:reacher\t''
+lightsout:jaco\t''
+tileswap:jaco\t''
 ball\t''"
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l map -d 'For --env unicycle: the terrain map (PNG) the robot calibrates on' -r -F
 complete -c mbrl -n "__fish_mbrl_using_subcommand calibrate" -l instance-seed -d 'Which instance (hidden parameters) to calibrate in' -r
@@ -437,7 +447,8 @@ test\t''"
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l model -d 'Successor model: `true` (the game\'s rules) or a SEADS checkpoint directory (its learned forward model and skill policies)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l max-replans -d 'Replans allowed when a skill\'s outcome differs from the model\'s prediction (SEADS --model)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l embodiment -d 'Play the plan with this manipulator\'s scripted controller' -r -f -a "cursor\t'A point moved by steps of at most 0.2, pushing where it stands (10 steps per move)'
-reacher\t'A torque-driven two-link arm over a 0.3 m board (50 steps per move)'"
+reacher\t'A torque-driven two-link arm over a 0.3 m board (50 steps per move)'
+jaco\t'The 9-DoF Kinova Jaco arm on MuJoCo, target joint velocities at 10 Hz (50 steps per move; needs a build with `make mujoco`)'"
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l search -d 'Search algorithm' -r -f -a "bidirectional\t'From both ends (moves undo themselves); far fewer states'
 bfs\t'From the start only, as the thesis\' planner'"
 complete -c mbrl -n "__fish_mbrl_using_subcommand solve-board" -l max-depth -d 'Longest plan searched for' -r
@@ -521,7 +532,8 @@ complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcomma
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l game -d 'Game: lightsout (5x5) or tileswap' -r -f -a "lightsout\t''
 tileswap\t''"
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l embodiment -d 'Manipulator' -r -f -a "cursor\t'A point moved by steps of at most 0.2, pushing where it stands (10 steps per move)'
-reacher\t'A torque-driven two-link arm over a 0.3 m board (50 steps per move)'"
+reacher\t'A torque-driven two-link arm over a 0.3 m board (50 steps per move)'
+jaco\t'The 9-DoF Kinova Jaco arm on MuJoCo, target joint velocities at 10 Hz (50 steps per move; needs a build with `make mujoco`)'"
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l max-depth -d 'Boards of depth 1..=max-depth are evaluated' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l boards -d 'Boards drawn per depth (fewer when the split has fewer)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from embodied" -l split -d 'Split the boards come from' -r -f -a "train\t''
@@ -574,6 +586,8 @@ lightsout:cursor\t''
 lightsout:reacher\t''
 tileswap:cursor\t''
 tileswap:reacher\t''
+lightsout:jaco\t''
+tileswap:jaco\t''
 ball\t''"
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l contexts -d 'Unseen contexts (instances) to calibrate in (thesis: 50)' -r
 complete -c mbrl -n "__fish_mbrl_using_subcommand eval; and __fish_seen_subcommand_from context" -l validation-rollouts -d 'Random validation rollouts per context (thesis: 20)' -r

@@ -13,7 +13,7 @@ use super::collect::{check_size, timesteps, REPLAY_STREAM};
 use super::{Dataset, DatasetLayout, Rollout, Timestep};
 use crate::envs::boards::{BoardGame, GameSpec, LightsOut, TileSwap};
 use crate::envs::embodiments::embodied::EmbodiedBoard;
-use crate::envs::embodiments::Embodiment;
+use crate::envs::embodiments::{BoardLayout, Embodiment};
 use crate::envs::{Env, EnvName, EnvSpec};
 use crate::error::{Error, Result};
 use crate::run::Monitor;
@@ -65,7 +65,7 @@ pub fn collect_embodied(settings: &EmbodiedCollectSettings, monitor: &dyn Monito
 /// Parses `--init-state` for an embodied env: the manipulator's state only, inside its workspace.
 pub fn parse_manipulator_state(text: &str, game: GameSpec, embodiment: Embodiment) -> Result<Vec<f64>> {
     let env = EnvName::Embodied(game, embodiment).canonical();
-    let names = embodiment.build().0.state_names().join(",");
+    let names = embodiment.build(&BoardLayout::of_spec(game)?)?.0.state_names().join(",");
     let state = text
         .split(',')
         .map(|field| {
@@ -81,7 +81,7 @@ pub fn parse_manipulator_state(text: &str, game: GameSpec, embodiment: Embodimen
 
 fn check_manipulator_state(state: &[f64], game: GameSpec, embodiment: Embodiment) -> Result<()> {
     let env = EnvName::Embodied(game, embodiment).canonical();
-    let manipulator = embodiment.build().0;
+    let manipulator = embodiment.build(&BoardLayout::of_spec(game)?)?.0;
     let names = manipulator.state_names();
     let expected = || format!("expected {} finite numbers ({}) for {env}", names.len(), names.join(","));
     if state.len() != names.len() {
@@ -102,7 +102,8 @@ fn replay_game<G: BoardGame>(game: G, settings: &EmbodiedReplaySettings) -> Resu
         Some(text) => game.parse(text).map_err(|e| Error::config(format!("--board '{text}': {e}")))?,
         None => game.goal(),
     };
-    let mut env = EmbodiedBoard::new(game, settings.embodiment.build().0, board);
+    let manipulator = settings.embodiment.build(&BoardLayout::of(&game))?.0;
+    let mut env = EmbodiedBoard::new(game, manipulator, board);
     let spec = spec_named(&env, &name);
     if let Some((t, a)) = settings.actions.iter().enumerate().find(|(_, a)| a.len() != spec.action_dim()) {
         return Err(Error::data(format!("action {t} has {} value(s); {name} takes {}", a.len(), spec.action_dim())));
@@ -138,7 +139,7 @@ fn collect_game<G: BoardGame>(game: G, settings: &EmbodiedCollectSettings, monit
     }
     let name = EnvName::Embodied(settings.game, settings.embodiment).canonical();
     let goal = game.goal();
-    let mut env = EmbodiedBoard::new(game.clone(), settings.embodiment.build().0, goal);
+    let mut env = EmbodiedBoard::new(game.clone(), settings.embodiment.build(&BoardLayout::of(&game))?.0, goal);
     let spec = spec_named(&env, &name);
     let limit = env.manipulator().skill_step_limit();
     check_size(&spec, settings.episodes, limit, "--episodes × the skill step limit")?;

@@ -3,7 +3,7 @@
 use super::boards::spec::GAME_HELP;
 use super::boards::{BoardGame, GameSpec, LightsOut, TileSwap};
 use super::embodiments::embodied::EmbodiedBoard;
-use super::embodiments::Embodiment;
+use super::embodiments::{BoardLayout, Embodiment};
 use super::mountaincar::MountainCar;
 use super::pendulum::{Pendulum, PendulumVariant};
 use super::toy::{Squash, Toy};
@@ -29,7 +29,7 @@ macro_rules! known_envs {
     () => {
         concat!(
             $crate::pendulum_envs!(),
-            ", toy:inner|outer, mountaincar, unicycle (with --map or --maps), terrain (map sets), lightsout[:<n>x<n>], tileswap, <game>:cursor|reacher (a board game \
+            ", toy:inner|outer, mountaincar, unicycle (with --map or --maps), terrain (map sets), lightsout[:<n>x<n>], tileswap, <game>:cursor|reacher|jaco (a board game \
              played by a manipulator, e.g. lightsout:cursor), ball"
         )
     };
@@ -38,10 +38,10 @@ macro_rules! known_envs {
 pub const KNOWN_ENVS: &str = known_envs!();
 
 /// Every env name without a number in it, as completion offers them and typos are matched against. The
-/// numbered forms (`pendulum:mass=<m>`, `lightsout:<n>x<n>[:cursor|reacher]`) are typed: a list of every
+/// numbered forms (`pendulum:mass=<m>`, `lightsout:<n>x<n>[:cursor|reacher|jaco]`) are typed: a list of every
 /// mass cannot be written, and the 36 sizes would bury the names. A test keeps this list in step with the
 /// variant lists of each family and with [`parse_env`].
-pub const ENV_NAMES: [&str; 17] = [
+pub const ENV_NAMES: [&str; 19] = [
     "pendulum",
     "pendulum:light",
     "pendulum:heavy",
@@ -58,6 +58,8 @@ pub const ENV_NAMES: [&str; 17] = [
     "lightsout:reacher",
     "tileswap:cursor",
     "tileswap:reacher",
+    "lightsout:jaco",
+    "tileswap:jaco",
     "ball",
 ];
 
@@ -154,8 +156,8 @@ impl EnvName {
                 g.name()
             ))),
             EnvName::Embodied(game, embodiment) => match game {
-                GameSpec::LightsOut(n) => Ok(embodied(LightsOut::new(*n)?, *embodiment)),
-                GameSpec::TileSwap => Ok(embodied(TileSwap::new(), *embodiment)),
+                GameSpec::LightsOut(n) => embodied(LightsOut::new(*n)?, *embodiment),
+                GameSpec::TileSwap => embodied(TileSwap::new(), *embodiment),
             },
             EnvName::Ball => Err(Error::config(
                 "'ball' is recorded as camera trajectories: use `mbrl collect --env ball --trajectories N`",
@@ -209,9 +211,10 @@ impl EnvName {
 }
 
 /// The game on its solved board, the manipulator at its default pose until reset.
-fn embodied<G: BoardGame>(game: G, embodiment: Embodiment) -> Box<dyn Env> {
+fn embodied<G: BoardGame>(game: G, embodiment: Embodiment) -> Result<Box<dyn Env>> {
     let goal = game.goal();
-    Box::new(EmbodiedBoard::new(game, embodiment.build().0, goal))
+    let manipulator = embodiment.build(&BoardLayout::of(&game))?.0;
+    Ok(Box::new(EmbodiedBoard::new(game, manipulator, goal)))
 }
 
 /// The simulator for `env` with the hidden parameters that `instance_seed` names. Every subcommand that takes

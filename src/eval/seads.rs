@@ -161,11 +161,11 @@ fn coverage<G: BoardGame>(
     boards: &[G::State],
     seed: u64,
     monitor: &dyn Monitor,
-) -> Vec<SkillRow> {
+) -> Result<Vec<SkillRow>> {
     let k = loaded.run.config.skills;
-    let mut collector = Collector::new(game, loaded.env.embodiment, boards.len().clamp(1, 64), k);
+    let mut collector = Collector::new(game, loaded.env.embodiment, boards.len().clamp(1, 64), k)?;
     let layout = collector.layout;
-    (0..k)
+    let rows = (0..k)
         .map(|skill| {
             let mut rng = rng_for(seed, &[10, skill as u64]);
             let labels = vec![skill; boards.len()];
@@ -192,7 +192,8 @@ fn coverage<G: BoardGame>(
                 mean_steps: episodes.iter().map(|e| layout.steps(e) as f64).sum::<f64>() / n,
             }
         })
-        .collect()
+        .collect::<Vec<_>>();
+    Ok(rows)
 }
 
 fn success_rows<G: BoardGame>(
@@ -296,7 +297,7 @@ fn report_game<G: BoardGame>(
     // Coverage boards: an even mix of the evaluated depths.
     let mut rng = rng_for(seed, &[30]);
     let coverage_boards: Vec<G::State> = (0..settings.coverage_boards).map(|_| pool.sample(&mut rng)).collect();
-    let skills = coverage(game, loaded, &coverage_boards, seed, &monitor);
+    let skills = coverage(game, loaded, &coverage_boards, seed, &monitor)?;
     let mut modes: Vec<usize> = skills.iter().filter_map(|s| s.mode_move).collect();
     modes.sort_unstable();
     modes.dedup();

@@ -27,6 +27,9 @@ pub enum EmbodimentChoice {
     Cursor,
     /// A torque-driven two-link arm over a 0.3 m board (50 steps per move).
     Reacher,
+    /// The 9-DoF Kinova Jaco arm on MuJoCo, target joint velocities at 10 Hz (50 steps per move; needs a build
+    /// with `make mujoco`).
+    Jaco,
 }
 
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
@@ -62,6 +65,7 @@ impl From<EmbodimentChoice> for Embodiment {
         match choice {
             EmbodimentChoice::Cursor => Embodiment::Cursor,
             EmbodimentChoice::Reacher => Embodiment::Reacher,
+            EmbodimentChoice::Jaco => Embodiment::Jaco,
         }
     }
 }

@@ -8,7 +8,7 @@ use super::bfs::{bidirectional, breadth_first, GameRules, SearchLimits, SearchRe
 use super::board_view::{plan_text, search_text, show_boards, EffectorTrace};
 use crate::envs::boards::BoardGame;
 use crate::envs::embodiments::embodied::{EmbodiedBoard, MoveOutcome};
-use crate::envs::embodiments::Embodiment;
+use crate::envs::embodiments::{BoardLayout, Embodiment};
 use crate::envs::Env;
 use crate::error::{Error, Result};
 use crate::run::{Event, Monitor};
@@ -89,7 +89,7 @@ pub fn execute_plan<G: BoardGame>(
     rng: &mut ChaCha8Rng,
     monitor: &dyn Monitor,
 ) -> Result<Execution<G::State>> {
-    let (manipulator, mut controller) = embodiment.build();
+    let (manipulator, mut controller) = embodiment.build(&BoardLayout::of(game))?;
     let mut env = EmbodiedBoard::new(game.clone(), manipulator, board);
     env.reset(rng);
     let mut moves = Vec::with_capacity(plan.len());

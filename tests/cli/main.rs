@@ -16,6 +16,7 @@ mod embodied;
 mod eval_render;
 mod export;
 mod foxglove_schemas;
+mod jaco;
 mod kill;
 mod list;
 mod outputs;

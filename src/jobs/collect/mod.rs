@@ -59,7 +59,7 @@ Board sets (lightsout 5x5, tileswap) hold every board of depth 1..D with its tra
 
 Terrain: --maps N writes N random 460 × 460 PNG maps (background colour and Bézier patches) and a manifest, terrain.json, into the new directory --out (default datasets/terrain): maps 0..N/2 train, the rest test. Unicycle: on one --map PNG (any 8-bit RGB image, resized to 460 × 460; x runs down its rows, y along its columns) or on the --split of a map set --maps DIR, a map drawn per instance with the robot (mass, throttle and steer gains of Table 5.1); x, y ~ U[0, 1], v ~ U[-5, 5], φ ~ U[0, 2π); actions colored noise (β 0.5, std 0.5, clipped to [-1, 1]); --init-state x,y,v,φ.
 
-Embodied boards (<game>:cursor|reacher) are recorded as skill episodes, one rollout each: an episode ends when the board changes or after 10 (cursor) / 50 (reacher) steps. --episodes N: random actions, each episode from a uniformly scrambled board and a reset manipulator. --actions: one run through the CSV (3 columns: dx,dy,push for cursor; two torques,push for reacher), split into episodes the same way, from --board (default: the solved board) and --init-state (cursor: x,y in [0,1]; reacher: shoulder,wrist angles in rad (|wrist| <= 160 deg) and their velocities; default: a reset drawn from --seed).
+Embodied boards (<game>:cursor|reacher|jaco) are recorded as skill episodes, one rollout each: an episode ends when the board changes or after 10 (cursor) / 50 (reacher, jaco) steps. --episodes N: random actions, each episode from a uniformly scrambled board and a reset manipulator. --actions: one run through the CSV (3 columns: dx,dy,push for cursor; two torques,push for reacher; 9 target joint velocities in rad/s for jaco), split into episodes the same way, from --board (default: the solved board) and --init-state (cursor: x,y in [0,1]; reacher: shoulder,wrist angles in rad (|wrist| <= 160 deg) and their velocities; jaco: 9 joint angles and 9 velocities; default: a reset drawn from --seed).
 
 Ball shots: launcher settings drawn as in thesis 6.5.1, 180 Hz camera with ~1 mm noise and dropouts.")]
 pub struct CollectOptions {
@@ -75,18 +75,18 @@ pub struct CollectOptions {
     #[arg(long, value_name = "CSV", conflicts_with_all = ["rollouts", "instances", "steps", "trajectories", "boards"])]
     actions: Option<PathBuf>,
     /// With --actions: the start state, comma-separated (pendulum: θ,θ̇; toy: s1,s2; mountaincar: x,ẋ;
-    /// unicycle: x,y,v,φ; <game>:cursor: x,y; <game>:reacher: shoulder,wrist,shoulder velocity,wrist velocity).
+    /// unicycle: x,y,v,φ; <game>:cursor: x,y; <game>:reacher: shoulder,wrist,shoulder velocity,wrist velocity; <game>:jaco: 9 angles, 9 velocities).
     #[arg(long, value_name = "X1,X2,…", requires = "actions", allow_hyphen_values = true)]
     init_state: Option<String>,
     /// With --actions: which instance of a parametrized env (default: --seed); the same seed names the same
     /// instance in every subcommand.
     #[arg(long, value_name = "S", requires = "actions")]
     instance_seed: Option<u64>,
-    /// With --actions on <game>:cursor|reacher: the start board, comma-separated as solve-board takes it
+    /// With --actions on <game>:cursor|reacher|jaco: the start board, comma-separated as solve-board takes it
     /// (default: the solved board).
     #[arg(long, value_name = "BOARD", requires = "actions")]
     board: Option<String>,
-    /// For <game>:cursor|reacher: N skill episodes of random actions, each from a scrambled board.
+    /// For <game>:cursor|reacher|jaco: N skill episodes of random actions, each from a scrambled board.
     #[arg(long, value_name = "N", conflicts_with_all = ["rollouts", "instances", "steps", "actions", "boards"])]
     episodes: Option<usize>,
     /// Steps per rollout.

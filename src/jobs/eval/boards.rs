@@ -83,6 +83,7 @@ pub fn embodied(options: EmbodiedOptions, invocation: &Invocation) -> Result<Job
     };
     let config = options.set.apply(config)?;
     config.validate()?;
+    config.settings.embodiment.ensure_buildable()?;
     Ok(report_job(
         "eval embodied",
         output_dir("--out", options.out.as_deref(), || PathBuf::from("reports/embodied"), invocation)?,

@@ -29,7 +29,7 @@ pub fn table() -> Result<Table> {
     }
     table.note("");
     table.note(format!("pendulum variants: {VARIANT_HELP}"));
-    table.note(format!("board games: {GAME_HELP}; any of them played by a manipulator: <game>:cursor|reacher"));
+    table.note(format!("board games: {GAME_HELP}; any of them played by a manipulator: <game>:cursor|reacher|jaco (jaco needs `make mujoco`)"));
     table.note("Gym's Pendulum-v0 is accepted as pendulum (same dynamics step for step).");
     Ok(table)
 }

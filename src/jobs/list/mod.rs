@@ -20,7 +20,7 @@ Examples:
   mbrl list envs          # names for --env, with state and action sizes and time step
   mbrl list methods       # names for `mbrl train METHOD`, with the data each trains on
   mbrl list presets       # --preset of each method: network, steps, batch, cost
-  mbrl list embodiments   # manipulators for <game>:cursor|reacher and --embodiment")]
+  mbrl list embodiments   # manipulators for <game>:cursor|reacher|jaco and --embodiment")]
 pub struct ListOptions {
     /// What to list.
     #[arg(value_enum)]

@@ -25,6 +25,9 @@ pub(super) fn prepare<G: DenseIndex>(
     let bidirectional = options.search == SearchChoice::Bidirectional;
     let search = if bidirectional { SearchKind::Bidirectional } else { SearchKind::Bfs };
     let embodiment = options.embodiment.map(Embodiment::from);
+    if let Some(e) = embodiment {
+        e.ensure_buildable()?;
+    }
     let title = format!("solve-board: {}", game.name());
     Ok(Job::new(title.clone(), move |monitor| {
         monitor.emit(&layout(&title, game.side(), true));

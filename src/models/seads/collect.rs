@@ -8,8 +8,9 @@ use super::boards::BoardPool;
 use super::memory::{Episode, ObsLayout};
 use crate::envs::boards::BoardGame;
 use crate::envs::embodiments::embodied::EmbodiedBoard;
-use crate::envs::embodiments::Embodiment;
+use crate::envs::embodiments::{BoardLayout, Embodiment};
 use crate::envs::Env;
+use crate::error::Result;
 
 /// The policy input: observation ⊕ onehot(k).
 pub fn policy_input(obs: &[f32], skill: usize, skills: usize, out: &mut Vec<f32>) {
@@ -24,15 +25,17 @@ pub struct Collector<G: BoardGame> {
 }
 
 impl<G: BoardGame> Collector<G> {
-    pub fn new(game: &G, embodiment: Embodiment, parallel: usize, skills: usize) -> Self {
-        let envs: Vec<EmbodiedBoard<G>> =
-            (0..parallel.max(1)).map(|_| EmbodiedBoard::new(game.clone(), embodiment.build().0, game.goal())).collect();
+    pub fn new(game: &G, embodiment: Embodiment, parallel: usize, skills: usize) -> Result<Self> {
+        let board = BoardLayout::of(game);
+        let envs: Vec<EmbodiedBoard<G>> = (0..parallel.max(1))
+            .map(|_| Ok(EmbodiedBoard::new(game.clone(), embodiment.build(&board)?.0, game.goal())))
+            .collect::<Result<_>>()?;
         let spec = envs[0].spec();
         let bits = game.symbolic(game.goal()).len();
         let obs_dim = spec.obs_names.len();
         // The observation is manipulator ⊕ board ⊕ remaining time.
         let layout = ObsLayout { obs_dim, action_dim: spec.action_low.len(), bits_offset: obs_dim - 1 - bits, bits };
-        Collector { envs, layout, skills }
+        Ok(Collector { envs, layout, skills })
     }
 
     pub fn step_limit(&self) -> usize {

@@ -58,7 +58,18 @@ impl EmbodiedGame {
                 game.name()
             )));
         }
+        if embodiment == crate::envs::embodiments::Embodiment::Jaco {
+            return Err(Error::config(format!(
+                "SEADS does not train on the Jaco arm yet ('{name}'); it trains on the cursor and reacher embodiments \
+                 (the Jaco plays boards with its scripted controller: solve-board, eval embodied, collect)"
+            )));
+        }
         Ok(EmbodiedGame { game, embodiment })
+    }
+
+    /// The board the manipulator plays on.
+    pub fn board_layout(&self) -> Result<crate::envs::embodiments::BoardLayout> {
+        crate::envs::embodiments::BoardLayout::of_spec(self.game)
     }
 
     pub fn name(&self) -> String {

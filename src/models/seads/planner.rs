@@ -15,6 +15,7 @@ use super::{EmbodiedGame, Seads, SeadsRun};
 use crate::control::{run_episode, Agent};
 use crate::envs::boards::BoardGame;
 use crate::envs::embodiments::embodied::EmbodiedBoard;
+use crate::envs::embodiments::BoardLayout;
 use crate::envs::Env;
 use crate::error::{Error, Result};
 use crate::nn::ParamSet;
@@ -42,7 +43,7 @@ pub fn load(dir: &Path, accept: Accept) -> Result<LoadedSeads> {
     let weights = opened.tensors(MODEL_FILE)?;
     let (model_tensors, policy_tensors): (Vec<_>, Vec<_>) =
         weights.into_iter().partition(|t| t.name.starts_with(MODEL_PREFIX));
-    let (manipulator, _) = env.embodiment.build();
+    let (manipulator, _) = env.embodiment.build(&env.board_layout()?)?;
     let sac_config =
         run.config.sac_config(run.details.policy_input, manipulator.action_low(), manipulator.action_high());
     let policy = Sac::from_weights(sac_config, &policy_tensors).map_err(|e| e.at(&dir.join(MODEL_FILE)))?;
@@ -237,7 +238,7 @@ pub fn solve_with_skills<G: BoardGame>(
     rng: &mut ChaCha8Rng,
     monitor: &dyn Monitor,
 ) -> Result<SkillSolve<G::State>> {
-    let (manipulator, _) = loaded.env.embodiment.build();
+    let (manipulator, _) = loaded.env.embodiment.build(&BoardLayout::of(game))?;
     let mut env = EmbodiedBoard::new(game.clone(), manipulator, board);
     env.reset(rng);
     let k = loaded.run.config.skills;

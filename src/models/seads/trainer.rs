@@ -71,7 +71,7 @@ impl<G: BoardGame> SeadsTrainer<G> {
     pub fn new(config: SeadsConfig, game: G, embodiment: Embodiment, seed: u64) -> Result<Self> {
         config.validate()?;
         let pool = BoardPool::new(&game, config.max_board_depth, Split::Train)?;
-        let collector = Collector::new(&game, embodiment, config.episodes_per_epoch, config.skills);
+        let collector = Collector::new(&game, embodiment, config.episodes_per_epoch, config.skills)?;
         let layout = collector.layout;
         let mut rng = rng_for(seed, &[INIT_STREAM]);
         let (low, high) = collector.action_bounds();
