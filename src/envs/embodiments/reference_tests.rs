@@ -2,6 +2,7 @@
 //! manipulator states, same pushed fields, same remaining time and skill ends, step for step.
 
 use super::embodied::EmbodiedBoard;
+use super::layout::BoardLayout;
 use super::reference_cases::{Pushed, ReferenceCase, REFERENCE_CASES};
 use super::Embodiment;
 use crate::envs::boards::{BoardGame, LightsOut, TileSwap};
@@ -19,7 +20,8 @@ fn replay<G: BoardGame>(
     pushed: impl Fn(usize) -> Pushed,
 ) -> Vec<String> {
     let goal = game.goal();
-    let mut env = EmbodiedBoard::new(game, embodiment.build().0, goal);
+    let manipulator = embodiment.build(&BoardLayout::of(&game)).unwrap().0;
+    let mut env = EmbodiedBoard::new(game, manipulator, goal);
     env.set_manipulator_state(case.start);
     env.start_skill();
     let tolerance = if embodiment == Embodiment::Reacher { REACHER_TOLERANCE } else { 0.0 };
