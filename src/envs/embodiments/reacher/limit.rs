@@ -43,11 +43,22 @@ fn impedance(violation: f64) -> f64 {
 /// How far past the stop a constant `torque` into it holds the wrist at rest: where the limit's force,
 /// K·d·violation/R at rest, equals the torque (d = dmax, as the violation exceeds solimp's width).
 pub(super) fn resting_violation(torque: f64, inverse_inertia_at_rest: f64, timestep: f64) -> f64 {
+    let (stiffness, _) = reference_gains(timestep);
+    let regularizer = (1.0 - IMPEDANCE_MAX) / IMPEDANCE_MAX * inverse_inertia_at_rest;
+    torque * regularizer / (stiffness * IMPEDANCE_MAX)
+}
+
+/// solref's stiffness K and damping B, both with dmax, the time constant at least twice the timestep.
+fn reference_gains(timestep: f64) -> (f64, f64) {
     let time_constant = TIME_CONSTANT.max(2.0 * timestep);
     let stiffness =
         1.0 / (IMPEDANCE_MAX * IMPEDANCE_MAX * time_constant * time_constant * DAMPING_RATIO * DAMPING_RATIO);
-    let regularizer = (1.0 - IMPEDANCE_MAX) / IMPEDANCE_MAX * inverse_inertia_at_rest;
-    torque * regularizer / (stiffness * IMPEDANCE_MAX)
+    (stiffness, 2.0 / (IMPEDANCE_MAX * time_constant))
+}
+
+/// Whether MuJoCo has a limit row for this wrist angle: only strictly past a stop.
+pub(super) fn is_past_stop(wrist_angle: f64) -> bool {
+    wrist_angle.abs() > WRIST_LIMIT
 }
 
 /// What the limit row needs from the arm at the start of a physics step.
@@ -66,18 +77,16 @@ pub(super) struct WristLimitInput {
 
 /// The torque the limit puts on the wrist in this step (zero inside the range).
 pub(super) fn wrist_limit_torque(input: &WristLimitInput) -> f64 {
-    let (distance, jacobian) = if input.wrist_angle > WRIST_LIMIT {
-        (WRIST_LIMIT - input.wrist_angle, -1.0)
-    } else if input.wrist_angle < -WRIST_LIMIT {
-        (input.wrist_angle + WRIST_LIMIT, 1.0)
-    } else {
+    if !is_past_stop(input.wrist_angle) {
         return 0.0;
+    }
+    let (distance, jacobian) = if input.wrist_angle > 0.0 {
+        (WRIST_LIMIT - input.wrist_angle, -1.0)
+    } else {
+        (input.wrist_angle + WRIST_LIMIT, 1.0)
     };
     let imp = impedance(-distance);
-    let time_constant = TIME_CONSTANT.max(2.0 * input.timestep);
-    let damping = 2.0 / (IMPEDANCE_MAX * time_constant);
-    let stiffness =
-        1.0 / (IMPEDANCE_MAX * IMPEDANCE_MAX * time_constant * time_constant * DAMPING_RATIO * DAMPING_RATIO);
+    let (stiffness, damping) = reference_gains(input.timestep);
     let reference = -damping * jacobian * input.wrist_velocity - stiffness * imp * distance;
     let regularizer = ((1.0 - imp) / imp * input.inverse_inertia_at_rest).max(MIN_VALUE);
     let residual = jacobian * input.free_acceleration - reference;

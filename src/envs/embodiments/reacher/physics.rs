@@ -3,7 +3,7 @@
 
 use std::f64::consts::PI;
 
-use super::limit::{resting_violation, wrist_limit_torque, WristLimitInput};
+use super::limit::{is_past_stop, resting_violation, wrist_limit_torque, WristLimitInput};
 use super::{
     ARM_LENGTH, CAPSULE_RADIUS, DAMPING, DENSITY, FINGER_OFFSET, FINGER_RADIUS, GEAR, HAND_LENGTH, TIMESTEP,
     WRIST_LIMIT,
@@ -200,15 +200,17 @@ impl Reacher {
             let u = if ctrl[j].is_finite() { ctrl[j].clamp(-1.0, 1.0) } else { 0.0 };
             force[j] = GEAR * u - bias[j] - self.damping * self.v[j];
         }
-        let free = solve2(m, force);
-        force[1] += wrist_limit_torque(&WristLimitInput {
-            wrist_angle: self.q[1],
-            wrist_velocity: self.v[1],
-            free_acceleration: free[1],
-            inverse_inertia: solve2(m, [0.0, 1.0])[1],
-            inverse_inertia_at_rest: self.inverse_inertia_at_rest,
-            timestep: h,
-        });
+        // Inside the range (most steps) MuJoCo has no limit row, and the two solves it needs are skipped.
+        if is_past_stop(self.q[1]) {
+            force[1] += wrist_limit_torque(&WristLimitInput {
+                wrist_angle: self.q[1],
+                wrist_velocity: self.v[1],
+                free_acceleration: solve2(m, force)[1],
+                inverse_inertia: solve2(m, [0.0, 1.0])[1],
+                inverse_inertia_at_rest: self.inverse_inertia_at_rest,
+                timestep: h,
+            });
+        }
         let lhs = [[m[0][0] + h * self.damping, m[0][1]], [m[1][0], m[1][1] + h * self.damping]];
         let acc = solve2(lhs, force);
         self.v = [self.v[0] + h * acc[0], self.v[1] + h * acc[1]];
