@@ -220,6 +220,12 @@ fn targets() -> Vec<Target> {
             Input::Arg { seed: "3.14,0" },
             "collect --env pendulum --actions actions.csv --init-state={in} --out {out}",
         ),
+        // The wrist may start past its stops (the soft limit brings it back), up to a turn either way.
+        target(
+            "init-state-reacher",
+            Input::Arg { seed: "0.5,4.5,0,-1" },
+            "collect --env lightsout:reacher --actions reacher.csv --init-state={in} --out {out}",
+        ),
         // Checkpoints: the files a model is loaded from, and the ones `train --resume` reads besides.
         target(
             "pets-plan",
@@ -413,6 +419,7 @@ fn generate_seeds(dir: &Path) -> Result<(), String> {
     write("ball.csv", &falling_ball_csv());
     write("actions.csv", "u\n0.5\n-2\n1.5\n1e-3\n");
     write("cursor.csv", "dx,dy,push\n0.2,-0.2,-1\n0.1,-0.1,0.9\n0,0,-1\n");
+    write("reacher.csv", "u1,u2,push\n1,-1,-1\n0.5,0.5,1\n0,0,1\n");
 
     make(dir, "collect --env pendulum --rollouts 3 --steps 10 --out roll.mcap")?;
     make(dir, "collect --env pendulum --images --rollouts 2 --steps 4 --out img.mcap")?;
