@@ -93,7 +93,7 @@ fn collection(c: &mut Criterion) {
 
 fn epoch(c: &mut Criterion) {
     let game = LightsOut::new(5).unwrap();
-    let config = SeadsConfig::preset(Preset::Paper, 25, true);
+    let config = SeadsConfig::preset(Preset::Paper, 25, Embodiment::Cursor);
     let mut trainer = SeadsTrainer::new(config, game, Embodiment::Cursor, 0).unwrap();
     // Fill the memory so that every timed epoch updates the model and SAC.
     let mut epoch = 0;

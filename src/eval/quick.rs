@@ -558,7 +558,7 @@ fn seads_slice(provenance: &Provenance, out_dir: &Path, monitor: &dyn Monitor) -
         env: Some(env.name()),
         data: Vec::new(),
         seed: provenance.seed,
-        config: seads::SeadsConfig::preset(seads::Preset::Small, env.moves(), true),
+        config: seads::SeadsConfig::preset(seads::Preset::Small, env.moves(), env.embodiment),
         variant: (),
         provenance: provenance.clone(),
     };

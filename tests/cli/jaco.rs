@@ -20,6 +20,8 @@ fn without_mujoco_naming_jaco_says_how_to_build_it() {
         .output()
         .unwrap();
     assert_one_line_error(&eval, &["Jaco", "make mujoco"]);
+    let train = mbrl(dir.path()).args(["train", "seads", "--env", "tileswap:jaco", "-q"]).output().unwrap();
+    assert_one_line_error(&train, &["Jaco", "make mujoco"]);
 }
 
 #[cfg(feature = "mujoco")]

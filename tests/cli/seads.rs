@@ -5,6 +5,7 @@
 use std::path::Path;
 
 use crate::common::*;
+use mbrl::envs::embodiments::Embodiment;
 use mbrl::models::seads::{self, EmbodiedGame, Preset, SeadsConfig};
 use mbrl::run::dir::Provenance;
 use mbrl::train::job::start;
@@ -65,7 +66,7 @@ fn small_preset_learns_tileswap_moves_and_solves_test_boards() {
 fn resume_ends_with_the_bytes_of_an_uninterrupted_run() {
     let dir = tempfile::tempdir().unwrap();
     let env = EmbodiedGame::parse("lightsout:cursor").unwrap();
-    let mut config = SeadsConfig::preset(Preset::Small, 25, true);
+    let mut config = SeadsConfig::preset(Preset::Small, 25, Embodiment::Cursor);
     config = mbrl::train::config::apply_toml(
         &config,
         "episodes_per_epoch = 8\nsampled_episodes = 16\nepisode_memory = 32\nmodel_hidden = 16\n\

@@ -2,6 +2,7 @@
 //! its cost: the work it does (derived from the preset) and, for the small presets, a measured wall time.
 
 use super::Table;
+use crate::envs::embodiments::Embodiment;
 use crate::jobs::train::PetsPreset;
 use crate::models::ball::learn::TrainSettings;
 use crate::models::context_net::{ContextConfig, EnvFamily, Preset as ContextPreset};
@@ -80,9 +81,11 @@ pub fn table() -> Table {
             Scale::Medium => SeadsPreset::Medium,
             Scale::Paper => SeadsPreset::Paper,
         };
-        for (cursor, family) in [(true, "<game>:cursor"), (false, "<game>:reacher")] {
+        for (embodiment, family) in
+            [(Embodiment::Cursor, "<game>:cursor"), (Embodiment::Reacher, "<game>:reacher"), (Embodiment::Jaco, "<game>:jaco")]
+        {
             // The skill count (the game's moves) changes no size listed here.
-            let c = SeadsConfig::preset(engine, 12, cursor);
+            let c = SeadsConfig::preset(engine, 12, embodiment);
             let sac = c.sac_hidden.iter().map(usize::to_string).collect::<Vec<_>>().join("×");
             let network = format!("SAC {sac}, model {}", c.model_hidden);
             let batch = format!("SAC {}, model {}", c.sac_batch, c.model_batch);

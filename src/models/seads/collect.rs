@@ -3,6 +3,7 @@
 //! the policy sees all active episodes as one batch of rows per control step.
 
 use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
 
 use super::boards::BoardPool;
 use super::memory::{Episode, ObsLayout};
@@ -22,6 +23,10 @@ pub struct Collector<G: BoardGame> {
     envs: Vec<EmbodiedBoard<G>>,
     pub layout: ObsLayout,
     pub skills: usize,
+    /// Step the batch's envs on rayon's threads. Only for a simulator whose step outweighs the hand-off (the
+    /// Jaco's millisecond of MuJoCo; a Cursor step is nanoseconds). The envs share nothing and draw nothing
+    /// while stepping, so the bytes do not depend on the thread count.
+    step_in_parallel: bool,
 }
 
 impl<G: BoardGame> Collector<G> {
@@ -35,7 +40,8 @@ impl<G: BoardGame> Collector<G> {
         let obs_dim = spec.obs_names.len();
         // The observation is manipulator ⊕ board ⊕ remaining time.
         let layout = ObsLayout { obs_dim, action_dim: spec.action_low.len(), bits_offset: obs_dim - 1 - bits, bits };
-        Ok(Collector { envs, layout, skills })
+        let step_in_parallel = embodiment == Embodiment::Jaco;
+        Ok(Collector { envs, layout, skills, step_in_parallel })
     }
 
     pub fn step_limit(&self) -> usize {
@@ -80,18 +86,34 @@ impl<G: BoardGame> Collector<G> {
                 }
                 let actions = policy(&inputs, active.len(), rng);
                 let a = self.layout.action_dim;
-                let mut still = Vec::with_capacity(active.len());
+                let mut slot_actions: Vec<Option<Vec<f64>>> = vec![None; chunk.len()];
                 for (row, &slot) in active.iter().enumerate() {
-                    let action: Vec<f64> = actions[row * a..(row + 1) * a].iter().map(|&x| x as f64).collect();
-                    let env = &mut self.envs[slot];
-                    let before = env.board();
-                    let step = env.step(&action);
+                    slot_actions[slot] = Some(actions[row * a..(row + 1) * a].iter().map(|&x| x as f64).collect());
+                }
+                let step_one = |(env, action): (&mut EmbodiedBoard<G>, &Option<Vec<f64>>)| {
+                    action.as_ref().map(|action| {
+                        let before = env.board();
+                        let step = env.step(action);
+                        let performed = (env.board() != before).then(|| {
+                            (0..env.game().num_moves()).find(|&m| env.game().apply(before, m) == env.board())
+                        });
+                        (step, performed)
+                    })
+                };
+                let envs = &mut self.envs[..chunk.len()];
+                let outcomes: Vec<_> = if self.step_in_parallel {
+                    envs.par_iter_mut().zip(slot_actions.par_iter()).map(step_one).collect()
+                } else {
+                    envs.iter_mut().zip(slot_actions.iter()).map(step_one).collect()
+                };
+                let mut still = Vec::with_capacity(active.len());
+                for (slot, (outcome, action)) in outcomes.into_iter().zip(&slot_actions).enumerate() {
+                    let (Some((step, performed)), Some(action)) = (outcome, action) else { continue };
                     let episode = &mut running[slot];
                     episode.actions.extend(action.iter().map(|&x| x as f32));
                     episode.obs.extend(step.obs.iter().map(|&x| x as f32));
-                    if env.board() != before {
-                        episode.performed =
-                            (0..env.game().num_moves()).find(|&m| env.game().apply(before, m) == env.board());
+                    if let Some(performed) = performed {
+                        episode.performed = performed;
                     }
                     if !step.done {
                         still.push(slot);

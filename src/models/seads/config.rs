@@ -3,8 +3,12 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::envs::embodiments::Embodiment;
 use crate::error::{Error, Result};
 use crate::rl::sac::SacConfig;
+
+/// The Jaco's `small` budget.
+pub const JACO_SMALL_STEPS: u64 = 2_000_000;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -16,7 +20,7 @@ pub enum Preset {
     Small,
     /// The paper's networks (256 units) on a fifth of the Cursor budget.
     Medium,
-    /// The paper's networks and budgets (500k env steps for the Cursor, 10M for the Reacher).
+    /// The paper's networks and budgets (500k env steps for the Cursor, 10M for the Reacher and the Jaco).
     Paper,
 }
 
@@ -62,21 +66,34 @@ pub struct SeadsConfig {
     pub sac_updates: usize,
     pub gamma: f64,
     pub tau: f64,
-    /// SAC's fixed temperature (0.1 Cursor, 0.01 Reacher).
+    /// SAC's fixed temperature (0.1 Cursor, 0.01 Reacher and Jaco).
     pub alpha: f64,
     /// Epochs between checkpoints.
     pub checkpoint_every: u64,
 }
 
 impl SeadsConfig {
-    /// `skills` = the game's move count, `cursor` = whether the embodiment is the Cursor (budgets and α differ).
-    pub fn preset(preset: Preset, skills: usize, cursor: bool) -> Self {
+    /// `skills` = the game's move count; the embodiment sets the budgets, α and the checkpoint interval.
+    pub fn preset(preset: Preset, skills: usize, embodiment: Embodiment) -> Self {
+        let cursor = embodiment == Embodiment::Cursor;
         let paper_steps = if cursor { 500_000 } else { 10_000_000 };
+        let small_steps = match embodiment {
+            Embodiment::Cursor => 60_000,
+            Embodiment::Reacher => 200_000,
+            // A Jaco step costs about a millisecond of MuJoCo (benches/jaco.rs): 2M steps fit in the hour
+            // this preset is meant for.
+            Embodiment::Jaco => JACO_SMALL_STEPS,
+        };
         let (width, env_steps, sampled, model_updates) = match preset {
-            Preset::Small => (64, if cursor { 60_000 } else { 200_000 }, 128, 16),
+            // The Jaco's small run keeps the paper's SAC width (42 observations and 9 joints).
+            Preset::Small if embodiment == Embodiment::Jaco => (256, small_steps, 128, 16),
+            Preset::Small => (64, small_steps, 128, 16),
             Preset::Medium => (256, paper_steps / 5, 256, 4),
             Preset::Paper => (256, paper_steps, 256, 4),
         };
+        // An epoch's ~1,000 Jaco steps take about a second of MuJoCo, far more than SAC updates of batch 128, so
+        // the small run makes four times the paper's updates per epoch to get more out of each costly step.
+        let sac_updates = if preset == Preset::Small && embodiment == Embodiment::Jaco { 64 } else { 16 };
         SeadsConfig {
             skills,
             env_steps,
@@ -95,7 +112,7 @@ impl SeadsConfig {
             sac_hidden: vec![width, width],
             sac_learning_rate: 3e-4,
             sac_batch: 128,
-            sac_updates: 16,
+            sac_updates,
             gamma: 0.99,
             tau: 0.005,
             alpha: if cursor { 0.1 } else { 0.01 },
@@ -187,13 +204,22 @@ mod tests {
     #[test]
     fn presets_validate_and_follow_the_authors_code() {
         for preset in [Preset::Small, Preset::Medium, Preset::Paper] {
-            for (skills, cursor) in [(25, true), (12, true), (25, false)] {
-                SeadsConfig::preset(preset, skills, cursor).validate().unwrap();
+            for (skills, embodiment) in [
+                (25, Embodiment::Cursor),
+                (12, Embodiment::Cursor),
+                (25, Embodiment::Reacher),
+                (12, Embodiment::Jaco),
+            ] {
+                SeadsConfig::preset(preset, skills, embodiment).validate().unwrap();
             }
         }
-        let paper = SeadsConfig::preset(Preset::Paper, 25, true);
+        let paper = SeadsConfig::preset(Preset::Paper, 25, Embodiment::Cursor);
         assert_eq!((paper.env_steps, paper.sac_batch, paper.sac_updates, paper.model_batch), (500_000, 128, 16, 32));
-        assert_eq!(SeadsConfig::preset(Preset::Paper, 25, false).alpha, 0.01);
+        assert_eq!(SeadsConfig::preset(Preset::Paper, 25, Embodiment::Reacher).alpha, 0.01);
+        let jaco = SeadsConfig::preset(Preset::Paper, 25, Embodiment::Jaco);
+        assert_eq!((jaco.env_steps, jaco.alpha, jaco.sac_updates), (10_000_000, 0.01, 16));
+        let small = SeadsConfig::preset(Preset::Small, 25, Embodiment::Jaco);
+        assert_eq!((small.env_steps, small.sac_hidden.as_slice(), small.sac_updates), (2_000_000, &[256, 256][..], 64));
         let mut bad = paper.clone();
         bad.skills = 1;
         assert!(bad.validate().unwrap_err().to_string().contains("skills"));

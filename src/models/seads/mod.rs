@@ -31,7 +31,8 @@ use crate::train::{
 };
 
 pub const METHOD: &str = "seads";
-pub const ENV_HELP: &str = "lightsout:cursor, tileswap:cursor, lightsout:reacher, tileswap:reacher";
+pub const ENV_HELP: &str =
+    "lightsout:cursor, tileswap:cursor, lightsout:reacher, tileswap:reacher, lightsout:jaco, tileswap:jaco (jaco needs `make mujoco`)";
 
 /// A board game played through a manipulator, as named on the command line (`lightsout:cursor`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -45,7 +46,7 @@ impl EmbodiedGame {
     pub fn parse(name: &str) -> Result<Self> {
         let bad = || {
             let embodied =
-                crate::envs::ENV_NAMES.into_iter().filter(|n| n.ends_with(":cursor") || n.ends_with(":reacher"));
+                crate::envs::ENV_NAMES.into_iter().filter(|n| n.ends_with(":cursor") || n.ends_with(":reacher") || n.ends_with(":jaco"));
             let hint = crate::util::suggest::did_you_mean(name, embodied);
             Error::config(format!("'{name}' is not an embodied board game{hint}; supported: {ENV_HELP}"))
         };
@@ -56,12 +57,6 @@ impl EmbodiedGame {
             return Err(Error::config(format!(
                 "SEADS plays lightsout (5x5) and tileswap; '{}' is not supported (games: {GAME_HELP}; embodiments: {EMBODIMENT_HELP})",
                 game.name()
-            )));
-        }
-        if embodiment == crate::envs::embodiments::Embodiment::Jaco {
-            return Err(Error::config(format!(
-                "SEADS does not train on the Jaco arm yet ('{name}'); it trains on the cursor and reacher embodiments \
-                 (the Jaco plays boards with its scripted controller: solve-board, eval embodied, collect)"
             )));
         }
         Ok(EmbodiedGame { game, embodiment })

@@ -4,7 +4,6 @@
 use std::path::PathBuf;
 
 use super::{EmbodiedGame, Preset, SeadsConfig};
-use crate::envs::embodiments::Embodiment;
 use crate::error::Result;
 use crate::train::config::apply_config_file;
 use crate::train::run_dir::default_out;
@@ -24,8 +23,7 @@ pub struct SeadsOptions {
 
 impl SeadsOptions {
     pub fn config(&self, game: &EmbodiedGame) -> Result<SeadsConfig> {
-        let cursor = game.embodiment == Embodiment::Cursor;
-        let mut config = SeadsConfig::preset(self.preset.unwrap_or(Preset::Small), game.moves(), cursor);
+        let mut config = SeadsConfig::preset(self.preset.unwrap_or(Preset::Small), game.moves(), game.embodiment);
         if let Some(path) = &self.config_file {
             config = apply_config_file(&config, path, &[super::METHOD])?;
         }

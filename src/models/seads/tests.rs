@@ -6,7 +6,7 @@ use crate::envs::boards::TileSwap;
 use crate::train::TrainingMethod;
 
 fn tiny(skills: usize) -> SeadsConfig {
-    let mut c = SeadsConfig::preset(Preset::Small, skills, true);
+    let mut c = SeadsConfig::preset(Preset::Small, skills, Embodiment::Cursor);
     c.episodes_per_epoch = 16;
     c.sampled_episodes = 32;
     c.episode_memory = 64;

@@ -37,7 +37,7 @@ const STATE_NAMES: [&str; 2 * JOINTS] = [
     "finger_3_velocity",
 ];
 
-const OBS_NAMES: [&str; 29] = [
+const OBS_NAMES: [&str; 42] = [
     "joint_1_sin",
     "joint_1_cos",
     "joint_2_sin",
@@ -50,6 +50,12 @@ const OBS_NAMES: [&str; 29] = [
     "joint_5_cos",
     "joint_6_sin",
     "joint_6_cos",
+    "joint_1_torque",
+    "joint_2_torque",
+    "joint_3_torque",
+    "joint_4_torque",
+    "joint_5_torque",
+    "joint_6_torque",
     "joint_1_velocity",
     "joint_2_velocity",
     "joint_3_velocity",
@@ -62,11 +68,18 @@ const OBS_NAMES: [&str; 29] = [
     "finger_1_velocity",
     "finger_2_velocity",
     "finger_3_velocity",
-    "tcp_x",
-    "tcp_y",
-    "tcp_height",
-    "tcp_down",
-    "tcp_yaw",
+    "pinch_x",
+    "pinch_y",
+    "pinch_z",
+    "pinch_r00",
+    "pinch_r01",
+    "pinch_r02",
+    "pinch_r10",
+    "pinch_r11",
+    "pinch_r12",
+    "pinch_r20",
+    "pinch_r21",
+    "pinch_r22",
 ];
 
 /// Where the touch sensing and the board's geoms are in the model.
@@ -83,6 +96,13 @@ pub struct Jaco {
     board: Board,
     /// The grip site (dm_control's tool centre point for the hand).
     tcp: usize,
+    /// The pinch site, whose pose the authors' agent observes.
+    pinch: usize,
+    /// Where each arm joint's 3-axis torque sensor reads in `sensordata`, and the joint's axis (local frame,
+    /// which the sensor's site shares).
+    torque_sensors: Vec<(usize, [f64; 3])>,
+    /// The touch sensors' readings: the first `touch_readings` values of `sensordata`.
+    touch_readings: usize,
     hand_bodies: Vec<usize>,
     /// Draws the resets after moves; reseeded from the episode's stream at every [`Manipulator::reset`].
     rng: ChaCha8Rng,
@@ -102,6 +122,15 @@ impl Jaco {
         let fields =
             (0..side * side).map(|k| id(MjtObjBase::mjOBJ_GEOM, &format!("field_{}_{}", k / side, k % side))).collect();
         let tcp = id(MjtObjBase::mjOBJ_SITE, &format!("{ARM_PREFIX}{HAND_PREFIX}gripsite"));
+        let pinch = id(MjtObjBase::mjOBJ_SITE, &format!("{ARM_PREFIX}{HAND_PREFIX}pinchsite"));
+        let torque_sensors = (1..=ARM_JOINTS)
+            .map(|k| {
+                let sensor = id(MjtObjBase::mjOBJ_SENSOR, &format!("joint_{k}_torque"));
+                let joint = id(MjtObjBase::mjOBJ_JOINT, &format!("{ARM_PREFIX}joint_{k}"));
+                (model.sensor_adr()[sensor] as usize, model.jnt_axis()[joint])
+            })
+            .collect();
+        let touch_readings = if layout.field_sensors { side * side } else { 1 };
         let hand_prefix = format!("{ARM_PREFIX}{HAND_PREFIX}");
         let hand_bodies = (0..model.ffi().nbody as usize)
             .filter(|&b| model.id_to_name(MjtObjBase::mjOBJ_BODY, b).is_some_and(|n| n.starts_with(&hand_prefix)))
@@ -114,6 +143,9 @@ impl Jaco {
             data,
             board: Board { layout, touch, fields },
             tcp,
+            pinch,
+            torque_sensors,
+            touch_readings,
             hand_bodies,
             rng: ChaCha8Rng::seed_from_u64(0),
         }
@@ -146,7 +178,7 @@ impl Jaco {
     fn push(&self, before: &[(i32, i32, [f64; 3])]) -> Option<BoardPoint> {
         let contact_of =
             |geom: usize| before.iter().find(|c| c.0 as usize == geom || c.1 as usize == geom).map(|c| c.2);
-        let readings = self.data.sensordata();
+        let readings = &self.data.sensordata()[..self.touch_readings];
         let width = self.board_width();
         match self.board.touch {
             Touch::PerField => {
@@ -205,9 +237,10 @@ impl Manipulator for Jaco {
         ARM_MAX_VELOCITY.iter().copied().chain([FINGER_MAX_VELOCITY; 3]).collect()
     }
 
-    /// The proprioception the authors' agent sees, less the joint torques and the pinch site's rotation
-    /// matrix: sin/cos of the arm joints (most turn without limit), their velocities, the fingers, and the
-    /// grip site's board position, height (m), downward component of its axis and yaw.
+    /// The proprioception the authors' agent sees (dm_control's Jaco observables in their order): sin/cos of the
+    /// arm joints (most turn without limit), the joint torques about their axes (N·m), the arm joints'
+    /// velocities, the fingers' angles and velocities, and the pinch site's world position (m) and rotation
+    /// matrix (row-major).
     fn obs_names(&self) -> Vec<&'static str> {
         OBS_NAMES.to_vec()
     }
@@ -215,17 +248,19 @@ impl Manipulator for Jaco {
     fn observe(&self) -> Vec<f64> {
         let q = self.data.qpos();
         let v = self.data.qvel();
+        let readings = self.data.sensordata();
         let mut obs = Vec::with_capacity(OBS_NAMES.len());
         for &angle in &q[..ARM_JOINTS] {
             obs.extend([angle.sin(), angle.cos()]);
         }
+        obs.extend(self.torque_sensors.iter().map(|&(adr, axis)| {
+            (0..3).map(|i| readings[adr + i] * axis[i]).sum::<f64>()
+        }));
         obs.extend_from_slice(&v[..ARM_JOINTS]);
         obs.extend_from_slice(&q[ARM_JOINTS..JOINTS]);
         obs.extend_from_slice(&v[ARM_JOINTS..JOINTS]);
-        let p = self.tcp_position();
-        let b = self.world_to_board([p[0], p[1]]);
-        let m = self.data.site_xmat()[self.tcp];
-        obs.extend([b[0], b[1], p[2], -m[8], m[3].atan2(m[0])]);
+        obs.extend_from_slice(&self.data.site_xpos()[self.pinch]);
+        obs.extend_from_slice(&self.data.site_xmat()[self.pinch]);
         obs
     }
 

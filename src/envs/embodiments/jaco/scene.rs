@@ -8,7 +8,7 @@ use std::sync::Arc;
 
 use mujoco_rs::prelude::*;
 
-use super::{ARM_MAX_VELOCITY, ARM_OFFSET, FIELD_HALF, FINGER_MAX_VELOCITY, TIMESTEP};
+use super::{ARM_JOINTS, ARM_MAX_VELOCITY, ARM_OFFSET, FIELD_HALF, FINGER_MAX_VELOCITY, TIMESTEP};
 use crate::error::{Error, Result};
 
 /// Prefixes the attached models' names get.
@@ -63,6 +63,11 @@ pub fn scene_xml(side: usize, touch: Touch) -> String {
         let _ = writeln!(fields, r#"<site name="touch" type="box" size="{half} {half} 0.005" pos="0 0 0.02"/>"#);
         let _ = writeln!(sensors, r#"<touch name="touch" site="touch"/>"#);
     }
+    // dm_control's JacoArm senses each arm joint with a 3-axis torque sensor at a site on the joint's body;
+    // the sites are added to the arm's model before it is attached (see `compile`), hence the prefix.
+    for k in 1..=ARM_JOINTS {
+        let _ = writeln!(sensors, r#"<torque name="joint_{k}_torque" site="{ARM_PREFIX}joint_{k}_site"/>"#);
+    }
     let mut actuators = String::new();
     for (k, (velocity, torque)) in ARM_MAX_VELOCITY.iter().zip(ARM_MAX_TORQUE).enumerate() {
         let joint = format!("{ARM_PREFIX}joint_{}", k + 1);
@@ -112,6 +117,13 @@ pub fn compile(side: usize, touch: Touch, kinova: &Path) -> Result<Arc<MjModel>>
         )));
     }
     let mut arm = MjSpec::from_xml(&arm_file).map_err(|e| mujoco_error("jaco_arm.xml", e))?;
+    for k in 1..=ARM_JOINTS {
+        arm.body_mut(&format!("b_{k}"))
+            .ok_or_else(|| mujoco_error("jaco_arm.xml", format!("no body 'b_{k}'")))?
+            .add_site()
+            .with_name(&format!("joint_{k}_site"))
+            .with_size([1e-3, 0.0, 0.0]);
+    }
     let mut hand = MjSpec::from_xml(kinova.join("jaco_hand.xml")).map_err(|e| mujoco_error("jaco_hand.xml", e))?;
     let hand_root = hand.body_mut("hand").ok_or_else(|| mujoco_error("jaco_hand.xml", "no body 'hand'"))?;
     arm.site_mut("wristsite")

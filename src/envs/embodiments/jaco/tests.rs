@@ -45,7 +45,9 @@ fn reset_puts_the_grip_site_in_the_box_pointing_down() {
         arm.reset(&mut rng);
         let obs = arm.observe();
         let n = obs.len();
-        let (height, down) = (obs[n - 3], obs[n - 2]);
+        // The pinch site's height (its offset from the grip site is 3.4 cm along the downward axis) and its
+        // z axis (the rotation matrix's last row's last entry) downwards.
+        let (height, down) = (obs[n - 10] + 0.034, -obs[n - 1]);
         // Board coordinates of the box (−0.1, 0.1) on a 0.5 m board: [0.3, 0.7].
         let b = arm.effector();
         assert!((0.3 - 1e-6..=0.7 + 1e-6).contains(&b[0]) && (0.3 - 1e-6..=0.7 + 1e-6).contains(&b[1]), "{b:?}");
@@ -107,4 +109,27 @@ fn tileswap_pushes_swap_at_pivots() {
         let out = env.execute(ctrl.as_mut(), mv);
         assert_eq!(out.performed, Some(mv), "move {mv}: {out:?}");
     }
+}
+
+#[test]
+fn observation_is_the_authors_proprioception() {
+    let (mut arm, _) = lightsout_jaco();
+    arm.reset(&mut ChaCha8Rng::seed_from_u64(5));
+    // Let the velocity actuators hold the arm against gravity for a control step.
+    arm.step(&[0.0; 9]);
+    let obs = arm.observe();
+    // 6 × (sin, cos), 6 torques, 6 velocities, 3 + 3 fingers, pinch position 3, rotation 9 (dm_control's order).
+    assert_eq!((obs.len(), arm.obs_names().len()), (42, 42));
+    assert_eq!((arm.obs_names()[12], arm.obs_names()[41]), ("joint_1_torque", "pinch_r22"));
+    // The shoulder and elbow carry the arm's weight; the base joint turns about the vertical and carries none of it.
+    let torque = &obs[12..18];
+    assert!(torque[1].abs() > 1.0 && torque[2].abs() > 0.5, "{torque:?}");
+    assert!(torque[0].abs() < 0.1 * torque[1].abs(), "{torque:?}");
+    let r = &obs[33..42];
+    for i in 0..3 {
+        let norm: f64 = (0..3).map(|j| r[3 * i + j] * r[3 * i + j]).sum();
+        assert!((norm - 1.0).abs() < 1e-9, "rows of the rotation matrix are unit vectors: {r:?}");
+    }
+    let p = &obs[30..33];
+    assert!((0.15..0.4).contains(&p[2]), "the pinch site is above the board: {p:?}");
 }
