@@ -7,7 +7,7 @@ MBRL := target/release/mbrl
 RUN := $(MBRL) --force
 SEED ?= 0
 
-.PHONY: build test bench completions mujoco mujoco-assets repro-jaco repro-quick repro-swingup repro-pendulum-data repro-boards repro-ball repro-pets repro-pets-loop repro-context repro-context-toy repro-context-mountaincar repro-tradyn repro-seads repro-dlgpd clean-reports
+.PHONY: build test bench completions mujoco mujoco-assets repro-jaco repro-seads-jaco repro-quick repro-swingup repro-pendulum-data repro-boards repro-ball repro-pets repro-pets-loop repro-context repro-context-toy repro-context-mountaincar repro-tradyn repro-seads repro-dlgpd clean-reports
 
 # The Jaco arm (`--embodiment jaco`, `lightsout:jaco`) runs on MuJoCo behind the `mujoco` cargo feature; the
 # default build stays MuJoCo-free. This target fetches MuJoCo 3.17.0 (the version mujoco-rs 7 binds) from its
@@ -45,6 +45,15 @@ repro-jaco: mujoco
 		$(RUN) eval embodied --game $$game --embodiment jaco --max-depth 5 --boards 100 --seed $(SEED) \
 			--no-tui --out reports/embodied-$$game-jaco || exit 1; \
 	done
+
+# Thesis 7.4 with the Jaco: SEADS on LightsOutJaco at SEADS_JACO_PRESET (small: 2M env steps, about an hour on
+# 2 cores; paper: the thesis' 10M, about five), then skill coverage and boards of depth 1-5 solved.
+SEADS_JACO_PRESET ?= small
+repro-seads-jaco: mujoco
+	$(RUN) train seads --env lightsout:jaco --preset $(SEADS_JACO_PRESET) --seed $(SEED) --no-tui -q \
+		--out models/seads-lightsout-jaco
+	$(RUN) eval seads --model models/seads-lightsout-jaco --boards 20 --seed $(SEED) --no-tui -q \
+		--out reports/seads-lightsout-jaco
 
 build:
 	cargo build --release

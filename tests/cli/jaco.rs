@@ -75,3 +75,31 @@ fn jaco_replays_target_velocities_from_a_given_state() {
         .unwrap();
     assert_one_line_error(&bad, &["--init-state", "18"]);
 }
+
+#[cfg(feature = "mujoco")]
+#[test]
+fn seads_trains_on_the_jaco_and_its_skills_play_the_board() {
+    let dir = tempfile::tempdir().unwrap();
+    let train = mbrl(dir.path())
+        .args(["--threads", "2", "train", "seads", "--env", "tileswap:jaco", "--env-steps", "1500", "--out", "m"])
+        .args(["-q", "sac_hidden=[32,32]", "episode_memory=64", "sampled_episodes=32", "checkpoint_every=1000"])
+        .output()
+        .unwrap();
+    assert!(train.status.success(), "{}", stderr_of(&train));
+    assert!(stdout_of(&train).contains("trained SEADS on tileswap:jaco"), "{}", stdout_of(&train));
+    let config: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("m/config.json")).unwrap()).unwrap();
+    // The policy sees the authors' 42 proprioceptive values, the board's bits, the remaining time and the
+    // skill's one-hot; it sets the 9 joints' target velocities.
+    let field = |key: &str| config[key].as_u64().unwrap_or_else(|| panic!("config.json has {key}: {config}"));
+    assert_eq!(field("policy_input"), 42 + field("board_bits") + 1 + 12);
+    assert_eq!((field("action_dim"), field("step_limit")), (9, 50));
+    let eval = mbrl(dir.path())
+        .args(["eval", "seads", "--model", "m", "--coverage-boards", "3", "--boards", "1", "--max-depth", "1"])
+        .args(["--out", "r", "-q"])
+        .output()
+        .unwrap();
+    assert!(eval.status.success(), "{}", stderr_of(&eval));
+    let skills = std::fs::read_to_string(dir.path().join("r/skills.csv")).unwrap();
+    assert_eq!(skills.lines().count(), 1 + 12, "{skills}");
+}

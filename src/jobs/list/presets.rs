@@ -81,9 +81,11 @@ pub fn table() -> Table {
             Scale::Medium => SeadsPreset::Medium,
             Scale::Paper => SeadsPreset::Paper,
         };
-        for (embodiment, family) in
-            [(Embodiment::Cursor, "<game>:cursor"), (Embodiment::Reacher, "<game>:reacher"), (Embodiment::Jaco, "<game>:jaco")]
-        {
+        for (embodiment, family) in [
+            (Embodiment::Cursor, "<game>:cursor"),
+            (Embodiment::Reacher, "<game>:reacher"),
+            (Embodiment::Jaco, "<game>:jaco"),
+        ] {
             // The skill count (the game's moves) changes no size listed here.
             let c = SeadsConfig::preset(engine, 12, embodiment);
             let sac = c.sac_hidden.iter().map(usize::to_string).collect::<Vec<_>>().join("×");

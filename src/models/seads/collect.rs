@@ -94,9 +94,8 @@ impl<G: BoardGame> Collector<G> {
                     action.as_ref().map(|action| {
                         let before = env.board();
                         let step = env.step(action);
-                        let performed = (env.board() != before).then(|| {
-                            (0..env.game().num_moves()).find(|&m| env.game().apply(before, m) == env.board())
-                        });
+                        let performed = (env.board() != before)
+                            .then(|| (0..env.game().num_moves()).find(|&m| env.game().apply(before, m) == env.board()));
                         (step, performed)
                     })
                 };

@@ -204,12 +204,9 @@ mod tests {
     #[test]
     fn presets_validate_and_follow_the_authors_code() {
         for preset in [Preset::Small, Preset::Medium, Preset::Paper] {
-            for (skills, embodiment) in [
-                (25, Embodiment::Cursor),
-                (12, Embodiment::Cursor),
-                (25, Embodiment::Reacher),
-                (12, Embodiment::Jaco),
-            ] {
+            for (skills, embodiment) in
+                [(25, Embodiment::Cursor), (12, Embodiment::Cursor), (25, Embodiment::Reacher), (12, Embodiment::Jaco)]
+            {
                 SeadsConfig::preset(preset, skills, embodiment).validate().unwrap();
             }
         }

@@ -45,8 +45,9 @@ impl EmbodiedGame {
     /// The registry's embodied env names, restricted to the games SEADS plays.
     pub fn parse(name: &str) -> Result<Self> {
         let bad = || {
-            let embodied =
-                crate::envs::ENV_NAMES.into_iter().filter(|n| n.ends_with(":cursor") || n.ends_with(":reacher") || n.ends_with(":jaco"));
+            let embodied = crate::envs::ENV_NAMES
+                .into_iter()
+                .filter(|n| n.ends_with(":cursor") || n.ends_with(":reacher") || n.ends_with(":jaco"));
             let hint = crate::util::suggest::did_you_mean(name, embodied);
             Error::config(format!("'{name}' is not an embodied board game{hint}; supported: {ENV_HELP}"))
         };

@@ -253,9 +253,9 @@ impl Manipulator for Jaco {
         for &angle in &q[..ARM_JOINTS] {
             obs.extend([angle.sin(), angle.cos()]);
         }
-        obs.extend(self.torque_sensors.iter().map(|&(adr, axis)| {
-            (0..3).map(|i| readings[adr + i] * axis[i]).sum::<f64>()
-        }));
+        obs.extend(
+            self.torque_sensors.iter().map(|&(adr, axis)| (0..3).map(|i| readings[adr + i] * axis[i]).sum::<f64>()),
+        );
         obs.extend_from_slice(&v[..ARM_JOINTS]);
         obs.extend_from_slice(&q[ARM_JOINTS..JOINTS]);
         obs.extend_from_slice(&v[ARM_JOINTS..JOINTS]);
