@@ -1,0 +1,134 @@
+//! Running one command under the memory and time bounds, and classifying how it ended.
+
+use std::ffi::{OsStr, OsString};
+use std::fs;
+use std::os::unix::ffi::{OsStrExt, OsStringExt};
+use std::os::unix::process::ExitStatusExt;
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitStatus, Stdio};
+use std::time::{Duration, Instant};
+
+use crate::seeds::{seeds, SELF_SNAPSHOT, SNAPSHOT};
+use crate::targets::{Program, Target};
+use crate::{MEMORY_LIMIT_KIB, TIME_LIMIT};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Verdict {
+    Ok,
+    CleanError,
+    Panic,
+    Abort(i32),
+    Hang,
+    Unclean(i32),
+}
+
+impl Verdict {
+    pub(crate) fn is_failure(self) -> bool {
+        !matches!(self, Verdict::Ok | Verdict::CleanError)
+    }
+
+    pub(crate) fn describe(self) -> String {
+        match self {
+            Verdict::Ok => "ok".into(),
+            Verdict::CleanError => "clean error".into(),
+            Verdict::Panic => "panic".into(),
+            Verdict::Abort(signal) => format!("abort (signal {signal})"),
+            Verdict::Hang => format!("hang (over {} s)", TIME_LIMIT.as_secs()),
+            Verdict::Unclean(code) => format!("unclean exit {code} without an 'error:' line"),
+        }
+    }
+}
+
+pub(crate) fn classify(status: Option<ExitStatus>, stderr: &str) -> Verdict {
+    let Some(status) = status else { return Verdict::Hang };
+    if let Some(signal) = status.signal() {
+        return Verdict::Abort(signal);
+    }
+    let code = status.code().unwrap_or(-1);
+    if code == 101 || stderr.contains("panicked") {
+        return Verdict::Panic;
+    }
+    let first = stderr.lines().find(|l| !l.trim().is_empty()).unwrap_or("");
+    match code {
+        0 => Verdict::Ok,
+        1 | 2 if first.starts_with("error:") => Verdict::CleanError,
+        _ => Verdict::Unclean(code),
+    }
+}
+
+/// The program and arguments of a run of `target` on `input`, writing to `out`.
+pub(crate) fn command_line(target: &Target, input: &OsStr, out: &Path) -> (PathBuf, Vec<OsString>) {
+    let (program, mut args): (_, Vec<OsString>) = match target.program {
+        Program::Mbrl => (seeds().join(SNAPSHOT), ["--threads", "1", "-q"].iter().map(OsString::from).collect()),
+        Program::BoardSetReader => (seeds().join(SELF_SNAPSHOT), Vec::new()),
+    };
+    for arg in target.args.split_whitespace() {
+        // `{in}` may sit inside an argument (`--board={in}`); the mutant's bytes go in as they are.
+        let arg = arg.replace("{out}", &out.to_string_lossy());
+        let (before, after) = arg.split_once("{in}").map_or((arg.as_str(), None), |(b, a)| (b, Some(a)));
+        let mut bytes = before.as_bytes().to_vec();
+        if let Some(after) = after {
+            bytes.extend_from_slice(input.as_bytes());
+            bytes.extend_from_slice(after.as_bytes());
+        }
+        args.push(OsString::from_vec(bytes));
+    }
+    (program, args)
+}
+
+pub(crate) struct Run {
+    pub(crate) verdict: Verdict,
+    pub(crate) stderr: String,
+    pub(crate) seconds: f64,
+}
+
+/// Runs one command under the address-space limit and the wall bound. stderr goes to a file (a pipe could fill
+/// up and stall the child while we poll), stdout is dropped.
+pub(crate) fn run_bounded(target: &Target, input: &OsStr, cwd: &Path, out: &Path, stderr_path: &Path) -> Run {
+    let (program, args) = command_line(target, input, out);
+    let limit = format!("ulimit -v {MEMORY_LIMIT_KIB}; exec \"$0\" \"$@\"");
+    let mut command = Command::new("sh");
+    command.arg("-c").arg(limit).arg(&program).args(&args).current_dir(cwd).env("NO_COLOR", "1");
+    let stderr_file = fs::File::create(stderr_path).unwrap();
+    let start = Instant::now();
+    let mut child = command.stdin(Stdio::null()).stdout(Stdio::null()).stderr(stderr_file).spawn().unwrap();
+    let mut pause = Duration::from_millis(1);
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break Some(status);
+        }
+        if start.elapsed() > TIME_LIMIT {
+            let _ = child.kill();
+            let _ = child.wait();
+            break None;
+        }
+        std::thread::sleep(pause);
+        pause = (pause * 2).min(Duration::from_millis(20));
+    };
+    let seconds = start.elapsed().as_secs_f64();
+    let stderr = String::from_utf8_lossy(&fs::read(stderr_path).unwrap_or_default()).into_owned();
+    let _ = fs::remove_file(stderr_path);
+    Run { verdict: classify(status, &stderr), stderr, seconds }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The verdicts of the kinds of endings a run can have (wait statuses as the kernel reports them).
+    #[test]
+    fn classification_of_endings() {
+        let exit = |code: i32| Some(ExitStatus::from_raw(code << 8));
+        let signal = |sig: i32| Some(ExitStatus::from_raw(sig));
+        assert_eq!(classify(exit(0), ""), Verdict::Ok);
+        assert_eq!(classify(exit(1), "error: x.mcap: not a readable MCAP file\n"), Verdict::CleanError);
+        assert_eq!(classify(exit(2), "error: unexpected argument '--x' (see 'mbrl --help')\n"), Verdict::CleanError);
+        assert_eq!(classify(exit(101), ""), Verdict::Panic);
+        assert_eq!(classify(exit(1), "thread 'main' panicked at src/x.rs:1:1:\nerror: x\n"), Verdict::Panic);
+        assert_eq!(classify(signal(6), "memory allocation of 68719476736 bytes failed\n"), Verdict::Abort(6));
+        assert_eq!(classify(signal(11), ""), Verdict::Abort(11));
+        assert_eq!(classify(None, ""), Verdict::Hang);
+        assert_eq!(classify(exit(1), "progress 3/5\nerror: late\n"), Verdict::Unclean(1));
+        assert_eq!(classify(exit(3), "error: x\n"), Verdict::Unclean(3));
+    }
+}
