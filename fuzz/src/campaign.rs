@@ -1,5 +1,6 @@
 //! The campaign: settings, the seeds checked, every mutant of every chosen target run over the workers.
 
+use std::collections::BTreeSet;
 use std::ffi::OsStr;
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -7,6 +8,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::Instant;
 
+use crate::garbage;
 use crate::mutant::{prepare, Mutant};
 use crate::report::{failures_dir, print_table, save_failure, shown, Counts, Failure};
 use crate::runner::{run_bounded, Run, Verdict};
@@ -22,6 +24,8 @@ pub(crate) struct Settings {
     /// Print every run's outcome and first stderr line.
     pub(crate) verbose: bool,
     pub(crate) binary: PathBuf,
+    /// The structure-aware extremes mode instead of random mutations.
+    pub(crate) extremes: bool,
 }
 
 /// The flags, else the environment, else the defaults; the message of an `Err` names the bad variable.
@@ -47,18 +51,43 @@ pub(crate) fn settings(cli: &Cli) -> Result<Settings, String> {
         only: only.split(',').map(str::trim).filter(|s| !s.is_empty()).map(String::from).collect(),
         verbose: cli.verbose || std::env::var_os("MBRL_FUZZ_VERBOSE").is_some(),
         binary,
+        extremes: cli.extremes || std::env::var_os("MBRL_FUZZ_EXTREMES").is_some(),
     })
 }
 
-/// Runs mutant `index` (or the seed) of a target and cleans up after it; a failure is saved first.
-pub(crate) fn run_one(target: &Target, seeds: &Path, index: Option<u64>, campaign: u64) -> (Run, Option<Mutant>) {
+/// Runs mutant `index` (or the seed) of a target and cleans up after it; a failure is saved first. In the
+/// extremes mode a clean exit is also checked for silent garbage against the seed's run.
+pub(crate) fn run_one(
+    target: &Target,
+    seeds: &Path,
+    index: Option<u64>,
+    campaign: u64,
+    extremes: bool,
+) -> (Run, Option<Mutant>) {
     let work = seeds.join("work").join(target.name);
     fs::create_dir_all(&work).unwrap();
-    let mutant = prepare(target, seeds, &work, index, campaign);
+    let mutant = match (extremes, index) {
+        (true, Some(index)) => crate::extremes::prepare(target, seeds, &work, index, campaign),
+        _ => prepare(target, seeds, &work, index, campaign),
+    };
     let label = index.map_or("seed".to_string(), |i| i.to_string());
     let out = work.join(format!("{label}.out"));
-    let run = run_bounded(target, &mutant.input, seeds, &out, &work.join(format!("{label}.stderr")));
+    let stdout = work.join(format!("{label}.stdout"));
+    let mut run = run_bounded(target, &mutant, seeds, &out, [&stdout, &work.join(format!("{label}.stderr"))]);
+    if extremes && run.verdict == Verdict::Ok {
+        let mut found = BTreeSet::new();
+        garbage::markers(&out, &mut found);
+        garbage::markers(&stdout, &mut found);
+        if let Input::Checkpoint { .. } = target.input {
+            garbage::markers(&mutant.path, &mut found);
+        }
+        if let Some(new) = garbage::judge(target.name, index.is_none(), found) {
+            run.verdict = Verdict::Garbage;
+            run.stderr = format!("non-finite numbers in the outputs: {new}\n{}", run.stderr);
+        }
+    }
     remove(&out);
+    remove(&stdout);
     if run.verdict.is_failure() {
         return (run, Some(mutant));
     }
@@ -72,9 +101,9 @@ pub(crate) fn remove(path: &Path) {
 
 /// Every unmutated seed must be read as intended under the same limits; otherwise the mutants test nothing
 /// (and a 4 GiB limit that breaks normal runs is itself a finding).
-pub(crate) fn check_seeds(targets: &[&Target], seeds: &Path) -> Result<(), String> {
+pub(crate) fn check_seeds(targets: &[&Target], seeds: &Path, extremes: bool) -> Result<(), String> {
     for target in targets {
-        let (run, failed) = run_one(target, seeds, None, 0);
+        let (run, failed) = run_one(target, seeds, None, 0, extremes);
         let expected = if target.seed_is_refused { Verdict::CleanError } else { Verdict::Ok };
         if let Some(mutant) = failed {
             remove(&mutant.path);
@@ -85,7 +114,7 @@ pub(crate) fn check_seeds(targets: &[&Target], seeds: &Path) -> Result<(), Strin
                 target.name,
                 run.verdict.describe(),
                 expected.describe(),
-                shown(target, OsStr::new("<seed>")),
+                shown(target, OsStr::new("<seed>"), None),
                 run.stderr
             ));
         }
@@ -96,7 +125,11 @@ pub(crate) fn check_seeds(targets: &[&Target], seeds: &Path) -> Result<(), Strin
 /// Runs every mutant of the chosen targets on the seeds; `Err` holds the report of the failures.
 pub(crate) fn fuzz_every_reader(settings: &Settings, targets: &[&Target]) -> Result<(), String> {
     let seeds = seeds();
-    check_seeds(targets, seeds)?;
+    check_seeds(targets, seeds, settings.extremes)?;
+    if settings.extremes {
+        let pairs: u64 = targets.iter().map(|t| crate::extremes::pairs(t, seeds)).sum();
+        eprintln!("fuzz: extremes: {pairs} (field or flag, extreme) pairs over the chosen targets");
+    }
     for target in targets {
         remove(&failures_dir().join(target.name));
     }
@@ -108,9 +141,10 @@ pub(crate) fn fuzz_every_reader(settings: &Settings, targets: &[&Target]) -> Res
     let failures = Mutex::new(Vec::new());
     let start = Instant::now();
     eprintln!(
-        "fuzz: {} targets × {} mutants, {} parallel runs, --seed {}",
+        "fuzz: {} targets × {} {}mutants, {} parallel runs, --seed {}",
         targets.len(),
         settings.mutants,
+        if settings.extremes { "extreme " } else { "" },
         settings.jobs,
         settings.campaign
     );
@@ -119,7 +153,7 @@ pub(crate) fn fuzz_every_reader(settings: &Settings, targets: &[&Target]) -> Res
             scope.spawn(|| {
                 while let Some(&(t, index)) = jobs.get(next.fetch_add(1, Ordering::Relaxed)) {
                     let target = targets[t];
-                    let (run, failed) = run_one(target, seeds, Some(index), settings.campaign);
+                    let (run, failed) = run_one(target, seeds, Some(index), settings.campaign, settings.extremes);
                     if let Some(mutant) = failed {
                         let saved = save_failure(target, &mutant, index, run.verdict, settings.campaign);
                         remove(&mutant.path);
@@ -128,7 +162,7 @@ pub(crate) fn fuzz_every_reader(settings: &Settings, targets: &[&Target]) -> Res
                             Input::Arg { .. } => mutant.input.clone(),
                             _ => saved.clone().into_os_string(),
                         };
-                        let command = shown(target, &input);
+                        let command = shown(target, &input, mutant.flag.as_ref());
                         let stderr = run.stderr.clone();
                         let description = mutant.description;
                         failures.lock().unwrap().push(Failure {

@@ -1,6 +1,8 @@
 #![doc = include_str!("../README.md")]
 
 mod campaign;
+mod extremes;
+mod garbage;
 mod mcap_doc;
 mod mutant;
 mod mutators;
@@ -54,6 +56,12 @@ pub(crate) struct Cli {
     /// Print every run's outcome and first stderr line [env: MBRL_FUZZ_VERBOSE, set to anything]
     #[arg(long)]
     pub(crate) verbose: bool,
+    /// Structure-aware extremes instead of random mutations: mutant i writes one extreme value (±1.8e308,
+    /// 5e-324, 0, -0, -1, 1e19, 2^64-1, NaN, inf, an empty or million-element array, …) into one numeric field
+    /// of the input or one numeric flag, and a clean exit whose outputs hold NaN or infinity fails
+    /// [env: MBRL_FUZZ_EXTREMES, set to anything]
+    #[arg(long)]
+    pub(crate) extremes: bool,
     /// Print the target names and exit
     #[arg(long)]
     pub(crate) list: bool,

@@ -21,6 +21,9 @@ pub(crate) struct Mutant {
     /// The `{in}` of the command: the mutant's path, or the mutated argument's bytes.
     pub(crate) input: OsString,
     pub(crate) description: String,
+    /// A numeric flag set to an extreme (`--steps`, `1e19`): it replaces the flag's value in the command, or is
+    /// added to it.
+    pub(crate) flag: Option<(String, String)>,
 }
 
 /// The generator of mutant `index` of `target`: the same for every run with the same `MBRL_FUZZ_SEED`.
@@ -54,7 +57,7 @@ pub(crate) fn prepare(target: &Target, seeds: &Path, work: &Path, index: Option<
             };
             let path = work.join(format!("{label}.{ext}"));
             fs::write(&path, bytes).unwrap();
-            Mutant { input: path.clone().into_os_string(), path, description }
+            Mutant { input: path.clone().into_os_string(), path, description, flag: None }
         }
         Input::Checkpoint { dir, files } => {
             let path = work.join(format!("{label}.ckpt"));
@@ -67,7 +70,7 @@ pub(crate) fn prepare(target: &Target, seeds: &Path, work: &Path, index: Option<
                     mutate_checkpoint(&mut rng, &path, file)
                 }
             };
-            Mutant { input: path.clone().into_os_string(), path, description }
+            Mutant { input: path.clone().into_os_string(), path, description, flag: None }
         }
         Input::Arg { seed } => {
             let mut bytes = seed.as_bytes().to_vec();
@@ -79,7 +82,7 @@ pub(crate) fn prepare(target: &Target, seeds: &Path, work: &Path, index: Option<
             bytes.iter_mut().filter(|b| **b == 0).for_each(|b| *b = 1);
             let path = work.join(format!("{label}.arg"));
             fs::write(&path, &bytes).unwrap();
-            Mutant { input: OsString::from_vec(bytes), path, description }
+            Mutant { input: OsString::from_vec(bytes), path, description, flag: None }
         }
     }
 }
@@ -110,21 +113,29 @@ pub(crate) fn mutate_checkpoint(rng: &mut ChaCha8Rng, dir: &Path, file: &str) ->
         mutate_document(rng, &mut bytes)
     };
     fs::write(&path, &bytes).unwrap();
-    let manifest_path = dir.join("checkpoint.json");
     // A map set's manifest vouches by pixel CRC, which a fuzzer cannot forge without decoding: left as is.
-    if file == "checkpoint.json" || !manifest_path.exists() {
+    if file == "checkpoint.json" || !dir.join("checkpoint.json").exists() {
         return format!("{file}: {what}");
-    }
-    let mut manifest: serde_json::Value = serde_json::from_slice(&fs::read(&manifest_path).unwrap()).unwrap();
-    if let Some(entry) = manifest["files"].get_mut(file) {
-        entry["bytes"] = bytes.len().into();
-        entry["crc32"] = crc32fast::hash(&bytes).into();
     }
     // The manifest records how much of the metrics log belongs to the checkpoint; mostly keep it consistent,
     // sometimes leave the old length to exercise the cut-back on resume.
-    if file == "metrics.jsonl" && rng.random_bool(0.8) {
+    let metrics_length = file == "metrics.jsonl" && rng.random_bool(0.8);
+    vouch(dir, file, &bytes, metrics_length);
+    format!("{file} (manifest updated): {what}")
+}
+
+/// Makes the manifest of the checkpoint in `dir` vouch for `bytes` as `file` (size and CRC-32, and with
+/// `metrics_length` the length of `metrics.jsonl` it owns).
+pub(crate) fn vouch(dir: &Path, file: &str, bytes: &[u8], metrics_length: bool) {
+    let manifest_path = dir.join("checkpoint.json");
+    let Ok(manifest) = fs::read(&manifest_path) else { return };
+    let mut manifest: serde_json::Value = serde_json::from_slice(&manifest).unwrap();
+    if let Some(entry) = manifest["files"].get_mut(file) {
+        entry["bytes"] = bytes.len().into();
+        entry["crc32"] = crc32fast::hash(bytes).into();
+    }
+    if file == "metrics.jsonl" && metrics_length {
         manifest["metrics_bytes"] = bytes.len().into();
     }
     fs::write(&manifest_path, serde_json::to_vec_pretty(&manifest).unwrap()).unwrap();
-    format!("{file} (manifest updated): {what}")
 }

@@ -31,6 +31,7 @@ pub(crate) struct Counts {
     pub(crate) aborts: u64,
     pub(crate) hangs: u64,
     pub(crate) unclean: u64,
+    pub(crate) garbage: u64,
     pub(crate) seconds: f64,
 }
 
@@ -45,6 +46,7 @@ impl Counts {
             Verdict::Abort(_) => self.aborts += 1,
             Verdict::Hang => self.hangs += 1,
             Verdict::Unclean(_) => self.unclean += 1,
+            Verdict::Garbage => self.garbage += 1,
         }
     }
 }
@@ -72,8 +74,8 @@ pub(crate) fn quote(arg: &OsStr) -> Vec<u8> {
 }
 
 /// The command as a reader would type it, for the report.
-pub(crate) fn shown(target: &Target, input: &OsStr) -> String {
-    let (program, args) = command_line(target, input, Path::new("OUT"));
+pub(crate) fn shown(target: &Target, input: &OsStr, flag: Option<&(String, String)>) -> String {
+    let (program, args) = command_line(target, input, flag, Path::new("OUT"));
     let name = if target.program == Program::Mbrl { "mbrl".into() } else { program.display().to_string() };
     let args: Vec<String> = args.iter().map(|a| String::from_utf8_lossy(&quote(a)).into_owned()).collect();
     format!("{name} {}", args.join(" "))
@@ -99,7 +101,7 @@ pub(crate) fn save_failure(target: &Target, mutant: &Mutant, index: u64, verdict
         Input::Arg { .. } => (OsString::from_vec(fs::read(&mutant.path).unwrap()), ""),
         Input::File { .. } => (relative.clone().into_os_string(), ""),
     };
-    let (_, args) = command_line(target, &input, Path::new("fuzz-out"));
+    let (_, args) = command_line(target, &input, mutant.flag.as_ref(), Path::new("fuzz-out"));
     let mut script = format!(
         "#!/bin/sh\n# mbrl fuzz reproducer: target {}, mutant {index} (mbrl-fuzz --seed {campaign})\n# mutation: {}\n\
          # verdict: {}\n# Runs in fuzz-failures/seeds with the harness's limits and the binary that failed\n\
@@ -137,13 +139,13 @@ pub(crate) fn save_failure(target: &Target, mutant: &Mutant, index: u64, verdict
 
 pub(crate) fn print_table(targets: &[&Target], counts: &[Counts]) {
     eprintln!(
-        "\n{:<22} {:>6} {:>6} {:>7} {:>6} {:>6} {:>6} {:>7} {:>8}",
-        "target", "runs", "ok", "errors", "panics", "aborts", "hangs", "unclean", "s/run"
+        "\n{:<22} {:>6} {:>6} {:>7} {:>6} {:>6} {:>6} {:>7} {:>7} {:>8}",
+        "target", "runs", "ok", "errors", "panics", "aborts", "hangs", "unclean", "garbage", "s/run"
     );
     let mut total = Counts::default();
     for (target, c) in targets.iter().zip(counts) {
         eprintln!(
-            "{:<22} {:>6} {:>6} {:>7} {:>6} {:>6} {:>6} {:>7} {:>8.3}",
+            "{:<22} {:>6} {:>6} {:>7} {:>6} {:>6} {:>6} {:>7} {:>7} {:>8.3}",
             target.name,
             c.runs,
             c.ok,
@@ -152,6 +154,7 @@ pub(crate) fn print_table(targets: &[&Target], counts: &[Counts]) {
             c.aborts,
             c.hangs,
             c.unclean,
+            c.garbage,
             c.seconds / c.runs.max(1) as f64
         );
         for (sum, part) in [
@@ -162,13 +165,14 @@ pub(crate) fn print_table(targets: &[&Target], counts: &[Counts]) {
             (&mut total.aborts, c.aborts),
             (&mut total.hangs, c.hangs),
             (&mut total.unclean, c.unclean),
+            (&mut total.garbage, c.garbage),
         ] {
             *sum += part;
         }
         total.seconds += c.seconds;
     }
     eprintln!(
-        "{:<22} {:>6} {:>6} {:>7} {:>6} {:>6} {:>6} {:>7} {:>8.3}\n",
+        "{:<22} {:>6} {:>6} {:>7} {:>6} {:>6} {:>6} {:>7} {:>7} {:>8.3}\n",
         "total",
         total.runs,
         total.ok,
@@ -177,6 +181,7 @@ pub(crate) fn print_table(targets: &[&Target], counts: &[Counts]) {
         total.aborts,
         total.hangs,
         total.unclean,
+        total.garbage,
         total.seconds / total.runs.max(1) as f64
     );
 }

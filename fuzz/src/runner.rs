@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, ExitStatus, Stdio};
 use std::time::{Duration, Instant};
 
+use crate::mutant::Mutant;
 use crate::seeds::{seeds, SELF_SNAPSHOT, SNAPSHOT};
 use crate::targets::{Program, Target};
 use crate::{MEMORY_LIMIT_KIB, TIME_LIMIT};
@@ -20,6 +21,8 @@ pub(crate) enum Verdict {
     Abort(i32),
     Hang,
     Unclean(i32),
+    /// Exit 0 on an extreme input, with NaN or infinity in the outputs where the seed's run had none.
+    Garbage,
 }
 
 impl Verdict {
@@ -35,6 +38,7 @@ impl Verdict {
             Verdict::Abort(signal) => format!("abort (signal {signal})"),
             Verdict::Hang => format!("hang (over {} s)", TIME_LIMIT.as_secs()),
             Verdict::Unclean(code) => format!("unclean exit {code} without an 'error:' line"),
+            Verdict::Garbage => "silent garbage: exit 0 with non-finite numbers in its outputs".into(),
         }
     }
 }
@@ -57,7 +61,12 @@ pub(crate) fn classify(status: Option<ExitStatus>, stderr: &str) -> Verdict {
 }
 
 /// The program and arguments of a run of `target` on `input`, writing to `out`.
-pub(crate) fn command_line(target: &Target, input: &OsStr, out: &Path) -> (PathBuf, Vec<OsString>) {
+pub(crate) fn command_line(
+    target: &Target,
+    input: &OsStr,
+    flag: Option<&(String, String)>,
+    out: &Path,
+) -> (PathBuf, Vec<OsString>) {
     let (program, mut args): (_, Vec<OsString>) = match target.program {
         Program::Mbrl => (seeds().join(SNAPSHOT), ["--threads", "1", "-q"].iter().map(OsString::from).collect()),
         Program::BoardSetReader => (seeds().join(SELF_SNAPSHOT), Vec::new()),
@@ -73,6 +82,19 @@ pub(crate) fn command_line(target: &Target, input: &OsStr, out: &Path) -> (PathB
         }
         args.push(OsString::from_vec(bytes));
     }
+    if let Some((name, value)) = flag {
+        // `--name=value` whatever the value: a negative number must not read as a flag.
+        let set = OsString::from(format!("{name}={value}"));
+        let prefix = format!("{name}=");
+        match args.iter().position(|a| a == name.as_str() || a.as_bytes().starts_with(prefix.as_bytes())) {
+            Some(i) if args[i] == name.as_str() && i + 1 < args.len() => {
+                args[i] = set;
+                args.remove(i + 1);
+            }
+            Some(i) => args[i] = set,
+            None => args.push(set),
+        }
+    }
     (program, args)
 }
 
@@ -83,15 +105,17 @@ pub(crate) struct Run {
 }
 
 /// Runs one command under the address-space limit and the wall bound. stderr goes to a file (a pipe could fill
-/// up and stall the child while we poll), stdout is dropped.
-pub(crate) fn run_bounded(target: &Target, input: &OsStr, cwd: &Path, out: &Path, stderr_path: &Path) -> Run {
-    let (program, args) = command_line(target, input, out);
+/// up and stall the child while we poll), and so does stdout, for the caller to scan.
+pub(crate) fn run_bounded(target: &Target, mutant: &Mutant, cwd: &Path, out: &Path, stdio: [&Path; 2]) -> Run {
+    let [stdout_path, stderr_path] = stdio;
+    let (program, args) = command_line(target, &mutant.input, mutant.flag.as_ref(), out);
     let limit = format!("ulimit -v {MEMORY_LIMIT_KIB}; exec \"$0\" \"$@\"");
     let mut command = Command::new("sh");
     command.arg("-c").arg(limit).arg(&program).args(&args).current_dir(cwd).env("NO_COLOR", "1");
     let stderr_file = fs::File::create(stderr_path).unwrap();
+    let stdout_file = fs::File::create(stdout_path).unwrap();
     let start = Instant::now();
-    let mut child = command.stdin(Stdio::null()).stdout(Stdio::null()).stderr(stderr_file).spawn().unwrap();
+    let mut child = command.stdin(Stdio::null()).stdout(stdout_file).stderr(stderr_file).spawn().unwrap();
     let mut pause = Duration::from_millis(1);
     let status = loop {
         if let Some(status) = child.try_wait().unwrap() {
