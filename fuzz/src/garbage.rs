@@ -1,6 +1,8 @@
 //! The "silent garbage" check of the extremes mode: a run that exits 0 on an absurd input must not have written
-//! non-finite numbers. Outputs are scanned for the spellings of NaN and infinity (and JSON's `null`, which
-//! serde writes for a non-finite float); what the unmutated seed's run writes too is not counted.
+//! non-finite numbers. Outputs are scanned for the spellings of NaN and infinity; what the unmutated seed's run
+//! writes too is not counted. JSON's `null` (what serde writes for a non-finite float) is not counted: too many
+//! fields are legitimately absent (no validation split, no best step), and a NaN would be caught as a diverged
+//! loss or in the CSV tables and reports beside it.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::fs;
@@ -31,11 +33,10 @@ pub(crate) fn markers(path: &Path, found: &mut BTreeSet<String>) {
         return;
     }
     let ext = path.extension().map_or(String::new(), |e| e.to_string_lossy().into_owned());
-    let json = matches!(ext.as_str(), "json" | "jsonl");
     match ext.as_str() {
         "csv" | "json" | "jsonl" | "md" | "txt" | "toml" | "tsv" => {
             if let Ok(bytes) = fs::read(path) {
-                scan(&String::from_utf8_lossy(&bytes), json, found);
+                scan(&String::from_utf8_lossy(&bytes), found);
             }
         }
         "mcap" => {
@@ -52,20 +53,20 @@ fn scan_mcap(bytes: &[u8], found: &mut BTreeSet<String>) {
     let Ok(records) = mcap::read::ChunkFlattener::new(bytes) else { return };
     for record in records {
         match record {
-            Ok(Record::Message { data, .. }) => scan(&String::from_utf8_lossy(&data), true, found),
-            Ok(Record::Metadata(m)) => m.metadata.values().for_each(|v| scan(v, true, found)),
+            Ok(Record::Message { data, .. }) => scan(&String::from_utf8_lossy(&data), found),
+            Ok(Record::Metadata(m)) => m.metadata.values().for_each(|v| scan(v, found)),
             Ok(_) => {}
             Err(_) => return,
         }
     }
 }
 
-/// Words spelling a non-finite number (`NaN`, `-inf`, `Infinity`), and `null` in JSON.
-pub(crate) fn scan(text: &str, json: bool, found: &mut BTreeSet<String>) {
+/// Words spelling a non-finite number (`NaN`, `-inf`, `Infinity`).
+pub(crate) fn scan(text: &str, found: &mut BTreeSet<String>) {
     let word = |c: char| c.is_ascii_alphanumeric() || c == '_' || c == '.';
     for token in text.split(|c: char| !word(c)) {
         let lower = token.to_ascii_lowercase();
-        if matches!(lower.as_str(), "nan" | "inf" | "infinity") || (json && lower == "null") {
+        if matches!(lower.as_str(), "nan" | "inf" | "infinity") {
             found.insert(lower);
         }
     }
@@ -78,12 +79,10 @@ mod tests {
     #[test]
     fn non_finite_spellings() {
         let mut found = BTreeSet::new();
-        scan("step,loss\n1,NaN\n2,-inf\n", false, &mut found);
+        scan("step,loss\n1,NaN\n2,-inf\n", &mut found);
         assert_eq!(found.iter().collect::<Vec<_>>(), ["inf", "nan"]);
         let mut found = BTreeSet::new();
-        scan("{\"information\":1,\"nano\":2,\"x\":null}", false, &mut found);
+        scan("{\"information\":1,\"nano\":2,\"x\":null,\"y\":\"a.inf\"}", &mut found);
         assert!(found.is_empty(), "{found:?}");
-        scan("{\"x\":null}", true, &mut found);
-        assert_eq!(found.iter().collect::<Vec<_>>(), ["null"]);
     }
 }

@@ -62,6 +62,10 @@ pub(crate) struct Cli {
     /// [env: MBRL_FUZZ_EXTREMES, set to anything]
     #[arg(long)]
     pub(crate) extremes: bool,
+    /// With --extremes: only the fields and flags whose name contains one of these comma-separated substrings
+    /// (`metadata.dt,--steps`) [env: MBRL_FUZZ_FIELDS]
+    #[arg(long, value_name = "A,B")]
+    pub(crate) fields: Option<String>,
     /// Print the target names and exit
     #[arg(long)]
     pub(crate) list: bool,
@@ -129,6 +133,9 @@ fn main() -> ExitCode {
         Err(e) => return setup_error(format!("{}: {e}", cli.dir.display())),
     };
     WORK.set(dir).expect("set once");
+    let fields = cli.fields.clone().or_else(|| std::env::var("MBRL_FUZZ_FIELDS").ok()).unwrap_or_default();
+    let fields = fields.split(',').map(str::trim).filter(|s| !s.is_empty()).map(String::from).collect();
+    extremes::FIELDS.set(fields).expect("set once");
     eprintln!("fuzz: testing {}", settings.binary.display());
     if let Err(message) = generate(&settings.binary) {
         return setup_error(message);

@@ -52,7 +52,8 @@ pub(crate) fn classify(status: Option<ExitStatus>, stderr: &str) -> Verdict {
     if code == 101 || stderr.contains("panicked") {
         return Verdict::Panic;
     }
-    let first = stderr.lines().find(|l| !l.trim().is_empty()).unwrap_or("");
+    // Warnings (`jobs::warn`) may come before the error that ended the run.
+    let first = stderr.lines().find(|l| !l.trim().is_empty() && !l.starts_with("warning:")).unwrap_or("");
     match code {
         0 => Verdict::Ok,
         1 | 2 if first.starts_with("error:") => Verdict::CleanError,
@@ -153,6 +154,7 @@ mod tests {
         assert_eq!(classify(signal(11), ""), Verdict::Abort(11));
         assert_eq!(classify(None, ""), Verdict::Hang);
         assert_eq!(classify(exit(1), "progress 3/5\nerror: late\n"), Verdict::Unclean(1));
+        assert_eq!(classify(exit(1), "warning: x: 5 of 5 steps\nerror: y\n"), Verdict::CleanError);
         assert_eq!(classify(exit(3), "error: x\n"), Verdict::Unclean(3));
     }
 }

@@ -96,9 +96,11 @@ pub(crate) fn generate_seeds(dir: &Path) -> Result<(), String> {
     write("actions.csv", "u\n0.5\n-2\n1.5\n1e-3\n");
     write("cursor.csv", "dx,dy,push\n0.2,-0.2,-1\n0.1,-0.1,0.9\n0,0,-1\n");
     write("reacher.csv", "u1,u2,push\n1,-1,-1\n0.5,0.5,1\n0,0,1\n");
+    write("unicycle.csv", "acceleration,turn\n0.5,0.1\n-0.5,1\n0,0\n");
 
     make(dir, "collect --env pendulum --rollouts 3 --steps 10 --out roll.mcap")?;
     make(dir, "collect --env pendulum --images --rollouts 2 --steps 4 --out img.mcap")?;
+    make(dir, "collect --env mountaincar --rollouts 2 --steps 10 --out mc.mcap")?;
     make(dir, "collect --env toy:inner --instances 4 --steps 12 --out ctx.mcap")?;
     make(dir, "collect --env pendulum:quadrant --instances 4 --steps 12 --out quad.mcap")?;
     make(dir, "collect --env ball --trajectories 2 --out ball.mcap")?;

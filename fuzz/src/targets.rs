@@ -86,6 +86,13 @@ pub(crate) fn targets() -> Vec<Target> {
             concat!("plan --env pendulum --model dlgpd --evidence {in} --out {out}", cheap_plan!()),
         ),
         target("images-eval", mcap("img.mcap"), "eval dataset --input {in} --out {out}"),
+        // The report of every kind of rollout dataset: time axes, state panels, returns.
+        target("pairs-eval", mcap("ctx.mcap"), "eval dataset --input {in} --out {out}"),
+        target("quadrant-eval", mcap("quad.mcap"), "eval dataset --input {in} --out {out}"),
+        target("unicycle-eval", mcap("uni.mcap"), "eval dataset --input {in} --out {out}"),
+        target("calib-eval", mcap("calib.mcap"), "eval dataset --input {in} --out {out}"),
+        target("mountaincar-eval", mcap("mc.mcap"), "eval dataset --input {in} --out {out}"),
+        target("rollouts-export", mcap("roll.mcap"), "export --input {in} --format npz --out {out}"),
         target(
             "pairs-train-context",
             mcap("ctx.mcap"),
@@ -131,6 +138,17 @@ pub(crate) fn targets() -> Vec<Target> {
             "terrain-set",
             Input::Checkpoint { dir: "terrain", files: &["terrain.json", "map000.png"] },
             "collect --env unicycle --maps {in} --split train --rollouts 1 --steps 3 --out {out}",
+        ),
+        // Torques past the Reacher's bound, and unicycle commands that could stall its adaptive integrator.
+        target(
+            "actions-reacher",
+            text("reacher.csv"),
+            "collect --env lightsout:reacher --actions {in} --init-state 0.5,1.2,0,0 --out {out}",
+        ),
+        target(
+            "actions-unicycle",
+            text("unicycle.csv"),
+            "collect --env unicycle --map map.png --actions {in} --init-state 0.3,0.4,0,1 --out {out}",
         ),
         target(
             "actions-cursor",

@@ -8,6 +8,7 @@ use safetensors::tensor::{Dtype, TensorView};
 use safetensors::SafeTensors;
 
 use crate::error::{Error, Result};
+use crate::util::domain::Domain;
 use crate::nn::{NamedTensor, ParamSet};
 
 /// Checkpoint files larger than this are refused before reading (the largest preset is a few MB).
@@ -115,6 +116,28 @@ pub fn parse(path: &Path, bytes: &[u8]) -> Result<Vec<StoredTensor>> {
         out.push(StoredTensor { name, shape, data });
     }
     Ok(out)
+}
+
+/// Trained weights, biases and normalizer statistics of every model stay far inside this; a larger value
+/// saturates or overflows the f32 activations it feeds (NaN predictions, degenerate evaluations).
+const WEIGHT: Domain = Domain::closed(-1e6, 1e6);
+/// A tensor named `*.std` holds standard deviations (normalizers, latent scales), which divide.
+const STD: Domain = Domain { lo: 0.0, lo_open: true, ..WEIGHT };
+
+/// The weights of a model file, each within its domain: the error names the tensor and element.
+pub fn check_weights(path: &Path, tensors: &[StoredTensor]) -> Result<()> {
+    for tensor in tensors {
+        let domain = if tensor.name.ends_with(".std") { STD } else { WEIGHT };
+        let values: Box<dyn Iterator<Item = f64>> = match &tensor.data {
+            TensorData::F32(v) => Box::new(v.iter().map(|&x| x as f64)),
+            TensorData::F64(v) => Box::new(v.iter().copied()),
+        };
+        if let Some((i, x)) = values.enumerate().find(|(_, x)| !domain.contains(*x)) {
+            let e = domain.check(&format!("tensor '{}'[{i}]", tensor.name), x).unwrap_err();
+            return Err(Error::bad_file(path, e.to_string()));
+        }
+    }
+    Ok(())
 }
 
 /// The f32 tensors named in `layout`, in its order and with its shapes; anything missing, extra or differently

@@ -106,6 +106,9 @@ impl Site {
     }
 }
 
+/// `--fields`: only the sites whose name contains one of these (`metadata.dt`, `--steps`); all when empty.
+pub(crate) static FIELDS: OnceLock<Vec<String>> = OnceLock::new();
+
 /// A target's sites with the extremes each holds, read from its seed once per process.
 struct Plan {
     sites: Vec<Site>,
@@ -141,6 +144,9 @@ fn make_plan(target: &Target, seeds: &Path) -> Plan {
     }
     if target.program == Program::Mbrl {
         sites.extend(flags::numeric_flags(target.args).into_iter().map(Site::Flag));
+    }
+    if let Some(only) = FIELDS.get().filter(|only| !only.is_empty()) {
+        sites.retain(|site| only.iter().any(|o| site.shown().contains(o.as_str())));
     }
     let extremes: Vec<Vec<Extreme>> = sites.iter().map(Site::extremes).collect();
     let pairs = extremes.iter().map(|e| e.len() as u64).sum();
