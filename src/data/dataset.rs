@@ -128,7 +128,10 @@ impl DatasetMeta {
             state_names: serde_json::from_str(field("state_names")?)
                 .map_err(|_| parse_err("state_names", "a JSON array of strings"))?,
             action_dim: ACTION_DIM
-                .check_count("metadata.action_dim", field("action_dim")?.parse().map_err(|_| parse_err("action_dim", "an integer"))?)
+                .check_count(
+                    "metadata.action_dim",
+                    field("action_dim")?.parse().map_err(|_| parse_err("action_dim", "an integer"))?,
+                )
                 .map_err(|e| Error::bad_file(path, e.to_string()))? as usize,
             dt: DT
                 .check("metadata.dt", field("dt")?.parse().map_err(|_| parse_err("dt", "a number"))?)
@@ -452,6 +455,34 @@ mod tests {
             None => record.remove("layout"),
         };
         write_messages(path, &layout(&data.meta), record, &data.steps).unwrap();
+    }
+
+    /// Extreme values in a well-formed file: a time step beyond (0, 1] s (a huge one made `eval dataset` tick an
+    /// infinite time axis), a count no env has, a recorded number whose square overflows.
+    #[test]
+    fn numbers_outside_their_domain_are_refused_with_the_field() {
+        let dir = tempfile::tempdir().unwrap();
+        let data = tiny_dataset();
+        let write = |name: &str, key: &str, value: &str| {
+            let path = dir.path().join(name);
+            let mut record = data.meta.to_record();
+            record.insert(key.into(), value.into());
+            write_messages(&path, &layout(&data.meta), record, &data.steps).unwrap();
+            read_dataset(&path).unwrap_err().to_string()
+        };
+        for dt in ["1.8e308", "1.7976931348623157e308", "0", "-0", "-1", "NaN", "2"] {
+            let err = write("dt.mcap", "dt", dt);
+            assert!(err.contains("dt.mcap") && err.contains("metadata.dt = ") && err.contains("(0, 1] s"), "{err}");
+        }
+        let err = write("dim.mcap", "action_dim", "18446744073709551615");
+        assert!(err.contains("metadata.action_dim = 18446744073709551615: expected a whole number in 0..=64"), "{err}");
+        let mut huge = tiny_dataset();
+        huge.steps[1].state[1] = 1e300;
+        huge.steps[0].next_state[1] = 1e300;
+        let path = dir.path().join("huge.mcap");
+        write_dataset(&path, &huge).unwrap();
+        let err = read_dataset(&path).unwrap_err().to_string();
+        assert!(err.contains("messages[0].next_state[1] = 1e300: expected a finite number in [-1e9, 1e9]"), "{err}");
     }
 
     #[test]

@@ -668,6 +668,21 @@ mod tests {
     }
 
     #[test]
+    fn axes_stay_bounded_whatever_the_values() {
+        for values in [vec![0.0, f64::MAX], vec![-f64::MAX, f64::MAX], vec![1e300], vec![f64::NAN, f64::INFINITY]] {
+            let (lo, hi) = bounds(values.iter().copied());
+            assert!(lo.is_finite() && hi.is_finite() && lo < hi && hi - lo <= 3.0 * AXIS_LIMIT, "{values:?}");
+        }
+        let r = axis(f64::NEG_INFINITY..f64::NAN);
+        assert!(r.start.is_finite() && r.end.is_finite() && r.start < r.end);
+        // A time axis of dt = f64::MAX: plotters ticked it without end before the limit.
+        let dir = tempfile::tempdir().unwrap();
+        let points = vec![(0.0, 0.0), (f64::MAX, 1e300)];
+        let panel = Panel { y_label: "x".into(), series: vec![Series { name: "a".into(), points }], y_range: None };
+        line_panels(&dir.path().join("p.png"), "t", "time [s]", &[panel]).unwrap();
+    }
+
+    #[test]
     fn box_stats_follow_matplotlib() {
         // numpy quartiles of 1..=9 and 30: q1 3.25, median 5.5, q3 7.75; 1.5 IQR reaches 14.5, so 30 is an
         // outlier and the upper whisker stops at 9, the farthest value inside.

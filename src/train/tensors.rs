@@ -8,8 +8,8 @@ use safetensors::tensor::{Dtype, TensorView};
 use safetensors::SafeTensors;
 
 use crate::error::{Error, Result};
-use crate::util::domain::Domain;
 use crate::nn::{NamedTensor, ParamSet};
+use crate::util::domain::Domain;
 
 /// Checkpoint files larger than this are refused before reading (the largest preset is a few MB).
 pub const MAX_TENSOR_FILE_BYTES: u64 = 1 << 31;
@@ -169,6 +169,22 @@ pub fn to_params(path: &Path, stored: &[StoredTensor], layout: &ParamSet) -> Res
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Finite but absurd weights (1e19 in a bias made evaluations print NaN) and a zero standard deviation are
+    /// refused by name.
+    #[test]
+    fn weights_outside_their_domain_are_named() {
+        let path = Path::new("m.safetensors");
+        let ok = StoredTensor::f32("input_normalizer.std", vec![2], vec![0.5, 2.0]);
+        assert!(check_weights(path, &[ok.clone()]).is_ok());
+        let big = StoredTensor::f32("hidden.bias", vec![3], vec![0.0, 1e19, 0.0]);
+        let err = check_weights(path, &[ok, big]).unwrap_err().to_string();
+        assert!(err.contains("m.safetensors") && err.contains("tensor 'hidden.bias'[1] = "), "{err}");
+        assert!(err.contains("expected a finite number in [-1e6, 1e6]"), "{err}");
+        let zero = StoredTensor::f64("latent_scale.std", vec![1], vec![0.0]);
+        let err = check_weights(path, &[zero]).unwrap_err().to_string();
+        assert!(err.contains("tensor 'latent_scale.std'[0] = 0: expected a finite number in (0, 1e6]"), "{err}");
+    }
 
     #[test]
     fn round_trip_and_same_bytes() {

@@ -48,7 +48,7 @@ impl Domain {
         if self.contains(value) {
             Ok(value)
         } else {
-            Err(OutOfDomain { field: field.to_string(), value: value.to_string(), domain: *self })
+            Err(OutOfDomain { field: field.to_string(), value: number(value), domain: *self })
         }
     }
 
@@ -66,11 +66,20 @@ impl fmt::Display for Domain {
     fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
         let unit = if self.unit.is_empty() { String::new() } else { format!(" {}", self.unit) };
         if self.integer {
-            write!(f, "a whole number in {}..={}{unit}", self.lo, self.hi)
+            write!(f, "a whole number in {}..={}{unit}", number(self.lo), number(self.hi))
         } else {
             let open = if self.lo_open { '(' } else { '[' };
-            write!(f, "a finite number in {open}{}, {}]{unit}", self.lo, self.hi)
+            write!(f, "a finite number in {open}{}, {}]{unit}", number(self.lo), number(self.hi))
         }
+    }
+}
+
+/// A number as a reader would write it: 1e300 rather than its 301 digits.
+fn number(x: f64) -> String {
+    if x.is_finite() && x != 0.0 && (x.abs() >= 1e6 || x.abs() < 1e-4) {
+        format!("{x:e}")
+    } else {
+        x.to_string()
     }
 }
 
@@ -106,6 +115,11 @@ mod tests {
         let n = Domain::count(1, 64);
         assert!(n.check("metadata.action_dim", 2.5).is_err());
         assert_eq!(n.check_count("metadata.action_dim", 3), Ok(3));
+        let err = Domain::closed(-1e9, 1e9).check("messages[2].state[0]", -f64::MAX).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "messages[2].state[0] = -1.7976931348623157e308: expected a finite number in [-1e9, 1e9]"
+        );
         let err = n.check_count("metadata.action_dim", u64::MAX).unwrap_err();
         assert_eq!(err.to_string(), "metadata.action_dim = 18446744073709551615: expected a whole number in 1..=64");
     }
