@@ -63,7 +63,7 @@ pub(crate) struct Cli {
     #[arg(long)]
     pub(crate) extremes: bool,
     /// With --extremes: only the fields and flags whose name contains one of these comma-separated substrings
-    /// (`metadata.dt,--steps`) [env: MBRL_FUZZ_FIELDS]
+    /// (`--fields=metadata.dt,--steps`: with `=` when the first starts with `--`) [env: MBRL_FUZZ_FIELDS]
     #[arg(long, value_name = "A,B")]
     pub(crate) fields: Option<String>,
     /// Print the target names and exit
