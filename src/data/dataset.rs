@@ -11,6 +11,7 @@ use super::mcap_io::{check_version, read_messages_and_raw, write_messages_with, 
 use super::rollout::{Rollout, Timestep};
 use super::schema::{FRAME_TOPIC, TIMESTEP_SCHEMA, TIMESTEP_SCHEMA_NAME, TIMESTEP_TOPIC};
 use crate::error::{Error, Result};
+use crate::util::domain::Domain;
 
 /// Version of the on-disk layout; readers reject any other.
 pub const FORMAT_VERSION: u32 = 1;
@@ -79,6 +80,15 @@ pub struct Dataset {
     pub frames: Vec<Vec<u8>>,
 }
 
+/// Every env steps at most a second at a time; a larger or non-positive `dt` is no recording this tool makes,
+/// and a huge one would make time axes (plots, log times) unbounded.
+const DT: Domain = Domain::above(0.0, 1.0).in_unit("s");
+/// States, actions and rewards of every env stay far inside this (angles, metres, rewards per step); a value
+/// beyond it is no recording, and its square (normalizers, losses) would overflow.
+const RECORDED: Domain = Domain::closed(-1e9, 1e9);
+/// The widest action of any env (the Jaco's joints and more): bounds what an action vector may claim.
+const ACTION_DIM: Domain = Domain::count(0, 64);
+
 impl DatasetMeta {
     fn to_record(&self) -> BTreeMap<String, String> {
         let mut record = BTreeMap::from([
@@ -117,8 +127,15 @@ impl DatasetMeta {
             instances: serde_json::from_str(field("instances")?).map_err(|_| parse_err("instances", "a JSON array"))?,
             state_names: serde_json::from_str(field("state_names")?)
                 .map_err(|_| parse_err("state_names", "a JSON array of strings"))?,
-            action_dim: field("action_dim")?.parse().map_err(|_| parse_err("action_dim", "an integer"))?,
-            dt: field("dt")?.parse().map_err(|_| parse_err("dt", "a number"))?,
+            action_dim: ACTION_DIM
+                .check_count(
+                    "metadata.action_dim",
+                    field("action_dim")?.parse().map_err(|_| parse_err("action_dim", "an integer"))?,
+                )
+                .map_err(|e| Error::bad_file(path, e.to_string()))? as usize,
+            dt: DT
+                .check("metadata.dt", field("dt")?.parse().map_err(|_| parse_err("dt", "a number"))?)
+                .map_err(|e| Error::bad_file(path, e.to_string()))?,
             layout: match record.get("layout") {
                 Some(text) => DatasetLayout::parse(path, text)?,
                 None => DatasetLayout::Rollouts,
@@ -328,10 +345,15 @@ fn validate_step(path: &Path, meta: &DatasetMeta, step: &Timestep, sequence: u32
             format!("{}: action has the wrong length, expected {}", where_(), meta.action_dim),
         ));
     }
-    let finite =
-        step.state.iter().chain(&step.next_state).chain(&step.action).all(|x| x.is_finite()) && step.reward.is_finite();
-    if !finite {
-        return Err(Error::bad_file(path, format!("{}: non-finite value in state, action or reward", where_())));
+    let fields = [("state", &step.state[..]), ("next_state", &step.next_state), ("action", &step.action)];
+    let values = fields.iter().flat_map(|(name, v)| v.iter().enumerate().map(move |(i, x)| (*name, Some(i), *x)));
+    for (name, i, x) in values.chain([("reward", None, step.reward)]) {
+        if !RECORDED.contains(x) {
+            let index = i.map_or(String::new(), |i| format!("[{i}]"));
+            let field = format!("messages[{sequence}].{name}{index}");
+            let e = RECORDED.check(&field, x).unwrap_err();
+            return Err(Error::bad_file(path, format!("{e} (rollout {}, t {})", step.rollout, step.t)));
+        }
     }
     Ok(())
 }
@@ -433,6 +455,34 @@ mod tests {
             None => record.remove("layout"),
         };
         write_messages(path, &layout(&data.meta), record, &data.steps).unwrap();
+    }
+
+    /// Extreme values in a well-formed file: a time step beyond (0, 1] s (a huge one made `eval dataset` tick an
+    /// infinite time axis), a count no env has, a recorded number whose square overflows.
+    #[test]
+    fn numbers_outside_their_domain_are_refused_with_the_field() {
+        let dir = tempfile::tempdir().unwrap();
+        let data = tiny_dataset();
+        let write = |name: &str, key: &str, value: &str| {
+            let path = dir.path().join(name);
+            let mut record = data.meta.to_record();
+            record.insert(key.into(), value.into());
+            write_messages(&path, &layout(&data.meta), record, &data.steps).unwrap();
+            read_dataset(&path).unwrap_err().to_string()
+        };
+        for dt in ["1.8e308", "1.7976931348623157e308", "0", "-0", "-1", "NaN", "2"] {
+            let err = write("dt.mcap", "dt", dt);
+            assert!(err.contains("dt.mcap") && err.contains("metadata.dt = ") && err.contains("(0, 1] s"), "{err}");
+        }
+        let err = write("dim.mcap", "action_dim", "18446744073709551615");
+        assert!(err.contains("metadata.action_dim = 18446744073709551615: expected a whole number in 0..=64"), "{err}");
+        let mut huge = tiny_dataset();
+        huge.steps[1].state[1] = 1e300;
+        huge.steps[0].next_state[1] = 1e300;
+        let path = dir.path().join("huge.mcap");
+        write_dataset(&path, &huge).unwrap();
+        let err = read_dataset(&path).unwrap_err().to_string();
+        assert!(err.contains("messages[0].next_state[1] = 1e300: expected a finite number in [-1e9, 1e9]"), "{err}");
     }
 
     #[test]

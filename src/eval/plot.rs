@@ -69,15 +69,34 @@ fn render_atomic(path: &Path, draw: impl FnOnce(&Path) -> Result<()>) -> Result<
     target.finish(tmp)
 }
 
+/// The widest axis a plot draws: plotters steps through the tick values of a range, and a range near the
+/// largest f64 (or one whose padding overflows) would never end. Values beyond it are drawn at its edge.
+const AXIS_LIMIT: f64 = 1e30;
+
+/// An axis range around the finite values, padded, never wider than ±[`AXIS_LIMIT`].
 fn bounds(values: impl Iterator<Item = f64>) -> (f64, f64) {
-    let (lo, hi) =
-        values.filter(|v| v.is_finite()).fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
+    let (lo, hi) = values
+        .filter(|v| v.is_finite())
+        .map(|v| v.clamp(-AXIS_LIMIT, AXIS_LIMIT))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
     if !lo.is_finite() {
         return (0.0, 1.0);
     }
     // A single value (one evidence size, one run) still needs an axis that reads as a range around it.
     let pad = if hi - lo > 1e-9 * lo.abs().max(1.0) { (hi - lo) * 0.05 } else { (lo.abs() * 0.1).max(1.0) };
     (lo - pad, hi + pad)
+}
+
+/// Every range a chart is built on, whoever computed it: finite, increasing and within ±[`AXIS_LIMIT`].
+fn axis(range: std::ops::Range<f64>) -> std::ops::Range<f64> {
+    let clamp = |v: f64, fallback: f64| if v.is_nan() { fallback } else { v.clamp(-AXIS_LIMIT, AXIS_LIMIT) };
+    let (lo, hi) = (clamp(range.start, 0.0), clamp(range.end, 1.0));
+    if lo < hi {
+        lo..hi
+    } else {
+        let (lo, hi) = bounds([lo, hi].into_iter());
+        lo..hi
+    }
 }
 
 type XyChart<'a, 'b> = ChartContext<'a, BitMapBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
@@ -96,7 +115,7 @@ fn titled_chart<'a, 'b>(
         .margin(12)
         .x_label_area_size(40)
         .y_label_area_size(60)
-        .build_cartesian_2d(x, y)
+        .build_cartesian_2d(axis(x), axis(y))
         .map_err(|e| plot_err(path, e))
 }
 
@@ -212,7 +231,7 @@ pub fn line_panels(path: &Path, title: &str, x_label: &str, panels: &[Panel]) ->
                 .margin(8)
                 .x_label_area_size(if k + 1 == rows { 36 } else { 8 })
                 .y_label_area_size(64)
-                .build_cartesian_2d(x0..x1, y0..y1)
+                .build_cartesian_2d(axis(x0..x1), axis(y0..y1))
                 .map_err(|e| plot_err(path, e))?;
             let mut mesh = chart.configure_mesh();
             mesh.y_desc(y_label.as_str());
@@ -282,7 +301,7 @@ pub fn band_panels(
                 .margin(8)
                 .x_label_area_size(36)
                 .y_label_area_size(52)
-                .build_cartesian_2d(x0..x1, 0.0..y1)
+                .build_cartesian_2d(axis(x0..x1), axis(0.0..y1))
                 .map_err(|e| plot_err(path, e))?;
             chart.configure_mesh().x_desc(x_label).y_desc(y_label).draw().map_err(|e| plot_err(path, e))?;
             for (i, band) in bands.iter().enumerate() {
@@ -534,7 +553,7 @@ pub fn histogram(path: &Path, title: &str, x_label: &str, values: &[f64], bins: 
             .margin(12)
             .x_label_area_size(40)
             .y_label_area_size(50)
-            .build_cartesian_2d(lo..hi, 0u32..top + 1)
+            .build_cartesian_2d(axis(lo..hi), 0u32..top + 1)
             .map_err(|e| plot_err(path, e))?;
         chart.configure_mesh().x_desc(x_label).y_desc("count").draw().map_err(|e| plot_err(path, e))?;
         chart
@@ -646,6 +665,21 @@ mod tests {
         let (groups, kinds) = (["a".to_string(), "b".to_string()], ["x".to_string(), "y".to_string(), "z".to_string()]);
         strip_plot(&dir.path().join("strip.png"), "s", "v", &groups, &kinds, &dots).unwrap();
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 5, "no temporary files left");
+    }
+
+    #[test]
+    fn axes_stay_bounded_whatever_the_values() {
+        for values in [vec![0.0, f64::MAX], vec![-f64::MAX, f64::MAX], vec![1e300], vec![f64::NAN, f64::INFINITY]] {
+            let (lo, hi) = bounds(values.iter().copied());
+            assert!(lo.is_finite() && hi.is_finite() && lo < hi && hi - lo <= 3.0 * AXIS_LIMIT, "{values:?}");
+        }
+        let r = axis(f64::NEG_INFINITY..f64::NAN);
+        assert!(r.start.is_finite() && r.end.is_finite() && r.start < r.end);
+        // A time axis of dt = f64::MAX: plotters ticked it without end before the limit.
+        let dir = tempfile::tempdir().unwrap();
+        let points = vec![(0.0, 0.0), (f64::MAX, 1e300)];
+        let panel = Panel { y_label: "x".into(), series: vec![Series { name: "a".into(), points }], y_range: None };
+        line_panels(&dir.path().join("p.png"), "t", "time [s]", &[panel]).unwrap();
     }
 
     #[test]

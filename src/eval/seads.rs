@@ -20,6 +20,7 @@ use crate::planning::bfs::SearchLimits;
 use crate::run::dir::{Provenance, RunDir};
 use crate::run::{Event, Monitor, NullMonitor, Tee};
 use crate::util::atomic::write_text;
+use crate::util::domain::Domain;
 use crate::util::seeding::rng_for;
 use crate::util::table::write_csv;
 
@@ -41,11 +42,21 @@ pub fn run_name(dir: &Path) -> String {
     dir.file_name().and_then(|n| n.to_str()).unwrap_or("model").to_string()
 }
 
+const BOARDS: Domain = Domain::count(1, 20_000);
+const COVERAGE_BOARDS: Domain = Domain::count(1, 100_000);
+
 impl SeadsEvalConfig {
     pub fn validate(&self) -> Result<()> {
         let s = &self.settings;
         if s.max_depth == 0 || s.max_depth > 10 || s.boards_per_depth == 0 || s.coverage_boards == 0 {
             return Err(Error::config("--max-depth must be 1..=10 and --boards, --coverage-boards at least 1"));
+        }
+        // Boards are sampled into memory before any is solved: a count near 2^64 was an allocation that
+        // aborted. The bounds are a thousand times the thesis' 20 boards per depth and our default 100.
+        for (flag, value, domain) in
+            [("--boards", s.boards_per_depth, BOARDS), ("--coverage-boards", s.coverage_boards, COVERAGE_BOARDS)]
+        {
+            domain.check_count(flag, value as u64).map_err(|e| Error::config(e.to_string()))?;
         }
         if self.models.is_empty() {
             return Err(Error::config("eval seads needs at least one --model"));
@@ -661,4 +672,34 @@ pub fn render_comparison(c: &SeadsComparison, dir: &Path) -> Result<()> {
         md.push_str(&format!("| {} | {} | {} | {} | {} |\n", t[0], t[1], t[2], t[3], t[4]));
     }
     write_text(&dir.join("report.md"), &md)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `--coverage-boards 18446744073709551615` sized a vector of boards and aborted on capacity overflow
+    /// (found by the extremes fuzzer); counts beyond their domain are a one-line error naming the flag.
+    #[test]
+    fn board_counts_are_bounded_before_any_board_is_sampled() {
+        let settings = SeadsEvalSettings {
+            max_depth: 1,
+            boards_per_depth: 1,
+            coverage_boards: 1,
+            max_replans: 1,
+            split: Split::Test,
+            max_search_nodes: 1000,
+        };
+        let config = |settings| SeadsEvalConfig { models: vec!["m".into()], allow_incomplete: false, settings };
+        assert!(config(settings.clone()).validate().is_ok());
+        let huge = SeadsEvalSettings { coverage_boards: usize::MAX, ..settings.clone() };
+        let err = config(huge).validate().unwrap_err().to_string();
+        assert!(
+            err.contains("--coverage-boards = 18446744073709551615: expected a whole number in 1..=100000"),
+            "{err}"
+        );
+        let huge = SeadsEvalSettings { boards_per_depth: 1 << 40, ..settings };
+        let err = config(huge).validate().unwrap_err().to_string();
+        assert!(err.contains("--boards = 1099511627776: expected a whole number in 1..=20000"), "{err}");
+    }
 }

@@ -151,7 +151,11 @@ impl OpenedCheckpoint {
             .get(name)
             .ok_or_else(|| Error::bad_file(self.dir.path(), format!("the checkpoint lists no {name}")))?;
         let bytes = self.dir.read_verified(name, entry)?;
-        tensors::parse(&self.dir.file(name), &bytes)
+        let stored = tensors::parse(&self.dir.file(name), &bytes)?;
+        if name == MODEL_FILE {
+            tensors::check_weights(&self.dir.file(name), &stored)?;
+        }
+        Ok(stored)
     }
 
     /// Where to pick the run up again, for `--resume`.

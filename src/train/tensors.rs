@@ -9,6 +9,7 @@ use safetensors::SafeTensors;
 
 use crate::error::{Error, Result};
 use crate::nn::{NamedTensor, ParamSet};
+use crate::util::domain::Domain;
 
 /// Checkpoint files larger than this are refused before reading (the largest preset is a few MB).
 pub const MAX_TENSOR_FILE_BYTES: u64 = 1 << 31;
@@ -117,6 +118,28 @@ pub fn parse(path: &Path, bytes: &[u8]) -> Result<Vec<StoredTensor>> {
     Ok(out)
 }
 
+/// Trained weights, biases and normalizer statistics of every model stay far inside this; a larger value
+/// saturates or overflows the f32 activations it feeds (NaN predictions, degenerate evaluations).
+const WEIGHT: Domain = Domain::closed(-1e6, 1e6);
+/// A tensor named `*.std` holds standard deviations (normalizers, latent scales), which divide.
+const STD: Domain = Domain { lo: 0.0, lo_open: true, ..WEIGHT };
+
+/// The weights of a model file, each within its domain: the error names the tensor and element.
+pub fn check_weights(path: &Path, tensors: &[StoredTensor]) -> Result<()> {
+    for tensor in tensors {
+        let domain = if tensor.name.ends_with(".std") { STD } else { WEIGHT };
+        let values: Box<dyn Iterator<Item = f64>> = match &tensor.data {
+            TensorData::F32(v) => Box::new(v.iter().map(|&x| x as f64)),
+            TensorData::F64(v) => Box::new(v.iter().copied()),
+        };
+        if let Some((i, x)) = values.enumerate().find(|(_, x)| !domain.contains(*x)) {
+            let e = domain.check(&format!("tensor '{}'[{i}]", tensor.name), x).unwrap_err();
+            return Err(Error::bad_file(path, e.to_string()));
+        }
+    }
+    Ok(())
+}
+
 /// The f32 tensors named in `layout`, in its order and with its shapes; anything missing, extra or differently
 /// shaped is an error naming the tensor.
 pub fn to_params(path: &Path, stored: &[StoredTensor], layout: &ParamSet) -> Result<ParamSet> {
@@ -146,6 +169,22 @@ pub fn to_params(path: &Path, stored: &[StoredTensor], layout: &ParamSet) -> Res
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Finite but absurd weights (1e19 in a bias made evaluations print NaN) and a zero standard deviation are
+    /// refused by name.
+    #[test]
+    fn weights_outside_their_domain_are_named() {
+        let path = Path::new("m.safetensors");
+        let ok = StoredTensor::f32("input_normalizer.std", vec![2], vec![0.5, 2.0]);
+        assert!(check_weights(path, std::slice::from_ref(&ok)).is_ok());
+        let big = StoredTensor::f32("hidden.bias", vec![3], vec![0.0, 1e19, 0.0]);
+        let err = check_weights(path, &[ok, big]).unwrap_err().to_string();
+        assert!(err.contains("m.safetensors") && err.contains("tensor 'hidden.bias'[1] = "), "{err}");
+        assert!(err.contains("expected a finite number in [-1e6, 1e6]"), "{err}");
+        let zero = StoredTensor::f64("latent_scale.std", vec![1], vec![0.0]);
+        let err = check_weights(path, &[zero]).unwrap_err().to_string();
+        assert!(err.contains("tensor 'latent_scale.std'[0] = 0: expected a finite number in (0, 1e6]"), "{err}");
+    }
 
     #[test]
     fn round_trip_and_same_bytes() {

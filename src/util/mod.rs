@@ -6,6 +6,7 @@ pub mod atomic;
 pub mod bounded_read;
 pub mod budget;
 pub mod colored_noise;
+pub mod domain;
 pub mod fast_exp;
 pub mod interrupt;
 pub mod png;
