@@ -88,3 +88,34 @@ fn search_through_a_model_that_knows_the_rules_finds_optimal_plans() {
         }
     }
 }
+
+#[cfg(feature = "mujoco")]
+#[test]
+fn jaco_episodes_do_not_depend_on_how_many_threads_step_them() {
+    use super::boards::BoardPool;
+    use super::collect::Collector;
+    use crate::envs::embodiments::Embodiment;
+    use rand::Rng;
+    use rand_chacha::ChaCha8Rng;
+
+    let game = TileSwap::new();
+    let pool = BoardPool::new(&game, 3, crate::envs::boards::split::Split::Train).unwrap();
+    let collect = |threads: usize| {
+        let pool_of_threads = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool_of_threads.install(|| {
+            let mut collector = Collector::new(&game, Embodiment::Jaco, 4, 12).unwrap();
+            let (low, high) = collector.action_bounds();
+            let mut rng = ChaCha8Rng::seed_from_u64(9);
+            collector.collect(&[0, 3, 7, 11], Starts::Pool(&pool), &mut rng, |_, rows, rng| {
+                (0..rows)
+                    .flat_map(|_| {
+                        low.iter().zip(&high).map(|(l, h)| rng.random_range(*l..*h) as f32).collect::<Vec<_>>()
+                    })
+                    .collect()
+            })
+        })
+    };
+    let (one, two) = (collect(1), collect(2));
+    assert_eq!(one, two);
+    assert!(one.iter().all(|e| !e.actions.is_empty()));
+}

@@ -133,31 +133,3 @@ fn observation_is_the_authors_proprioception() {
     let p = &obs[30..33];
     assert!((0.15..0.4).contains(&p[2]), "the pinch site is above the board: {p:?}");
 }
-
-#[test]
-fn seads_episodes_do_not_depend_on_how_many_threads_step_them() {
-    use crate::models::seads::boards::BoardPool;
-    use crate::models::seads::collect::{Collector, Starts};
-    use rand::Rng;
-
-    let game = TileSwap::new();
-    let pool = BoardPool::new(&game, 3, crate::envs::boards::split::Split::Train).unwrap();
-    let collect = |threads: usize| {
-        let pool_of_threads = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-        pool_of_threads.install(|| {
-            let mut collector = Collector::new(&game, Embodiment::Jaco, 4, 12).unwrap();
-            let (low, high) = collector.action_bounds();
-            let mut rng = ChaCha8Rng::seed_from_u64(9);
-            collector.collect(&[0, 3, 7, 11], Starts::Pool(&pool), &mut rng, |_, rows, rng| {
-                (0..rows)
-                    .flat_map(|_| {
-                        low.iter().zip(&high).map(|(l, h)| rng.random_range(*l..*h) as f32).collect::<Vec<_>>()
-                    })
-                    .collect()
-            })
-        })
-    };
-    let (one, two) = (collect(1), collect(2));
-    assert_eq!(one, two);
-    assert!(one.iter().all(|e| !e.actions.is_empty()));
-}
