@@ -46,8 +46,8 @@ repro-jaco: mujoco
 			--no-tui --out reports/embodied-$$game-jaco || exit 1; \
 	done
 
-# Thesis 7.4 with the Jaco: SEADS on LightsOutJaco at SEADS_JACO_PRESET (small: 2M env steps, about an hour on
-# 2 cores; paper: the thesis' 10M, about five), then skill coverage and boards of depth 1-5 solved.
+# Thesis 7.4 with the Jaco: SEADS on LightsOutJaco at SEADS_JACO_PRESET (small: 2M env steps, about 75 min on
+# 2 cores; paper: the thesis' 10M, about five hours), then skill coverage and boards of depth 1-5 solved.
 SEADS_JACO_PRESET ?= small
 repro-seads-jaco: mujoco
 	$(RUN) train seads --env lightsout:jaco --preset $(SEADS_JACO_PRESET) --seed $(SEED) --no-tui -q \

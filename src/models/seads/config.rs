@@ -80,8 +80,8 @@ impl SeadsConfig {
         let small_steps = match embodiment {
             Embodiment::Cursor => 60_000,
             Embodiment::Reacher => 200_000,
-            // A Jaco step costs about a millisecond of MuJoCo (benches/jaco.rs): 2M steps fit in the hour
-            // this preset is meant for.
+            // A Jaco step costs about a millisecond of MuJoCo (benches/jaco.rs): 2M steps take about 75 min
+            // on 2 cores (440 steps/s measured with this preset).
             Embodiment::Jaco => JACO_SMALL_STEPS,
         };
         let (width, env_steps, sampled, model_updates) = match preset {
