@@ -7,7 +7,7 @@ MBRL := target/release/mbrl
 RUN := $(MBRL) --force
 SEED ?= 0
 
-.PHONY: build test bench completions mujoco mujoco-assets repro-jaco repro-seads-jaco repro-quick repro-swingup repro-pendulum-data repro-boards repro-ball repro-pets repro-pets-loop repro-context repro-context-toy repro-context-mountaincar repro-tradyn repro-seads repro-dlgpd clean-reports
+.PHONY: build test bench bench-vs-pytorch completions mujoco mujoco-assets repro-jaco repro-seads-jaco repro-quick repro-swingup repro-pendulum-data repro-boards repro-ball repro-pets repro-pets-loop repro-context repro-context-toy repro-context-mountaincar repro-tradyn repro-seads repro-dlgpd clean-reports
 
 # The Jaco arm (`--embodiment jaco`, `lightsout:jaco`) runs on MuJoCo behind the `mujoco` cargo feature; the
 # default build stays MuJoCo-free. This target fetches MuJoCo 3.17.0 (the version mujoco-rs 7 binds) from its
@@ -63,6 +63,12 @@ test:
 
 bench:
 	cargo bench
+
+# Every learned method's training step beside PyTorch's, back to back, with GFLOP/s, the GEMM ceiling and the
+# machine's load (docs/benchmarks.md). Needs torch: PYTORCH_PYTHON names an interpreter that has it.
+PYTORCH_PYTHON ?= python3
+bench-vs-pytorch:
+	python3 benches/vs_pytorch.py --python $(PYTORCH_PYTHON) $(if $(QUICK),--quick) $(if $(ONLY),--only $(ONLY))
 
 $(MBRL): build
 

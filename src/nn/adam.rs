@@ -47,6 +47,9 @@ impl AdamConfig {
     }
 }
 
+/// Elements per parallel task of the update.
+const UPDATE_BLOCK: usize = 1 << 14;
+
 /// Optimizer state for a list of parameter buffers.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Adam<T> {
@@ -71,9 +74,10 @@ impl<T: Float + Send + Sync> Adam<T> {
         T::from(x).unwrap_or_else(T::nan)
     }
 
-    /// One update of `params` with `grads` (consumed: clipped and decayed in place). Returns the global gradient
-    /// norm before clipping, which training logs to spot blow-ups early.
-    pub fn update(&mut self, params: &mut [&mut Vec<T>], grads: &mut [Vec<T>]) -> Result<f64> {
+    /// One update of `params` with `grads` (consumed: clipped and decayed in place). With clipping configured,
+    /// returns the global gradient norm before clipping; without, the norm is not computed (a sequential sum over
+    /// every gradient would cost a fused training step a tenth of its time) and `None` is returned.
+    pub fn update(&mut self, params: &mut [&mut Vec<T>], grads: &mut [Vec<T>]) -> Result<Option<f64>> {
         if params.len() != self.exp_avg.len() || grads.len() != params.len() {
             return Err(Error::config(format!(
                 "optimizer holds {} tensors, got {} parameters and {} gradients",
@@ -82,12 +86,14 @@ impl<T: Float + Send + Sync> Adam<T> {
                 grads.len()
             )));
         }
-        let norm = grads.iter().flatten().fold(T::zero(), |acc, g| acc + *g * *g).sqrt();
+        let mut norm = None;
         if let Some(max_norm) = self.config.clip_grad_norm {
-            let coef = Self::cast(max_norm) / (norm + Self::cast(1e-6));
+            let total = grads.iter().flatten().fold(T::zero(), |acc, g| acc + *g * *g).sqrt();
+            let coef = Self::cast(max_norm) / (total + Self::cast(1e-6));
             if coef < T::one() {
                 grads.iter_mut().flatten().for_each(|g| *g = *g * coef);
             }
+            norm = Some(total.to_f64().unwrap_or(f64::NAN));
         }
         self.step += 1;
         let c = &self.config;
@@ -107,15 +113,27 @@ impl<T: Float + Send + Sync> Adam<T> {
             .zip(grads.par_iter())
             .zip(self.exp_avg.par_iter_mut().zip(self.exp_avg_sq.par_iter_mut()))
             .for_each(|((p, g), (m, v))| {
-                for i in 0..p.len() {
-                    let grad = if wd > T::zero() { g[i] + wd * p[i] } else { g[i] };
-                    m[i] = beta1 * m[i] + (T::one() - beta1) * grad;
-                    v[i] = beta2 * v[i] + (T::one() - beta2) * grad * grad;
-                    let denom = v[i].sqrt() / bias2_sqrt + eps;
-                    p[i] = p[i] - step_size * m[i] / denom;
-                }
+                // Blocks rather than whole tensors: a network's few large weights then spread over every thread.
+                p.par_chunks_mut(UPDATE_BLOCK)
+                    .zip(g.par_chunks(UPDATE_BLOCK))
+                    .zip(m.par_chunks_mut(UPDATE_BLOCK).zip(v.par_chunks_mut(UPDATE_BLOCK)))
+                    .for_each(|((p, g), (m, v))| {
+                        // Zipped slices rather than indices: without bounds checks the loop vectorizes.
+                        let step = |p: &mut T, grad: T, m: &mut T, v: &mut T| {
+                            *m = beta1 * *m + (T::one() - beta1) * grad;
+                            *v = beta2 * *v + (T::one() - beta2) * grad * grad;
+                            let denom = v.sqrt() / bias2_sqrt + eps;
+                            *p = *p - step_size * *m / denom;
+                        };
+                        let each = p.iter_mut().zip(g.iter()).zip(m.iter_mut().zip(v.iter_mut()));
+                        if wd > T::zero() {
+                            each.for_each(|((p, &g), (m, v))| step(p, g + wd * *p, m, v));
+                        } else {
+                            each.for_each(|((p, &g), (m, v))| step(p, g, m, v));
+                        }
+                    });
             });
-        Ok(norm.to_f64().unwrap_or(f64::NAN))
+        Ok(norm)
     }
 }
 
@@ -163,7 +181,7 @@ mod tests {
         let (mut a, mut b) = (vec![0.0], vec![0.0]);
         let mut g = vec![vec![3.0], vec![4.0]];
         let norm = adam.update(&mut [&mut a, &mut b], &mut g).unwrap();
-        assert!((norm - 5.0).abs() < 1e-12);
+        assert!((norm.expect("clipping computes the norm") - 5.0).abs() < 1e-12);
         assert!((g[0][0] - 0.6).abs() < 1e-6 && (g[1][0] - 0.8).abs() < 1e-6, "{g:?}");
     }
 

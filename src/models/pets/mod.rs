@@ -5,6 +5,7 @@
 pub mod config;
 pub mod data;
 pub mod dynamics;
+pub mod grad;
 pub mod net;
 pub mod options;
 pub mod train;

@@ -1,16 +1,17 @@
 //! Training the ensemble: one [`TrainingMethod`] step draws a batch per member (from its bootstrap resample),
-//! takes the Gaussian NLL through burn's autodiff and updates the weights with our Adam.
+//! takes the Gaussian NLL and its gradient on the hand-written path (`grad.rs`, held to burn's autodiff by a
+//! test) and updates the weights with our Adam.
 
-use burn::tensor::Device;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::config::PetsConfig;
 use super::data::Transitions;
+use super::grad::{EnsembleNet, Workspace};
 use super::net::{torch_name, PetsNet, INPUT_MEAN, INPUT_STD};
 use crate::error::{Error, Result};
-use crate::nn::tensor::{scalar, tensor, training_device};
-use crate::nn::{gaussian_nll, Adam, Normalizer, ParamSet};
+use crate::nn::tensor::training_device;
+use crate::nn::{Adam, Normalizer, ParamSet};
 use crate::train::{state, StoredTensor, TrainingMethod};
 use crate::util::seeding::{derive_seed, rng_for};
 
@@ -23,8 +24,6 @@ const MAX_VALID_ROWS: usize = 4096;
 pub struct PetsTrainer {
     config: PetsConfig,
     seed: u64,
-    device: Device,
-    net: Option<PetsNet>,
     params: ParamSet,
     adam: Adam<f32>,
     normalizer: Normalizer,
@@ -32,6 +31,9 @@ pub struct PetsTrainer {
     valid: Transitions,
     /// Per member: the training rows it draws its batches from.
     members_rows: Vec<Vec<u32>>,
+    workspace: Workspace,
+    batch_inputs: Vec<f32>,
+    batch_targets: Vec<f32>,
 }
 
 impl PetsTrainer {
@@ -48,10 +50,11 @@ impl PetsTrainer {
         let normalizer = Normalizer::fit(&train.inputs, train.input_dim)?;
         normalizer.apply(&mut train.inputs);
         normalizer.apply(&mut valid.inputs);
-        let device = training_device();
+        // The burn module only draws the initial weights (mbrl-lib's initialization, in its parameter order).
         let mut init_rng = ChaCha8Rng::seed_from_u64(derive_seed(seed, &[INIT_STREAM]));
-        let net = PetsNet::init(&config, train.input_dim, train.target_dim, &device, &mut init_rng);
+        let net = PetsNet::init(&config, train.input_dim, train.target_dim, &training_device(), &mut init_rng);
         let params = ParamSet::<f32>::from_module(&net, torch_name);
+        EnsembleNet::new(&params, &config, train.input_dim, train.target_dim)?;
         let sizes: Vec<usize> = params.tensors.iter().map(|t| t.values.len()).collect();
         let adam = Adam::new(config.optimizer, &sizes);
         let n = train.len();
@@ -65,17 +68,19 @@ impl PetsTrainer {
                 }
             })
             .collect();
-        Ok(PetsTrainer { config, seed, device, net: Some(net), params, adam, normalizer, train, valid, members_rows })
-    }
-
-    fn net(&self) -> &PetsNet {
-        self.net.as_ref().expect("the network is only taken out while loading new weights")
-    }
-
-    fn load_params(&mut self) -> Result<()> {
-        let net = self.net.take().expect("network present");
-        self.net = Some(self.params.load_into(net, &self.device)?);
-        Ok(())
+        Ok(PetsTrainer {
+            config,
+            seed,
+            params,
+            adam,
+            normalizer,
+            train,
+            valid,
+            members_rows,
+            workspace: Workspace::default(),
+            batch_inputs: Vec::new(),
+            batch_targets: Vec::new(),
+        })
     }
 
     pub fn parameter_count(&self) -> usize {
@@ -85,11 +90,12 @@ impl PetsTrainer {
 
 impl TrainingMethod for PetsTrainer {
     fn step(&mut self, step: u64) -> Result<f64> {
-        let (e, b) = (self.config.ensemble, self.config.batch_size);
+        let b = self.config.batch_size;
         let (din, dout) = (self.train.input_dim, self.train.target_dim);
         let mut rng = rng_for(self.seed, &[BATCH_STREAM, step]);
-        let mut inputs = Vec::with_capacity(e * b * din);
-        let mut targets = Vec::with_capacity(e * b * dout);
+        let (inputs, targets) = (&mut self.batch_inputs, &mut self.batch_targets);
+        inputs.clear();
+        targets.clear();
         for rows in &self.members_rows {
             for _ in 0..b {
                 let row = rows[rng.random_range(0..rows.len())] as usize;
@@ -97,16 +103,12 @@ impl TrainingMethod for PetsTrainer {
                 targets.extend_from_slice(&self.train.targets[row * dout..(row + 1) * dout]);
             }
         }
-        let net = self.net();
-        let (mean, logvar) = net.forward(tensor(inputs, [e, b, din], &self.device));
-        let loss = gaussian_nll(mean, logvar, tensor(targets, [e, b, dout], &self.device)) + net.bounds.penalty();
-        let value = scalar(&loss);
+        let net = EnsembleNet::new(&self.params, &self.config, din, dout)?;
+        let value = net.loss_and_gradients(&self.params, &mut self.workspace, inputs, targets, b, true);
         if !value.is_finite() {
             return Ok(value);
         }
-        let mut grads = ParamSet::<f32>::gradients(net, &loss.backward());
-        self.adam.update(&mut self.params.values_mut(), &mut grads)?;
-        self.load_params()?;
+        self.adam.update(&mut self.params.values_mut(), &mut self.workspace.gradients)?;
         Ok(value)
     }
 
@@ -118,9 +120,8 @@ impl TrainingMethod for PetsTrainer {
         let (e, din, dout) = (self.config.ensemble, self.valid.input_dim, self.valid.target_dim);
         let inputs: Vec<f32> = self.valid.inputs[..rows * din].repeat(e);
         let targets: Vec<f32> = self.valid.targets[..rows * dout].repeat(e);
-        let (mean, _) = self.net().forward(tensor(inputs, [e, rows, din], &self.device));
-        let mse = (mean - tensor(targets, [e, rows, dout], &self.device)).powi_scalar(2).mean();
-        Ok(Some(scalar(&mse.reshape([1]))))
+        let net = EnsembleNet::new(&self.params, &self.config, din, dout)?;
+        Ok(Some(net.mean_squared_error(&mut self.workspace, &inputs, &targets, rows)))
     }
 
     fn weights(&self) -> Vec<StoredTensor> {
@@ -136,7 +137,6 @@ impl TrainingMethod for PetsTrainer {
     }
 
     fn restore(&mut self, saved: &[StoredTensor]) -> Result<()> {
-        state::restore(saved, &mut self.params, &mut self.adam)?;
-        self.load_params()
+        state::restore(saved, &mut self.params, &mut self.adam)
     }
 }

@@ -1,0 +1,253 @@
+//! One training step of every learned method, at one thread and at two, timed as PyTorch's side is
+//! (benches/pytorch/training_steps.py), plus the machine's f32 GEMM ceiling through faer in the same run.
+//! benches/vs_pytorch.py runs both and prints the ratio table; run alone, this prints one JSON object per line:
+//!
+//!   cargo bench --bench training_steps -- [--quick] [--only NAME[,NAME…]]
+//!
+//! Each workload's figure is the median of its timed steps after warm-up steps; the ceiling is the best of
+//! several 1024³ products. The step counts and sizes are those the issue names (PETS small and medium, the
+//! context model's paper net at batch 64 and 512, SAC at batch 128, DLGPD at 256 and 1024, the ball EKF at
+//! 64 chunks × 50 frames).
+
+use std::time::Instant;
+
+use faer::{Accum, Mat};
+use mbrl::data::collect_ball::{collect_ball, BallCollectSettings};
+use mbrl::envs::ball::Orientation;
+use mbrl::models::ball::learn::{train as train_ball, TrainSettings};
+use mbrl::models::context::config::{ContextConfig, EnvFamily, Preset as ContextPreset};
+use mbrl::models::context::data::{ContextData, Episode, InstancePair};
+use mbrl::models::context::ContextTrainer;
+use mbrl::models::dlgpd::data::ObservationKind;
+use mbrl::models::dlgpd::model::{loss_and_gradients, sample_noise, Batch, Gradients};
+use mbrl::models::dlgpd::vae::VaeNet;
+use mbrl::models::gp::{GpHypers, HyperInit};
+use mbrl::models::pets::data::Transitions;
+use mbrl::models::pets::{PetsConfig, PetsTrainer, Preset as PetsPreset};
+use mbrl::nn::backprop::matmul;
+use mbrl::nn::features::{feature_dim, features};
+use mbrl::nn::tensor::training_device;
+use mbrl::rl::sac::{Sac, SacConfig, TransitionBatch};
+use mbrl::run::NullMonitor;
+use mbrl::train::TrainingMethod;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+// The binary runs on mimalloc (cmd/main.rs) and these figures are meant to be its.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
+/// Something that takes one training step per call.
+type Step = Box<dyn FnMut()>;
+
+struct Workload {
+    name: &'static str,
+    /// Builds the trainer (not timed) and returns its step.
+    build: fn() -> Step,
+    warmup: usize,
+    /// Timed steps: the median of these is the figure.
+    repeats: usize,
+}
+
+fn pets_transitions(n: usize) -> Transitions {
+    const ANGULAR: [bool; 2] = [true, false];
+    let mut rng = ChaCha8Rng::seed_from_u64(1);
+    let mut t = Transitions { input_dim: feature_dim(&ANGULAR, 1), target_dim: 2, ..Default::default() };
+    for _ in 0..n {
+        let s = [rng.random_range(-std::f64::consts::PI..std::f64::consts::PI), rng.random_range(-8.0..8.0)];
+        features(&s, &[rng.random_range(-2.0..2.0)], &ANGULAR, &mut t.inputs);
+        t.targets.extend([rng.random_range(-0.4f32..0.4), rng.random_range(-1.0f32..1.0)]);
+    }
+    t
+}
+
+fn pets(preset: PetsPreset) -> Step {
+    let mut trainer =
+        PetsTrainer::new(PetsConfig::preset(preset), 0, pets_transitions(5000), Transitions::default()).unwrap();
+    let mut step = 0;
+    Box::new(move || {
+        step += 1;
+        trainer.step(step).unwrap();
+    })
+}
+
+fn context_data(instances: usize, len: usize) -> ContextData {
+    let (state, action) = (3, 1);
+    let mut rng = ChaCha8Rng::seed_from_u64(1);
+    let mut episode = || Episode {
+        states: (0..(len + 1) * state).map(|_| rng.random_range(-1.0..1.0)).collect(),
+        actions: (0..len * action).map(|_| rng.random_range(-2.0..2.0)).collect(),
+        len,
+    };
+    let pairs = (0..instances).map(|_| InstancePair { target: episode(), source: episode() }).collect();
+    ContextData { state_dim: state, action_dim: action, local_dim: 0, pairs }
+}
+
+fn context(batch: usize) -> Step {
+    let mut config = ContextConfig::preset(ContextPreset::Paper, EnvFamily::Control);
+    config.batch_size = batch;
+    let mut trainer = ContextTrainer::new(config, 0, context_data(200, 100), context_data(0, 100)).unwrap();
+    let mut step = 0;
+    Box::new(move || {
+        step += 1;
+        trainer.step(step).unwrap();
+    })
+}
+
+/// SEADS' Cursor-LightsOut sizes: observation 53, action 3, hidden [256, 256].
+fn sac() -> Step {
+    const OBS: usize = 53;
+    let mut rng = ChaCha8Rng::seed_from_u64(1);
+    let mut sac = Sac::new(SacConfig::new(OBS, vec![-0.2, -0.2, -1.0], vec![0.2, 0.2, 1.0]), &mut rng).unwrap();
+    let rows = 128;
+    let mut uniform = |n: usize, lo: f32, hi: f32| (0..n).map(|_| rng.random_range(lo..hi)).collect::<Vec<f32>>();
+    let batch = TransitionBatch {
+        rows,
+        obs: uniform(rows * OBS, 0.0, 1.0),
+        actions: uniform(rows * 3, -0.2, 0.2),
+        rewards: uniform(rows, -2.0, 1.0),
+        next_obs: uniform(rows * OBS, 0.0, 1.0),
+        done: uniform(rows, 0.0, 1.0).into_iter().map(|x| (x < 0.1) as u8 as f32).collect(),
+    };
+    Box::new(move || {
+        sac.update(&batch, &mut rng).unwrap();
+    })
+}
+
+/// The whole step's loss and gradients (two encodings of the frame pairs, one decoding, four exact GPs),
+/// without the optimizer update, as PyTorch's side times it.
+fn dlgpd(rows: usize) -> Step {
+    let mut rng = ChaCha8Rng::seed_from_u64(0);
+    let device = training_device();
+    let vae = VaeNet::init(ObservationKind::Images { side: 64 }, 3, 0, &device, &mut rng).unwrap();
+    let transition: Vec<GpHypers> = (0..3).map(|_| GpHypers::new(&HyperInit::dlgpd(4, 1.0)).unwrap()).collect();
+    let reward = GpHypers::new(&HyperInit::dlgpd(4, 4.0)).unwrap();
+    let pixels = rows * 6 * 64 * 64;
+    let frames: Vec<f32> = (0..pixels).map(|i| ((i % 251) as f32) / 251.0).collect();
+    let actions: Vec<f64> = (0..rows).map(|_| rng.random_range(-2.0..2.0)).collect();
+    let rewards: Vec<f64> = (0..rows).map(|_| -rng.random_range(0.0..10.0)).collect();
+    let batch = Batch { rows, obs: frames.clone(), next_obs: frames, actions, rewards };
+    let noise = sample_noise(rows, 3, &mut rng);
+    Box::new(move || {
+        loss_and_gradients(&vae, &transition, &reward, &batch, (&noise.0, &noise.1), Gradients::Wanted, &device)
+            .unwrap();
+    })
+}
+
+/// One optimizer step at the thesis' batch: `train` for 11 steps minus `train` for 1, so the set-up (chunk
+/// cutting, the first filter pass) is not counted.
+fn ball() -> Step {
+    let settings = BallCollectSettings {
+        trajectories: 40,
+        orientation: Orientation::Default,
+        augment_rotations: 0,
+        seed: 1,
+        command_line: String::new(),
+    };
+    let recordings = collect_ball(&settings, &NullMonitor).unwrap().recordings;
+    Box::new(move || {
+        let run = |steps| {
+            let start = Instant::now();
+            train_ball(&recordings, &TrainSettings { steps, ..TrainSettings::default() }, &NullMonitor).unwrap();
+            start.elapsed()
+        };
+        let (one, eleven) = (run(1), run(11));
+        STEP_OVERRIDE.with(|o| o.set(Some(eleven.saturating_sub(one).as_secs_f64() / 10.0)));
+    })
+}
+
+thread_local! {
+    /// A step that times itself (the ball's difference of two runs) leaves its figure here.
+    static STEP_OVERRIDE: std::cell::Cell<Option<f64>> = const { std::cell::Cell::new(None) };
+}
+
+const WORKLOADS: &[Workload] = &[
+    Workload { name: "pets_small", build: || pets(PetsPreset::Small), warmup: 20, repeats: 200 },
+    Workload { name: "pets_medium", build: || pets(PetsPreset::Medium), warmup: 10, repeats: 60 },
+    Workload { name: "context_b64", build: || context(64), warmup: 2, repeats: 10 },
+    Workload { name: "context_b512", build: || context(512), warmup: 1, repeats: 3 },
+    Workload { name: "sac_b128", build: sac, warmup: 10, repeats: 100 },
+    Workload { name: "dlgpd_b256", build: || dlgpd(256), warmup: 1, repeats: 3 },
+    Workload { name: "dlgpd_b1024", build: || dlgpd(1024), warmup: 1, repeats: 3 },
+    Workload { name: "ball_b64x50", build: ball, warmup: 0, repeats: 3 },
+];
+
+fn median(mut xs: Vec<f64>) -> f64 {
+    xs.sort_by(f64::total_cmp);
+    let n = xs.len();
+    if n % 2 == 1 {
+        xs[n / 2]
+    } else {
+        0.5 * (xs[n / 2 - 1] + xs[n / 2])
+    }
+}
+
+fn time_workload(workload: &Workload, quick: bool) -> (f64, usize) {
+    let mut step = (workload.build)();
+    let (warmup, repeats) = if quick {
+        (workload.warmup.min(2), (workload.repeats / 5).max(2))
+    } else {
+        (workload.warmup, workload.repeats)
+    };
+    for _ in 0..warmup {
+        step();
+    }
+    let samples = (0..repeats)
+        .map(|_| {
+            let start = Instant::now();
+            step();
+            let elapsed = start.elapsed().as_secs_f64();
+            STEP_OVERRIDE.with(|o| o.take()).unwrap_or(elapsed)
+        })
+        .collect();
+    (median(samples), repeats)
+}
+
+/// The best rate of a 1024 × 1024 × 1024 f32 product (2.15 GFLOP each) on the pool's threads, through faer's
+/// kernel split by rows as the fused training paths call it (`nn::backprop::matmul`).
+fn gemm_ceiling(quick: bool) -> f64 {
+    let n = 1024;
+    let a = Mat::<f32>::from_fn(n, n, |i, j| ((i * 7 + j * 3) % 17) as f32 / 17.0 - 0.5);
+    let b = Mat::<f32>::from_fn(n, n, |i, j| ((i * 5 + j * 11) % 13) as f32 / 13.0 - 0.5);
+    let mut c = Mat::<f32>::zeros(n, n);
+    let flops = 2.0 * (n * n * n) as f64;
+    (0..if quick { 10 } else { 40 })
+        .map(|_| {
+            let start = Instant::now();
+            matmul(c.as_mut(), Accum::Replace, a.as_ref(), b.as_ref());
+            flops / start.elapsed().as_secs_f64() / 1e9
+        })
+        .fold(0.0, f64::max)
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let quick = args.iter().any(|a| a == "--quick");
+    let only: Option<Vec<String>> = args
+        .iter()
+        .position(|a| a == "--only")
+        .and_then(|i| args.get(i + 1))
+        .map(|list| list.split(',').map(str::to_string).collect());
+    if let Some(names) = &only {
+        if let Some(unknown) = names.iter().find(|n| WORKLOADS.iter().all(|w| w.name != n.as_str())) {
+            let known: Vec<&str> = WORKLOADS.iter().map(|w| w.name).collect();
+            eprintln!("error: unknown workload '{unknown}'; known: {}", known.join(", "));
+            std::process::exit(2);
+        }
+    }
+    for threads in [1, 2] {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("a rayon pool");
+        let ceiling = pool.install(|| gemm_ceiling(quick));
+        println!(r#"{{"workload":"gemm_ceiling","threads":{threads},"gflops":{ceiling:.2}}}"#);
+        for workload in WORKLOADS {
+            if only.as_ref().is_some_and(|names| !names.iter().any(|n| n == workload.name)) {
+                continue;
+            }
+            let (seconds, samples) = pool.install(|| time_workload(workload, quick));
+            println!(
+                r#"{{"workload":"{}","threads":{threads},"seconds":{seconds:.6e},"samples":{samples}}}"#,
+                workload.name
+            );
+        }
+    }
+}

@@ -1,0 +1,155 @@
+#!/usr/bin/env python3
+"""mbrl's training steps beside PyTorch's, back to back on this machine: runs
+`cargo bench --bench training_steps` and benches/pytorch/training_steps.py, then prints the ratio table
+with each step's FLOP count, both sides' GFLOP/s, the f32 GEMM ceiling measured in the same run, and the
+load the machine was under (load average, and how many cores other processes kept busy while each side ran).
+
+A step meets the target when mbrl is at least 2x PyTorch, or when mbrl reaches at least 85 % of the GEMM
+ceiling without being slower than PyTorch (where PyTorch itself already runs near the ceiling).
+
+Usage: python3 benches/vs_pytorch.py [--quick] [--only NAME[,NAME...]] [--python PY] [--markdown FILE]
+(`make bench-vs-pytorch` runs it; PYTORCH_PYTHON names an interpreter that has torch.)
+"""
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+
+LABELS = {
+    "pets_small": "PETS small (5 × 3×64), batch 256",
+    "pets_medium": "PETS medium (5 × 4×200), batch 256",
+    "context_b64": "context model, paper net, batch 64 × 50",
+    "context_b512": "context model, paper net, batch 512 × 50",
+    "sac_b128": "SAC update (SEADS 2×256), batch 128",
+    "dlgpd_b256": "DLGPD step without Adam, batch 256",
+    "dlgpd_b1024": "DLGPD step without Adam, batch 1024",
+    "ball_b64x50": "ball EKF, 64 chunks × 50 frames",
+}
+
+
+def machine_busy_seconds():
+    with open("/proc/stat") as f:
+        fields = [int(v) for v in f.readline().split()[1:]]
+    idle = fields[3] + fields[4]
+    return (sum(fields[:8]) - idle) / os.sysconf("SC_CLK_TCK")
+
+
+def children_seconds():
+    t = os.times()
+    return t.children_user + t.children_system
+
+
+def load_average():
+    with open("/proc/loadavg") as f:
+        return f.read().split()[0]
+
+
+def run_side(name, command):
+    """Runs one side; returns its JSON rows and what else the machine did meanwhile."""
+    load_before = load_average()
+    busy0, own0, wall0 = machine_busy_seconds(), children_seconds(), time.monotonic()
+    proc = subprocess.run(command, cwd=ROOT, stdout=subprocess.PIPE, text=True)
+    busy1, own1, wall1 = machine_busy_seconds(), children_seconds(), time.monotonic()
+    if proc.returncode != 0:
+        sys.exit(f"error: {name} side failed (exit {proc.returncode}): {' '.join(command)}")
+    rows = [json.loads(line) for line in proc.stdout.splitlines() if line.startswith("{")]
+    others = max(0.0, (busy1 - busy0) - (own1 - own0)) / max(wall1 - wall0, 1e-9)
+    return rows, {"load_before": load_before, "load_after": load_average(), "other_cores": others, "wall": wall1 - wall0}
+
+
+def find_python(explicit):
+    candidates = [explicit] if explicit else [os.environ.get("PYTORCH_PYTHON"), sys.executable, "python3"]
+    for python in filter(None, candidates):
+        probe = subprocess.run([python, "-c", "import torch"], capture_output=True)
+        if probe.returncode == 0:
+            return python
+    sys.exit(
+        "error: no Python with torch found. Install it with `pip install torch` (CPU-only wheels: "
+        "`pip install torch --index-url https://download.pytorch.org/whl/cpu`), or name an interpreter that has "
+        "it with --python or PYTORCH_PYTHON."
+    )
+
+
+def fmt_time(seconds):
+    if seconds is None:
+        return "—"
+    return f"{seconds * 1e3:.2f} ms" if seconds < 1 else f"{seconds:.2f} s"
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="fewer timed steps on both sides")
+    parser.add_argument("--only", help="comma-separated workloads: " + ", ".join(LABELS))
+    parser.add_argument("--python", help="the Python interpreter with torch")
+    parser.add_argument("--markdown", help="also write the table to this file")
+    args = parser.parse_args()
+    python = find_python(args.python)
+    extra = (["--quick"] if args.quick else []) + (["--only", args.only] if args.only else [])
+
+    ours, our_load = run_side("mbrl", ["cargo", "bench", "--quiet", "--bench", "training_steps", "--"] + extra)
+    theirs, their_load = run_side("PyTorch", [python, os.path.join(HERE, "pytorch", "training_steps.py")] + extra)
+
+    torch_version = next((r["torch"] for r in theirs if "torch" in r), "?")
+    ceiling = {r["threads"]: r["gflops"] for r in ours if r.get("workload") == "gemm_ceiling"}
+    mbrl = {(r["workload"], r["threads"]): r for r in ours if "seconds" in r}
+    torch_rows = {(r["workload"], r["threads"]): r for r in theirs if "workload" in r}
+
+    lines = [
+        f"| training step | threads | PyTorch {torch_version} | mbrl | mbrl / PyTorch speed | GFLOP per step "
+        "| PyTorch GFLOP/s | mbrl GFLOP/s | mbrl, % of GEMM ceiling | target |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for (name, threads), row in mbrl.items():
+        other = torch_rows.get((name, threads), {})
+        ours_s, theirs_s, flops = row["seconds"], other.get("seconds"), other.get("flops")
+        ratio = theirs_s / ours_s if theirs_s else None
+        gflop = flops / 1e9 if flops else None
+        our_rate = gflop / ours_s if gflop else None
+        their_rate = gflop / theirs_s if gflop and theirs_s else None
+        share = our_rate / ceiling[threads] if our_rate and threads in ceiling else None
+        if ratio is None:
+            verdict = "no PyTorch reference"
+        elif ratio >= 2.0 or (share is not None and share >= 0.85 and ratio >= 1.0):
+            verdict = "met"
+        else:
+            verdict = "not met"
+        cells = [
+            LABELS.get(name, name),
+            str(threads),
+            fmt_time(theirs_s),
+            fmt_time(ours_s),
+            f"{ratio:.2f}×" if ratio else "—",
+            f"{gflop:.3g}" if gflop else "—",
+            f"{their_rate:.1f}" if their_rate else "—",
+            f"{our_rate:.1f}" if our_rate else "—",
+            f"{100 * share:.0f} %" if share else "—",
+            verdict,
+        ]
+        lines.append("| " + " | ".join(cells) + " |")
+    ceilings = ", ".join(f"{ceiling[t]:.1f} GFLOP/s at {t} thread{'s' if t > 1 else ''}" for t in sorted(ceiling))
+    lines.append("")
+    lines.append(f"f32 GEMM ceiling (faer, 1024³, best of the run): {ceilings}.")
+    for side, load in (("mbrl", our_load), ("PyTorch", their_load)):
+        lines.append(
+            f"{side} side: {load['wall']:.0f} s, load average {load['load_before']} → {load['load_after']}, "
+            f"other processes kept {load['other_cores']:.2f} cores busy."
+        )
+    lines.append(
+        "FLOPs: matmul and convolution FLOPs of forward and backward, counted by torch's FlopCounterMode on "
+        "PyTorch's step; both sides' GFLOP/s divide that count by their own time."
+    )
+    table = "\n".join(lines)
+    print(table)
+    if args.markdown:
+        with open(args.markdown, "w") as f:
+            f.write(table + "\n")
+
+
+if __name__ == "__main__":
+    main()
