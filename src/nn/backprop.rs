@@ -129,6 +129,18 @@ impl<'a> Dense<'a> {
     }
 }
 
+impl Dense<'_> {
+    /// The input gradients for output gradients `dy`, leaving the weights' gradients alone: for a network held
+    /// fixed while something upstream of it learns (SAC's critics under the actor's loss).
+    pub fn backward_input(&self, dy: &[f32], rows: usize) -> Vec<f32> {
+        debug_assert_eq!(dy.len(), rows * self.d_out);
+        let (o, i) = (self.d_out, self.d_in);
+        let mut dx = vec![0.0; rows * i];
+        matmul(view_mut(&mut dx, rows, i), Accum::Replace, view(dy, rows, o), view(&self.weight, o, i));
+        dx
+    }
+}
+
 /// sums[j] += Σ_rows m[row, j] for a row-major matrix with `sums.len()` columns.
 pub fn add_column_sums(sums: &mut [f32], m: &[f32]) {
     for row in m.chunks(sums.len()) {

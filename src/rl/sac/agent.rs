@@ -1,7 +1,7 @@
-//! The SAC agent: burn modules for the two gradient passes, plain buffers (ParamSet) as the parameters of
-//! record, our Adam per network, and the fast path rebuilt after each update for acting and critic targets.
+//! The SAC agent: plain buffers (ParamSet) as the parameters of record, the two gradient passes written out by
+//! hand over them (`grad.rs`; burn's modules in `networks.rs` are their reference), our Adam per network, and the
+//! fast path rebuilt after each update for acting and critic targets.
 
-use burn::module::Module;
 use burn::tensor::{Device, Tensor};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -9,10 +9,11 @@ use rand_distr::StandardNormal;
 
 use super::batch::{SacLosses, TransitionBatch};
 use super::config::SacConfig;
+use super::grad::{actor_loss_and_gradients, critic_loss_and_gradients};
 use super::inference::{concat_rows, PolicyFast, TwinQFast};
 use super::networks::{critic_name, policy_name, GaussianPolicy, QNetwork, CRITIC, CRITIC_TARGET, TANH_EPSILON};
 use crate::error::{Error, Result};
-use crate::nn::tensor::{scalar, tensor, training_device};
+use crate::nn::tensor::training_device;
 use crate::nn::{Adam, AdamConfig, ParamSet};
 
 const HALF_LN_2PI: f32 = 0.918_938_5;
@@ -20,9 +21,6 @@ const HALF_LN_2PI: f32 = 0.918_938_5;
 pub struct Sac {
     pub(super) config: SacConfig,
     pub(super) device: Device,
-    /// Taken out only while new parameters are loaded into them.
-    policy: Option<GaussianPolicy>,
-    critic: Option<QNetwork>,
     pub(super) policy_params: ParamSet,
     pub(super) critic_params: ParamSet,
     /// Named `critic_target.*`; only ever used without gradients, so it has no burn module.
@@ -78,8 +76,6 @@ impl Sac {
             bias: config.action_bias(),
             config,
             device,
-            policy: Some(policy),
-            critic: Some(critic),
             policy_params,
             critic_params,
             target_params,
@@ -120,13 +116,16 @@ impl Sac {
         &self.target_params
     }
 
-    /// The burn actor, for checks against the fast path.
-    pub fn policy_module(&self) -> &GaussianPolicy {
-        self.policy.as_ref().expect("the policy is only taken out while loading new weights")
+    /// The actor as a burn module holding the current weights, for checks against the hand-written paths.
+    pub fn policy_module(&self) -> Result<GaussianPolicy> {
+        let module = GaussianPolicy::init(&self.config, &self.device, &mut ChaCha8Rng::seed_from_u64(0));
+        self.policy_params.load_into(module, &self.device)
     }
 
-    fn critic_module(&self) -> &QNetwork {
-        self.critic.as_ref().expect("the critic is only taken out while loading new weights")
+    /// The twin critics as a burn module holding the current weights.
+    pub fn critic_module(&self) -> Result<QNetwork> {
+        let module = QNetwork::init(&self.config, &self.device, &mut ChaCha8Rng::seed_from_u64(0));
+        self.critic_params.load_into(module, &self.device)
     }
 
     /// `rows` observations (row-major `rows × obs_dim`) → `rows × action_dim` actions in env units:
@@ -199,40 +198,35 @@ impl Sac {
             })
             .collect();
 
-        let input = tensor(concat_rows(&batch.obs, od, &batch.actions, ad, n), [n, od + ad], &self.device);
-        let target = tensor(y, [n, 1], &self.device);
-        let (q1, q2) = self.critic_module().forward(input);
-        let mean_q = scalar(&((q1.clone() + q2.clone()).mean() / 2.0));
-        let critic_loss = (q1 - target.clone()).square().mean() + (q2 - target).square().mean();
-        let critic_value = scalar(&critic_loss);
+        let input = concat_rows(&batch.obs, od, &batch.actions, ad, n);
+        let (critic_value, mean_q, mut grads) =
+            critic_loss_and_gradients(&self.critic_params, CRITIC, &self.config.hidden, &input, &y, n)?;
         if !critic_value.is_finite() {
             return Err(Error::diverged(format!("sac update {}: critic loss is {critic_value}", self.updates)));
         }
-        let mut grads = ParamSet::<f32>::gradients(self.critic_module(), &critic_loss.backward());
         self.critic_adam.update(&mut self.critic_params.values_mut(), &mut grads)?;
-        self.load_critic()?;
 
         // Actor: reparameterized sample, scored by the updated critics whose parameters get no gradient.
         let eps: Vec<f32> = (0..n * ad).map(|_| rng.sample(StandardNormal)).collect();
-        let obs = tensor(batch.obs.clone(), [n, od], &self.device);
-        let (mean, log_std) = self.policy_module().forward(obs.clone());
-        let eps = tensor(eps, [n, ad], &self.device);
-        let squashed = (mean + log_std.clone().exp() * eps.clone()).tanh();
-        let scale = tensor(self.scale.clone(), [1, ad], &self.device);
-        let bias = tensor(self.bias.clone(), [1, ad], &self.device);
-        let log_prob = log_prob(eps, log_std, squashed.clone(), scale.clone());
-        let actions = squashed * scale + bias;
-        let frozen = self.critic_module().clone().no_grad();
-        let (q1, q2) = frozen.forward(Tensor::cat(vec![obs, actions], 1));
-        let entropy = -scalar(&log_prob.clone().mean());
-        let actor_loss = (log_prob * alpha - q1.min_pair(q2)).mean();
-        let actor_value = scalar(&actor_loss);
-        if !actor_value.is_finite() {
-            return Err(Error::diverged(format!("sac update {}: actor loss is {actor_value}", self.updates)));
+        let actor = actor_loss_and_gradients(
+            &self.policy_params,
+            &self.critic_params,
+            CRITIC,
+            &self.config.hidden,
+            &batch.obs,
+            &eps,
+            &self.scale,
+            &self.bias,
+            alpha,
+            n,
+        )?;
+        if !actor.loss.is_finite() {
+            return Err(Error::diverged(format!("sac update {}: actor loss is {}", self.updates, actor.loss)));
         }
-        let mut grads = ParamSet::<f32>::gradients(self.policy_module(), &actor_loss.backward());
+        let mut grads = actor.gradients;
         self.policy_adam.update(&mut self.policy_params.values_mut(), &mut grads)?;
         self.load_policy()?;
+        let (actor_value, entropy) = (actor.loss, actor.entropy);
 
         let tau = self.config.tau as f32;
         for (t, live) in self.target_params.tensors.iter_mut().zip(&self.critic_params.tensors) {
@@ -247,15 +241,7 @@ impl Sac {
 
     // Loading cannot fail on shapes: parameter values are only ever replaced by checked ones of equal length.
     pub(super) fn load_policy(&mut self) -> Result<()> {
-        let policy = self.policy.take().expect("policy present");
-        self.policy = Some(self.policy_params.load_into(policy, &self.device)?);
         self.policy_fast = PolicyFast::from_params(&self.policy_params, self.config.hidden.len())?;
-        Ok(())
-    }
-
-    pub(super) fn load_critic(&mut self) -> Result<()> {
-        let critic = self.critic.take().expect("critic present");
-        self.critic = Some(self.critic_params.load_into(critic, &self.device)?);
         Ok(())
     }
 

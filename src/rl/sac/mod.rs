@@ -11,6 +11,7 @@
 pub mod agent;
 pub mod batch;
 pub mod config;
+pub mod grad;
 pub mod inference;
 pub mod networks;
 mod state;

@@ -127,7 +127,6 @@ impl Sac {
             (critic_m, critic_v, critic_step);
         self.updates = updates;
         self.load_policy()?;
-        self.load_critic()?;
         self.load_targets()
     }
 
@@ -140,7 +139,6 @@ impl Sac {
         self.target_params = super::agent::renamed(&critic, super::networks::CRITIC, super::networks::CRITIC_TARGET);
         (self.policy_params, self.critic_params) = (policy, critic);
         self.load_policy()?;
-        self.load_critic()?;
         self.load_targets()
     }
 }

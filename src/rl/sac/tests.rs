@@ -56,7 +56,7 @@ fn deterministic_actions_match_the_burn_forward_and_stay_in_bounds() {
     let obs = random_obs(&mut rng, rows * c.obs_dim, 30.0);
     let fast = sac.act(&obs, rows, true, &mut rng);
     assert_in_bounds(&fast, &c);
-    let (mean, _) = sac.policy_module().forward(tensor(obs, [rows, c.obs_dim], &training_device()));
+    let (mean, _) = sac.policy_module().unwrap().forward(tensor(obs, [rows, c.obs_dim], &training_device()));
     let (scale, bias) = (c.action_scale(), c.action_bias());
     for (i, (m, f)) in values(&mean).iter().zip(&fast).enumerate() {
         let expected = m.tanh() * scale[i % 3] + bias[i % 3];
@@ -314,4 +314,86 @@ fn bad_batches_and_configs_are_errors() {
         assert!(err.contains(field) && !err.contains('\n'), "{field}: {err}");
         assert!(Sac::new(bad, &mut rng).is_err());
     }
+}
+
+/// Both losses and every gradient of the hand-written update against burn's autodiff through the modules of
+/// `networks.rs`, on weights large enough that some log σ leave the clamp and both critics win some rows' min.
+#[test]
+fn hand_written_losses_and_gradients_match_burn_autodiff() {
+    use super::grad::{actor_loss_and_gradients, critic_loss_and_gradients};
+    use super::networks::CRITIC;
+    use crate::nn::tensor::scalar;
+    use crate::nn::ParamSet;
+    use burn::module::Module;
+    use burn::tensor::Tensor;
+
+    let mut c = config(7, vec![-0.2, -0.2, -1.0], vec![0.2, 0.2, 1.0]);
+    c.hidden = vec![9, 8];
+    let mut rng = ChaCha8Rng::seed_from_u64(21);
+    let mut sac = Sac::new(c.clone(), &mut rng).unwrap();
+    for t in sac.policy_params.tensors.iter_mut().chain(sac.critic_params.tensors.iter_mut()) {
+        t.values.iter_mut().for_each(|v| *v = rng.random_range(-0.9..0.9));
+    }
+    let (rows, od, ad) = (13, c.obs_dim, c.action_dim);
+    let batch = random_batch(&mut rng, &c, rows);
+    let obs = random_obs(&mut rng, rows * od, 3.0);
+    let targets = random_obs(&mut rng, rows, 2.0);
+    let eps = random_obs(&mut rng, rows * ad, 1.5);
+    let (scale, bias) = (c.action_scale(), c.action_bias());
+    let device = training_device();
+    let close = |name: &str, ours: &[Vec<f32>], theirs: &[Vec<f32>], params: &ParamSet| {
+        for ((t, ours), theirs) in params.tensors.iter().zip(ours).zip(theirs) {
+            let scale = theirs.iter().fold(0.0f32, |m, x| m.max(x.abs())).max(1e-3);
+            let worst = ours.iter().zip(theirs).fold(0.0f32, |m, (x, y)| m.max((x - y).abs()));
+            assert!(worst <= 2e-4 * scale, "{name}: '{}' differs by {worst} at scale {scale}", t.name);
+            assert!(ours.iter().any(|g| *g != 0.0), "{name}: '{}' got no gradient", t.name);
+        }
+    };
+
+    let input = super::inference::concat_rows(&obs, od, &batch.actions, ad, rows);
+    let critic = sac.critic_module().unwrap();
+    let (q1, q2) = critic.forward(tensor(input.clone(), [rows, od + ad], &device));
+    let target = tensor(targets.clone(), [rows, 1], &device);
+    let loss = (q1 - target.clone()).square().mean() + (q2 - target).square().mean();
+    let reference = ParamSet::<f32>::gradients(&critic, &loss.backward());
+    let (ours, _, grads) =
+        critic_loss_and_gradients(&sac.critic_params, CRITIC, &c.hidden, &input, &targets, rows).unwrap();
+    assert!((ours - scalar(&loss)).abs() < 1e-4 * (1.0 + ours.abs()), "critic loss {ours} vs {}", scalar(&loss));
+    close("critic", &grads, &reference, &sac.critic_params);
+
+    let policy = sac.policy_module().unwrap();
+    let frozen = sac.critic_module().unwrap().no_grad();
+    let obs_t = tensor(obs.clone(), [rows, od], &device);
+    let (mean, log_std) = policy.forward(obs_t.clone());
+    let raw = values(&mean).len();
+    assert_eq!(raw, rows * ad);
+    let eps_t = tensor(eps.clone(), [rows, ad], &device);
+    let squashed = (mean + log_std.clone().exp() * eps_t.clone()).tanh();
+    let scale_t = tensor(scale.clone(), [1, ad], &device);
+    let lp = log_prob(eps_t, log_std.clone(), squashed.clone(), scale_t.clone());
+    let actions = squashed * scale_t + tensor(bias.clone(), [1, ad], &device);
+    let (q1, q2) = frozen.forward(Tensor::cat(vec![obs_t, actions], 1));
+    let chose_q2 = values(&q2).iter().zip(values(&q1)).filter(|(b, a)| *b < a).count();
+    assert!(chose_q2 > 0 && chose_q2 < rows, "both critics should win some rows' min ({chose_q2} of {rows})");
+    let clamped = values(&log_std).iter().filter(|&&s| s == super::networks::LOG_STD_MAX).count();
+    assert!(clamped > 0, "some log σ should hit the clamp");
+    let alpha = 0.3f32;
+    let loss = (lp * alpha - q1.min_pair(q2)).mean();
+    let reference = ParamSet::<f32>::gradients(&policy, &loss.backward());
+    let actor = actor_loss_and_gradients(
+        &sac.policy_params,
+        &sac.critic_params,
+        CRITIC,
+        &c.hidden,
+        &obs,
+        &eps,
+        &scale,
+        &bias,
+        alpha,
+        rows,
+    )
+    .unwrap();
+    let theirs = scalar(&loss);
+    assert!((actor.loss - theirs).abs() < 1e-4 * (1.0 + theirs.abs()), "actor loss {} vs {theirs}", actor.loss);
+    close("actor", &actor.gradients, &reference, &sac.policy_params);
 }
