@@ -50,15 +50,15 @@ impl<'a> ReluStack<'a> {
     }
 
     /// Backward from the output gradients `dy` (of the ReLU'd output `y` when the forward had `relu_last`):
-    /// adds the weights' gradients to `grads` unless `frozen`, and returns the input gradients when asked for.
+    /// adds the weights' gradients to `grads` (none for a network held fixed), and returns the input gradients
+    /// when asked for.
     fn backward(
         &self,
         tape: &StackTape,
         relu_output: Option<&[f32]>,
         dy: &[f32],
         rows: usize,
-        grads: &mut [Vec<f32>],
-        frozen: bool,
+        mut grads: Option<&mut [Vec<f32>]>,
         want_dx: bool,
     ) -> Vec<f32> {
         let mut d = dy.to_vec();
@@ -67,14 +67,10 @@ impl<'a> ReluStack<'a> {
         }
         for (k, layer) in self.layers.iter().enumerate().rev() {
             let need_dx = k > 0 || want_dx;
-            d = if frozen {
-                if need_dx {
-                    layer.backward_input(&d, rows)
-                } else {
-                    Vec::new()
-                }
-            } else {
-                layer.backward(&tape.inputs[k], &d, rows, grads, need_dx)
+            d = match grads.as_deref_mut() {
+                Some(grads) => layer.backward(&tape.inputs[k], &d, rows, grads, need_dx),
+                None if need_dx => layer.backward_input(&d, rows),
+                None => Vec::new(),
             };
             if k > 0 {
                 // The input of layer k is the ReLU'd output of layer k − 1.
@@ -120,7 +116,7 @@ pub fn critic_loss_and_gradients(
             .collect();
         loss += sum / rows as f64;
         q_sum += q.iter().map(|&q| f64::from(q)).sum::<f64>();
-        critic.backward(&tape, None, &dq, rows, &mut grads, false, false);
+        critic.backward(&tape, None, &dq, rows, Some(&mut grads), false);
     }
     Ok((loss, q_sum / (2 * rows) as f64, grads))
 }
@@ -134,9 +130,9 @@ pub struct ActorLoss {
     pub gradients: Vec<Vec<f32>>,
 }
 
-/// The actor's loss mean(α log π(a|s) − min(q1, q2)(s, a)) for reparameterized actions a = tanh(mean + σ·ε)·scale
-/// + bias with noise `eps` (rows × action), through the critics in `critic_params` held fixed, and its gradient
-/// for every tensor of `policy_params`.
+/// The actor's loss mean(α log π(a|s) − min(q1, q2)(s, a)) for the reparameterized actions
+/// a = tanh(mean + σ·ε)·scale + bias with noise `eps` (rows × action), through the critics in `critic_params`
+/// held fixed, and its gradient for every tensor of `policy_params`.
 #[allow(clippy::too_many_arguments)]
 pub fn actor_loss_and_gradients(
     policy_params: &ParamSet,
@@ -198,9 +194,8 @@ pub fn actor_loss_and_gradients(
         loss += f64::from(alpha * log_prob[r] - q_min);
         log_prob_sum += f64::from(log_prob[r]);
     }
-    let mut unused = Vec::new();
-    let mut d_input = q1_net.backward(&tape1, None, &dq1, rows, &mut unused, true, true);
-    add_into(&mut d_input, &q2_net.backward(&tape2, None, &dq2, rows, &mut unused, true, true));
+    let mut d_input = q1_net.backward(&tape1, None, &dq1, rows, None, true);
+    add_into(&mut d_input, &q2_net.backward(&tape2, None, &dq2, rows, None, true));
 
     let d_log_prob = alpha * per_row;
     let (mut d_mean, mut d_raw_log_std) = (vec![0.0f32; n], vec![0.0f32; n]);
@@ -221,6 +216,6 @@ pub fn actor_loss_and_gradients(
     let mut gradients = zero_gradients(policy_params);
     let mut d_h = mean_head.backward(&h, &d_mean, rows, &mut gradients, true);
     add_into(&mut d_h, &log_std_head.backward(&h, &d_raw_log_std, rows, &mut gradients, true));
-    trunk.backward(&trunk_tape, Some(&h), &d_h, rows, &mut gradients, false, false);
+    trunk.backward(&trunk_tape, Some(&h), &d_h, rows, Some(&mut gradients), false);
     Ok(ActorLoss { loss: loss / rows as f64, entropy: -log_prob_sum / rows as f64, gradients })
 }
