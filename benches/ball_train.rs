@@ -2,10 +2,10 @@
 //! forward filter, backward pass through burn's autodiff, Adam update. Measured as 10 steps per sample.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use mbrl::data::collect_ball::{collect_ball, BallCollectSettings};
-use mbrl::envs::ball::Orientation;
 use mbrl::models::ball::learn::{train, TrainSettings};
 use mbrl::run::NullMonitor;
+
+mod inputs;
 
 // The binary runs on mimalloc (cmd/main.rs) and these figures are meant to be its: the library no longer
 // chooses the process allocator, so each benchmark declares the same one.
@@ -13,14 +13,7 @@ use mbrl::run::NullMonitor;
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 fn bench(c: &mut Criterion) {
-    let settings = BallCollectSettings {
-        trajectories: 40,
-        orientation: Orientation::Default,
-        augment_rotations: 0,
-        seed: 1,
-        command_line: String::new(),
-    };
-    let recordings = collect_ball(&settings, &NullMonitor).unwrap().recordings;
+    let recordings = inputs::ball_recordings();
     let mut group = c.benchmark_group("ball_ekf_train_10_steps_batch64x50");
     group.sample_size(10);
     for launcher_prior in [false, true] {

@@ -10,7 +10,6 @@ use mbrl::data::collect::{collect_instance_pairs, InstancePairSettings};
 use mbrl::data::write_dataset;
 use mbrl::envs::parse_env;
 use mbrl::models::context::config::{ContextConfig, EnvFamily, Preset};
-use mbrl::models::context::data::{ContextData, Episode, InstancePair};
 use mbrl::models::context::dynamics::ContextDynamics;
 use mbrl::models::context::eig::EigObjective;
 use mbrl::models::context::fast::{FastContextModel, RolloutScratch};
@@ -33,20 +32,8 @@ use rand_chacha::ChaCha8Rng;
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
-const STATE: usize = 3;
-const ACTION: usize = 1;
-
-/// Random pendulum-shaped rollout pairs (speed does not depend on what the numbers mean).
-fn data(instances: usize, len: usize) -> ContextData {
-    let mut rng = ChaCha8Rng::seed_from_u64(1);
-    let mut episode = || Episode {
-        states: (0..(len + 1) * STATE).map(|_| rng.random_range(-1.0..1.0)).collect(),
-        actions: (0..len * ACTION).map(|_| rng.random_range(-2.0..2.0)).collect(),
-        len,
-    };
-    let pairs = (0..instances).map(|_| InstancePair { target: episode(), source: episode() }).collect();
-    ContextData { state_dim: STATE, action_dim: ACTION, local_dim: 0, pairs }
-}
+mod inputs;
+use inputs::{context_data as data, CONTEXT_ACTION as ACTION, CONTEXT_STATE as STATE};
 
 fn paper_config(batch: usize) -> ContextConfig {
     let mut c = ContextConfig::preset(Preset::Paper, EnvFamily::Control);

@@ -11,7 +11,7 @@ use mbrl::envs::pendulum::dynamics::PendulumReward;
 use mbrl::models::pets::data::Transitions;
 use mbrl::models::pets::net::{torch_name, PetsNet};
 use mbrl::models::pets::{PetsConfig, PetsDynamics, PetsTrainer, Preset, Propagation};
-use mbrl::nn::features::{feature_dim, features};
+use mbrl::nn::features::features;
 use mbrl::nn::tensor::{inference_device, tensor, values};
 use mbrl::nn::{Normalizer, ParamSet};
 use mbrl::planning::{Cem, CemConfig};
@@ -25,22 +25,11 @@ use rand_distr::StandardNormal;
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
-const ANGULAR: [bool; 2] = [true, false];
+mod inputs;
+use inputs::{pets_transitions as transitions, PENDULUM_ANGULAR as ANGULAR};
 
 fn config(preset: Preset) -> PetsConfig {
     PetsConfig::preset(preset)
-}
-
-/// Random pendulum-like transitions (training speed does not depend on what the numbers mean).
-fn transitions(n: usize) -> Transitions {
-    let mut rng = ChaCha8Rng::seed_from_u64(1);
-    let mut t = Transitions { input_dim: feature_dim(&ANGULAR, 1), target_dim: 2, ..Default::default() };
-    for _ in 0..n {
-        let s = [rng.random_range(-std::f64::consts::PI..std::f64::consts::PI), rng.random_range(-8.0..8.0)];
-        features(&s, &[rng.random_range(-2.0..2.0)], &ANGULAR, &mut t.inputs);
-        t.targets.extend([rng.random_range(-0.4f32..0.4), rng.random_range(-1.0f32..1.0)]);
-    }
-    t
 }
 
 fn train_step(c: &mut Criterion) {

@@ -3,7 +3,7 @@
 //! `act` for the 32 episodes collected in lockstep.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use mbrl::rl::sac::{Sac, SacConfig, TransitionBatch};
+use mbrl::rl::sac::Sac;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -12,23 +12,8 @@ use rand_chacha::ChaCha8Rng;
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
-const OBS: usize = 53;
-
-fn config() -> SacConfig {
-    SacConfig::new(OBS, vec![-0.2, -0.2, -1.0], vec![0.2, 0.2, 1.0])
-}
-
-fn batch(rng: &mut ChaCha8Rng, rows: usize) -> TransitionBatch {
-    let mut uniform = |n: usize, lo: f32, hi: f32| (0..n).map(|_| rng.random_range(lo..hi)).collect::<Vec<f32>>();
-    TransitionBatch {
-        rows,
-        obs: uniform(rows * OBS, 0.0, 1.0),
-        actions: uniform(rows * 3, -0.2, 0.2),
-        rewards: uniform(rows, -2.0, 1.0),
-        next_obs: uniform(rows * OBS, 0.0, 1.0),
-        done: uniform(rows, 0.0, 1.0).into_iter().map(|x| (x < 0.1) as u8 as f32).collect(),
-    }
-}
+mod inputs;
+use inputs::{sac_batch as batch, sac_config as config, SAC_OBS as OBS};
 
 fn update(c: &mut Criterion) {
     let mut rng = ChaCha8Rng::seed_from_u64(1);

@@ -12,11 +12,8 @@
 use std::time::Instant;
 
 use faer::{Accum, Mat};
-use mbrl::data::collect_ball::{collect_ball, BallCollectSettings};
-use mbrl::envs::ball::Orientation;
 use mbrl::models::ball::learn::{train as train_ball, TrainSettings};
 use mbrl::models::context::config::{ContextConfig, EnvFamily, Preset as ContextPreset};
-use mbrl::models::context::data::{ContextData, Episode, InstancePair};
 use mbrl::models::context::ContextTrainer;
 use mbrl::models::dlgpd::data::ObservationKind;
 use mbrl::models::dlgpd::model::{loss_and_gradients, sample_noise, Batch, Gradients};
@@ -25,13 +22,14 @@ use mbrl::models::gp::{GpHypers, HyperInit};
 use mbrl::models::pets::data::Transitions;
 use mbrl::models::pets::{PetsConfig, PetsTrainer, Preset as PetsPreset};
 use mbrl::nn::backprop::matmul;
-use mbrl::nn::features::{feature_dim, features};
 use mbrl::nn::tensor::training_device;
-use mbrl::rl::sac::{Sac, SacConfig, TransitionBatch};
+use mbrl::rl::sac::Sac;
 use mbrl::run::NullMonitor;
 use mbrl::train::TrainingMethod;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+
+mod inputs;
 
 // The binary runs on mimalloc (cmd/main.rs) and these figures are meant to be its.
 #[global_allocator]
@@ -49,21 +47,10 @@ struct Workload {
     repeats: usize,
 }
 
-fn pets_transitions(n: usize) -> Transitions {
-    const ANGULAR: [bool; 2] = [true, false];
-    let mut rng = ChaCha8Rng::seed_from_u64(1);
-    let mut t = Transitions { input_dim: feature_dim(&ANGULAR, 1), target_dim: 2, ..Default::default() };
-    for _ in 0..n {
-        let s = [rng.random_range(-std::f64::consts::PI..std::f64::consts::PI), rng.random_range(-8.0..8.0)];
-        features(&s, &[rng.random_range(-2.0..2.0)], &ANGULAR, &mut t.inputs);
-        t.targets.extend([rng.random_range(-0.4f32..0.4), rng.random_range(-1.0f32..1.0)]);
-    }
-    t
-}
-
 fn pets(preset: PetsPreset) -> Step {
     let mut trainer =
-        PetsTrainer::new(PetsConfig::preset(preset), 0, pets_transitions(5000), Transitions::default()).unwrap();
+        PetsTrainer::new(PetsConfig::preset(preset), 0, inputs::pets_transitions(5000), Transitions::default())
+            .unwrap();
     let mut step = 0;
     Box::new(move || {
         step += 1;
@@ -71,22 +58,11 @@ fn pets(preset: PetsPreset) -> Step {
     })
 }
 
-fn context_data(instances: usize, len: usize) -> ContextData {
-    let (state, action) = (3, 1);
-    let mut rng = ChaCha8Rng::seed_from_u64(1);
-    let mut episode = || Episode {
-        states: (0..(len + 1) * state).map(|_| rng.random_range(-1.0..1.0)).collect(),
-        actions: (0..len * action).map(|_| rng.random_range(-2.0..2.0)).collect(),
-        len,
-    };
-    let pairs = (0..instances).map(|_| InstancePair { target: episode(), source: episode() }).collect();
-    ContextData { state_dim: state, action_dim: action, local_dim: 0, pairs }
-}
-
 fn context(batch: usize) -> Step {
     let mut config = ContextConfig::preset(ContextPreset::Paper, EnvFamily::Control);
     config.batch_size = batch;
-    let mut trainer = ContextTrainer::new(config, 0, context_data(200, 100), context_data(0, 100)).unwrap();
+    let mut trainer =
+        ContextTrainer::new(config, 0, inputs::context_data(200, 100), inputs::context_data(0, 100)).unwrap();
     let mut step = 0;
     Box::new(move || {
         step += 1;
@@ -96,19 +72,9 @@ fn context(batch: usize) -> Step {
 
 /// SEADS' Cursor-LightsOut sizes: observation 53, action 3, hidden [256, 256].
 fn sac() -> Step {
-    const OBS: usize = 53;
     let mut rng = ChaCha8Rng::seed_from_u64(1);
-    let mut sac = Sac::new(SacConfig::new(OBS, vec![-0.2, -0.2, -1.0], vec![0.2, 0.2, 1.0]), &mut rng).unwrap();
-    let rows = 128;
-    let mut uniform = |n: usize, lo: f32, hi: f32| (0..n).map(|_| rng.random_range(lo..hi)).collect::<Vec<f32>>();
-    let batch = TransitionBatch {
-        rows,
-        obs: uniform(rows * OBS, 0.0, 1.0),
-        actions: uniform(rows * 3, -0.2, 0.2),
-        rewards: uniform(rows, -2.0, 1.0),
-        next_obs: uniform(rows * OBS, 0.0, 1.0),
-        done: uniform(rows, 0.0, 1.0).into_iter().map(|x| (x < 0.1) as u8 as f32).collect(),
-    };
+    let mut sac = Sac::new(inputs::sac_config(), &mut rng).unwrap();
+    let batch = inputs::sac_batch(&mut rng, 128);
     Box::new(move || {
         sac.update(&batch, &mut rng).unwrap();
     })
@@ -137,14 +103,7 @@ fn dlgpd(rows: usize) -> Step {
 /// One optimizer step at the thesis' batch: `train` for 11 steps minus `train` for 1, so the set-up (chunk
 /// cutting, the first filter pass) is not counted.
 fn ball() -> Step {
-    let settings = BallCollectSettings {
-        trajectories: 40,
-        orientation: Orientation::Default,
-        augment_rotations: 0,
-        seed: 1,
-        command_line: String::new(),
-    };
-    let recordings = collect_ball(&settings, &NullMonitor).unwrap().recordings;
+    let recordings = inputs::ball_recordings();
     Box::new(move || {
         let run = |steps| {
             let start = Instant::now();
