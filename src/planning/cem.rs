@@ -178,7 +178,11 @@ impl Cem {
 
     /// Optimizes a sequence of `horizon` actions. Returns the final mean (row-major `horizon × action_dim`)
     /// and calls `on_iteration` after each refit.
-    pub fn plan(&mut self, objective: &dyn Objective, mut on_iteration: impl FnMut(&CemIteration)) -> Vec<f64> {
+    ///
+    /// A candidate whose cost is NaN never becomes an elite. When no candidate of an iteration has a finite
+    /// cost, there is nothing to refit to: the objective's model has diverged from every start, and the plan
+    /// stops there with `Error::Diverged` naming the iteration rather than returning actions chosen blindly.
+    pub fn plan(&mut self, objective: &dyn Objective, mut on_iteration: impl FnMut(&CemIteration)) -> Result<Vec<f64>> {
         let cfg = &self.config;
         let (h, d, n) = (cfg.horizon, cfg.action_dim(), cfg.candidates);
         let per = h * d;
@@ -196,6 +200,14 @@ impl Cem {
             objective.costs(&candidates, h, &mut costs);
             // A model that diverges must not win the elite selection.
             costs.iter_mut().filter(|c| c.is_nan()).for_each(|c| *c = f64::INFINITY);
+            if !costs.iter().any(|c| c.is_finite()) {
+                return Err(Error::diverged(format!(
+                    "CEM iteration {} of {}: none of the {n} candidates has a finite cost (the model's \
+                     predictions are NaN or infinite from this start)",
+                    iteration + 1,
+                    self.config.iterations
+                )));
+            }
             order.iter_mut().enumerate().for_each(|(i, o)| *o = i);
             let elites = self.config.elites;
             order.select_nth_unstable_by(elites - 1, |&a, &b| costs[a].total_cmp(&costs[b]).then(a.cmp(&b)));
@@ -210,7 +222,7 @@ impl Cem {
             }
         }
         self.calls += 1;
-        self.mean.clone()
+        Ok(self.mean.clone())
     }
 
     /// Drops the first step of the previous mean and repeats zero at the end.
@@ -298,7 +310,7 @@ mod tests {
         let run = |stop_std| {
             let mut cem = Cem::new(CemConfig { stop_std, iterations: 40, ..config(NoiseKind::White) }, 3).unwrap();
             let mut iterations = 0;
-            cem.plan(&objective, |_| iterations += 1);
+            cem.plan(&objective, |_| iterations += 1).unwrap();
             iterations
         };
         let (all, stopped) = (run(None), run(Some(0.01)));
@@ -312,7 +324,7 @@ mod tests {
             let target: Vec<f64> = (0..8).map(|t| 1.5 * ((t as f64) * 0.7).sin()).collect();
             let mut cem = Cem::new(config(noise), 1).unwrap();
             let mut last = f64::INFINITY;
-            let plan = cem.plan(&Quadratic { target: target.clone() }, |it| last = it.best_cost);
+            let plan = cem.plan(&Quadratic { target: target.clone() }, |it| last = it.best_cost).unwrap();
             let err: f64 = plan.iter().zip(&target).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
             assert!(err < 0.05, "{noise:?}: max error {err}");
             assert!(last < 1e-2, "{noise:?}: best cost {last}");
@@ -322,7 +334,7 @@ mod tests {
     #[test]
     fn samples_respect_bounds_even_for_targets_outside() {
         let mut cem = Cem::new(config(NoiseKind::White), 2).unwrap();
-        let plan = cem.plan(&Quadratic { target: vec![5.0; 8] }, |_| {});
+        let plan = cem.plan(&Quadratic { target: vec![5.0; 8] }, |_| {}).unwrap();
         assert!(plan.iter().all(|a| (1.9..=2.0).contains(a)), "{plan:?}");
     }
 
@@ -333,7 +345,7 @@ mod tests {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             pool.install(|| {
                 let mut cem = Cem::new(config(NoiseKind::White), 9).unwrap();
-                cem.plan(&Quadratic { target: target.clone() }, |_| {})
+                cem.plan(&Quadratic { target: target.clone() }, |_| {}).unwrap()
             })
         };
         assert_eq!(run(1), run(3));
@@ -361,8 +373,27 @@ mod tests {
             }
         }
         let mut cem = Cem::new(config(NoiseKind::White), 5).unwrap();
-        let plan = cem.plan(&NanForPositive, |_| {});
+        let plan = cem.plan(&NanForPositive, |_| {}).unwrap();
         assert!(plan[0] <= 0.0 && plan[0] > -0.2, "{}", plan[0]);
+    }
+
+    #[test]
+    fn a_model_diverged_from_every_start_stops_the_plan_at_the_first_such_iteration() {
+        use std::sync::atomic::{AtomicUsize, Ordering};
+        struct DivergesAfter(AtomicUsize);
+        impl Objective for DivergesAfter {
+            fn costs(&self, _candidates: &[f64], _horizon: usize, costs: &mut [f64]) {
+                let calls = self.0.fetch_add(1, Ordering::Relaxed) + 1;
+                let value = if calls >= 3 { f64::NAN } else { 1.0 };
+                costs.iter_mut().enumerate().for_each(|(i, c)| *c = if i % 2 == 0 { value } else { f64::INFINITY });
+            }
+        }
+        let mut cem = Cem::new(config(NoiseKind::White), 5).unwrap();
+        let mut seen = 0;
+        let err = cem.plan(&DivergesAfter(AtomicUsize::new(0)), |_| seen += 1).unwrap_err();
+        assert_eq!(seen, 2, "the two finite iterations are reported, the third is not");
+        let message = err.to_string();
+        assert!(message.contains("CEM iteration 3 of") && message.contains("finite cost"), "{message}");
     }
 
     #[test]

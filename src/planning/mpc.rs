@@ -5,7 +5,7 @@ use super::{Cem, CemIteration};
 use crate::control::{run_episode, Agent, BatchDynamics, ReturnObjective};
 use crate::data::Rollout;
 use crate::envs::Env;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::run::Monitor;
 use crate::util::seeding::derive_seed;
 
@@ -44,6 +44,11 @@ impl<'a, F: FnMut(usize, &CemIteration)> MpcAgent<'a, F> {
     }
 }
 
+/// A plan that failed at episode step `t`, with the step in its message.
+pub fn planning_failed(t: usize, error: Error) -> Error {
+    Error::diverged(format!("episode step {}: {error}", t + 1))
+}
+
 impl<F: FnMut(usize, &CemIteration)> Agent for MpcAgent<'_, F> {
     fn reset(&mut self) -> Result<()> {
         self.cem.reset();
@@ -54,7 +59,7 @@ impl<F: FnMut(usize, &CemIteration)> Agent for MpcAgent<'_, F> {
         let horizon = self.cem.config().horizon;
         let objective = ReturnObjective::new(self.model, state, derive_seed(self.seed, &[t as u64, 0]));
         let on_iteration = &mut self.on_iteration;
-        let plan = self.cem.plan(&objective, |it| on_iteration(t, it));
+        let plan = self.cem.plan(&objective, |it| on_iteration(t, it)).map_err(|e| planning_failed(t, e))?;
         let seed = derive_seed(self.seed, &[t as u64, 1]);
         self.model.rollout(state, &plan, horizon, seed, &mut [0.0], Some(&mut self.predicted));
         Ok(plan[..self.model.action_dim()].to_vec())

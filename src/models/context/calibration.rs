@@ -12,6 +12,7 @@ use crate::control::{run_episode, Agent, Transition};
 use crate::data::Rollout;
 use crate::envs::Env;
 use crate::error::{Error, Result};
+use crate::planning::mpc::planning_failed;
 use crate::planning::{Cem, CemConfig, NoiseKind};
 use crate::run::Monitor;
 use crate::util::seeding::{derive_seed, rng_for};
@@ -201,10 +202,12 @@ impl Agent for CalibrationAgent<'_> {
             );
             let mut cem = Cem::new((self.cem_config)(horizon), derive_seed(self.seed, &[2, t as u64]))?;
             let phase = format!("step {}/{n}: EIG planning", t + 1);
-            self.plan = cem.plan(&objective, |it| {
-                monitor.scalar("cem/best_entropy", it.iteration as u64, it.best_cost);
-                monitor.progress(&phase, it.iteration as u64 + 1, settings.iterations as u64);
-            });
+            self.plan = cem
+                .plan(&objective, |it| {
+                    monitor.scalar("cem/best_entropy", it.iteration as u64, it.best_cost);
+                    monitor.progress(&phase, it.iteration as u64 + 1, settings.iterations as u64);
+                })
+                .map_err(|e| planning_failed(t, e))?;
             self.plan.truncate(horizon * a);
         }
         let offset = if mpc { 0 } else { t };

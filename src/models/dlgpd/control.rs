@@ -24,6 +24,7 @@ use crate::envs::pendulum::{Pendulum, PendulumVariant, StartDistribution};
 use crate::envs::Env;
 use crate::error::{Error, Result};
 use crate::nn::tensor::inference_device;
+use crate::planning::mpc::planning_failed;
 use crate::planning::{Cem, CemConfig};
 use crate::run::Monitor;
 use crate::util::seeding::{derive_seed, rng_for};
@@ -218,6 +219,7 @@ impl Agent for ImageAgent<'_> {
             monitor.scalar("cem/best_cost", it.iteration as u64, it.best_cost);
             monitor.scalar("cem/elite_mean_cost", it.iteration as u64, it.elite_mean_cost);
         });
+        let plan = plan.map_err(|e| planning_failed(t, e))?;
         self.iterations.push(used);
         Ok(plan[..1].to_vec())
     }

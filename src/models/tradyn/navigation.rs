@@ -9,6 +9,7 @@ use crate::data::Rollout;
 use crate::envs::terrain::TerrainMap;
 use crate::envs::Env;
 use crate::error::{Error, Result};
+use crate::planning::mpc::planning_failed;
 use crate::planning::{Cem, CemConfig, NoiseKind};
 use crate::run::{Background, Event, Monitor, PanelSpec, PathView};
 use crate::util::seeding::derive_seed;
@@ -210,6 +211,7 @@ impl Agent for NavigationAgent<'_> {
             monitor.scalar("cem/elite_mean_cost", it.iteration as u64, it.elite_mean_cost);
             monitor.progress(&phase, it.iteration as u64 + 1, settings.cem.iterations as u64);
         });
+        let plan = plan.map_err(|e| planning_failed(t, e))?;
         let d = self.dynamics.state_dim();
         self.planned = vec![0.0; horizon * d];
         self.dynamics.rollout(state, &plan, horizon, 0, &mut [0.0], Some(&mut self.planned));
