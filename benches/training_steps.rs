@@ -35,8 +35,8 @@ mod inputs;
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
-/// Something that takes one training step per call.
-type Step = Box<dyn FnMut()>;
+/// Something that takes one training step per call; a step that times itself returns its own figure.
+type Step = Box<dyn FnMut() -> Option<f64>>;
 
 struct Workload {
     name: &'static str,
@@ -55,6 +55,7 @@ fn pets(preset: PetsPreset) -> Step {
     Box::new(move || {
         step += 1;
         trainer.step(step).unwrap();
+        None
     })
 }
 
@@ -67,6 +68,7 @@ fn context(batch: usize) -> Step {
     Box::new(move || {
         step += 1;
         trainer.step(step).unwrap();
+        None
     })
 }
 
@@ -77,6 +79,7 @@ fn sac() -> Step {
     let batch = inputs::sac_batch(&mut rng, 128);
     Box::new(move || {
         sac.update(&batch, &mut rng).unwrap();
+        None
     })
 }
 
@@ -97,6 +100,7 @@ fn dlgpd(rows: usize) -> Step {
     Box::new(move || {
         loss_and_gradients(&vae, &transition, &reward, &batch, (&noise.0, &noise.1), Gradients::Wanted, &device)
             .unwrap();
+        None
     })
 }
 
@@ -111,13 +115,8 @@ fn ball() -> Step {
             start.elapsed()
         };
         let (one, eleven) = (run(1), run(11));
-        STEP_OVERRIDE.with(|o| o.set(Some(eleven.saturating_sub(one).as_secs_f64() / 10.0)));
+        Some(eleven.saturating_sub(one).as_secs_f64() / 10.0)
     })
-}
-
-thread_local! {
-    /// A step that times itself (the ball's difference of two runs) leaves its figure here.
-    static STEP_OVERRIDE: std::cell::Cell<Option<f64>> = const { std::cell::Cell::new(None) };
 }
 
 const WORKLOADS: &[Workload] = &[
@@ -154,9 +153,8 @@ fn time_workload(workload: &Workload, quick: bool) -> (f64, usize) {
     let samples = (0..repeats)
         .map(|_| {
             let start = Instant::now();
-            step();
-            let elapsed = start.elapsed().as_secs_f64();
-            STEP_OVERRIDE.with(|o| o.take()).unwrap_or(elapsed)
+            let own = step();
+            own.unwrap_or(start.elapsed().as_secs_f64())
         })
         .collect();
     (median(samples), repeats)

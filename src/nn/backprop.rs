@@ -123,9 +123,7 @@ impl<'a> Dense<'a> {
         if !want_dx {
             return Vec::new();
         }
-        let mut dx = vec![0.0; rows * i];
-        matmul(view_mut(&mut dx, rows, i), Accum::Replace, view(dy, rows, o), view(&self.weight, o, i));
-        dx
+        self.backward_input(dy, rows)
     }
 }
 

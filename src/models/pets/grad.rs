@@ -202,8 +202,8 @@ impl<'a> EnsembleNet<'a> {
 
     /// The loss mbrl-lib trains on, for inputs [members, rows, in] (normalized) and targets
     /// [members, rows, target_dim]: per member the mean over rows and outputs of ½((μ − y)² e^{−log σ²} +
-    /// log σ²), summed over members, plus 0.01 (Σ max_logvar − Σ min_logvar). With `want_gradients`, also its
-    /// gradient for every tensor of `params` (the set these layers view), left in `ws.gradients`.
+    /// log σ²), summed over members, plus 0.01 (Σ max_logvar − Σ min_logvar). Also its gradient for every
+    /// tensor of `params` (the set these layers view), left in `ws.gradients`.
     pub fn loss_and_gradients(
         &self,
         params: &ParamSet,
@@ -211,7 +211,6 @@ impl<'a> EnsembleNet<'a> {
         inputs: &[f32],
         targets: &[f32],
         rows: usize,
-        want_gradients: bool,
     ) -> f64 {
         let (e, d) = (self.members, self.target_dim);
         self.forward(ws, inputs, rows);
@@ -240,11 +239,6 @@ impl<'a> EnsembleNet<'a> {
         }
         let penalty = BOUNDS_PENALTY * (self.max_logvar.iter().sum::<f32>() - self.min_logvar.iter().sum::<f32>());
         let loss = member_sums.iter().map(|s| s / (rows * d) as f64).sum::<f64>() + f64::from(penalty);
-        if !want_gradients {
-            ws.d_output = d_output;
-            return loss;
-        }
-
         if ws.gradients.len() != params.tensors.len() {
             ws.gradients = zero_gradients(params);
         }
@@ -329,8 +323,8 @@ mod tests {
             let mut ws = Workspace::default();
             // Twice on one workspace: what the first pass leaves behind must not leak into the second.
             let other_inputs: Vec<f32> = inputs.iter().rev().copied().collect();
-            fused.loss_and_gradients(&params, &mut ws, &other_inputs, &targets, rows, true);
-            let loss = fused.loss_and_gradients(&params, &mut ws, &inputs, &targets, rows, true);
+            fused.loss_and_gradients(&params, &mut ws, &other_inputs, &targets, rows);
+            let loss = fused.loss_and_gradients(&params, &mut ws, &inputs, &targets, rows);
             let grads = ws.gradients;
             let theirs = scalar(&reference_loss);
             assert!((loss - theirs).abs() < 1e-4 * (1.0 + theirs.abs()), "case {case}: loss {loss} vs {theirs}");
@@ -360,7 +354,7 @@ mod tests {
             pool.install(|| {
                 let fused = EnsembleNet::new(&params, &config, din, dout).unwrap();
                 let mut ws = Workspace::default();
-                let loss = fused.loss_and_gradients(&params, &mut ws, &inputs, &targets, rows, true);
+                let loss = fused.loss_and_gradients(&params, &mut ws, &inputs, &targets, rows);
                 (loss.to_bits(), ws.gradients)
             })
         };

@@ -104,7 +104,7 @@ impl TrainingMethod for PetsTrainer {
             }
         }
         let net = EnsembleNet::new(&self.params, &self.config, din, dout)?;
-        let value = net.loss_and_gradients(&self.params, &mut self.workspace, inputs, targets, b, true);
+        let value = net.loss_and_gradients(&self.params, &mut self.workspace, inputs, targets, b);
         if !value.is_finite() {
             return Ok(value);
         }
