@@ -1,6 +1,8 @@
 //! The "silent garbage" check of the extremes mode: a run that exits 0 on an absurd input must not have written
-//! non-finite numbers. Outputs are scanned for the spellings of NaN and infinity; what the unmutated seed's run
-//! writes too is not counted. JSON's `null` (what serde writes for a non-finite float) is not counted: too many
+//! non-finite numbers, nor a dataset that mbrl's own readers refuse. Outputs are scanned for the spellings of NaN
+//! and infinity, and the MCAP messages (JSON) for a float beyond the ±1e9 every dataset reader accepts (states,
+//! actions, rewards, times: no recording holds such a value); what the unmutated seed's run writes too is not
+//! counted. JSON's `null` (what serde writes for a non-finite float) is not counted: too many
 //! fields are legitimately absent (no validation split, no best step), and a NaN would be caught as a diverged
 //! loss or in the CSV tables and reports beside it.
 
@@ -53,11 +55,35 @@ fn scan_mcap(bytes: &[u8], found: &mut BTreeSet<String>) {
     let Ok(records) = mcap::read::ChunkFlattener::new(bytes) else { return };
     for record in records {
         match record {
-            Ok(Record::Message { data, .. }) => scan(&String::from_utf8_lossy(&data), found),
+            Ok(Record::Message { data, .. }) => {
+                let text = String::from_utf8_lossy(&data);
+                scan(&text, found);
+                if let Ok(value) = serde_json::from_str::<serde_json::Value>(&text) {
+                    scan_magnitudes(&value, found);
+                }
+            }
             Ok(Record::Metadata(m)) => m.metadata.values().for_each(|v| scan(v, found)),
             Ok(_) => {}
             Err(_) => return,
         }
+    }
+}
+
+/// The largest magnitude a dataset reader accepts in a recorded value.
+const RECORDED_LIMIT: f64 = mbrl::data::dataset::RECORDED.hi;
+
+/// Marks a float (not an integer: ids, steps and seeds may be large) beyond [`RECORDED_LIMIT`] anywhere in a
+/// message.
+fn scan_magnitudes(value: &serde_json::Value, found: &mut BTreeSet<String>) {
+    match value {
+        serde_json::Value::Number(n) if n.is_f64() => {
+            if n.as_f64().is_some_and(|x| x.abs() > RECORDED_LIMIT) {
+                found.insert(format!("a dataset value beyond ±{RECORDED_LIMIT:e}"));
+            }
+        }
+        serde_json::Value::Array(items) => items.iter().for_each(|v| scan_magnitudes(v, found)),
+        serde_json::Value::Object(fields) => fields.values().for_each(|v| scan_magnitudes(v, found)),
+        _ => {}
     }
 }
 
@@ -83,6 +109,42 @@ mod tests {
         assert_eq!(found.iter().collect::<Vec<_>>(), ["inf", "nan"]);
         let mut found = BTreeSet::new();
         scan("{\"information\":1,\"nano\":2,\"x\":null,\"y\":\"a.inf\"}", &mut found);
+        assert!(found.is_empty(), "{found:?}");
+    }
+
+    /// The whole path: a dataset mbrl writes with one absurd action is marked, the same dataset without it not.
+    #[test]
+    fn an_absurd_recorded_value_in_a_written_dataset_is_marked() {
+        use mbrl::data::collect::{replay, ReplaySettings};
+        let dir = std::env::temp_dir().join(format!("mbrl-fuzz-garbage-{}", std::process::id()));
+        fs::create_dir_all(&dir).unwrap();
+        let found_in = |action: f64| {
+            let settings = ReplaySettings {
+                env: mbrl::envs::parse_env("pendulum").unwrap(),
+                actions: vec![vec![0.5], vec![action]],
+                init_state: None,
+                instance_seed: None,
+                seed: 0,
+                command_line: String::new(),
+            };
+            let path = dir.join(format!("{action:e}.mcap"));
+            mbrl::data::write_dataset(&path, &replay(&settings).unwrap()).unwrap();
+            let mut found = BTreeSet::new();
+            markers(&path, &mut found);
+            found
+        };
+        assert_eq!(found_in(1e300).len(), 1);
+        assert!(found_in(1.5).is_empty());
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn absurd_floats_in_messages_but_not_large_integers() {
+        let mut found = BTreeSet::new();
+        scan_magnitudes(&serde_json::json!({"t": 18446744073709551615u64, "state": [0.5, -2e9]}), &mut found);
+        assert_eq!(found.len(), 1, "{found:?}");
+        let mut found = BTreeSet::new();
+        scan_magnitudes(&serde_json::json!({"t": 18446744073709551615u64, "state": [0.5, 1e9]}), &mut found);
         assert!(found.is_empty(), "{found:?}");
     }
 }

@@ -216,6 +216,27 @@ pub(crate) fn targets() -> Vec<Target> {
             Input::Arg { seed: "0.5,4.5,0,-1" },
             "collect --env lightsout:reacher --actions reacher.csv --init-state={in} --out {out}",
         ),
+        target(
+            "init-state-mountaincar",
+            Input::Arg { seed: "0.2,-0.5" },
+            "collect --env mountaincar --actions actions.csv --init-state={in} --out {out}",
+        ),
+        target(
+            "init-state-toy",
+            Input::Arg { seed: "0.1,-0.2" },
+            "collect --env toy:inner --actions actions.csv --init-state={in} --out {out}",
+        ),
+        // Calibration takes a start of its own, checked by the same rules as a replay's.
+        target(
+            "init-state-calibrate",
+            Input::Arg { seed: "0.1,-0.2" },
+            concat!(
+                "calibrate --model context-model --env toy:inner --instance-seed 1 --strategy random ",
+                "--transitions 2 --init-state={in} --out {out}"
+            ),
+        ),
+        // The number inside an env name.
+        target("env-mass", Input::Arg { seed: "1.5" }, "collect --env pendulum:mass={in} --rollouts 1 --steps 3 --out {out}"),
         // Checkpoints: the files a model is loaded from, and the ones `train --resume` reads besides.
         target(
             "pets-plan",

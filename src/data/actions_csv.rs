@@ -4,6 +4,7 @@
 use std::io::Read;
 use std::path::Path;
 
+use crate::data::dataset::RECORDED;
 use crate::error::{Error, Result};
 
 /// More steps than any experiment needs; a file beyond it is a mistake, not a workload.
@@ -11,7 +12,9 @@ pub const MAX_ACTION_ROWS: usize = 1_000_000;
 /// Bounds what is read at all, so an endless stream (a pipe, /dev/zero) fails instead of filling memory.
 pub const MAX_ACTION_BYTES: u64 = 64 << 20;
 
-/// Reads the actions in `path`, each row exactly `action_dim` finite numbers. The first row is taken as a
+/// Reads the actions in `path`, each row exactly `action_dim` finite numbers within the range every dataset
+/// reader accepts (±1e9): the env clips an action to its bounds when it steps, but the replay records the action
+/// as given, and a dataset its own readers refuse is no output. The first row is taken as a
 /// header when it is not all numbers.
 pub fn read_actions(path: &Path, action_dim: usize) -> Result<Vec<Vec<f64>>> {
     let file = crate::util::bounded_read::open_regular(path)?;
@@ -101,13 +104,9 @@ fn parse_row(path: &Path, row: u64, record: &csv::StringRecord) -> Result<Vec<f6
             let value: f64 = field
                 .parse()
                 .map_err(|_| Error::bad_file(path, format!("row {row}, column {column}: '{field}' is not a number")))?;
-            if !value.is_finite() {
-                return Err(Error::bad_file(
-                    path,
-                    format!("row {row}, column {column}: '{field}' is not finite; expected a finite number"),
-                ));
-            }
-            Ok(value)
+            RECORDED.check(&format!("row {row}, column {column}"), value).map_err(|e| {
+                Error::bad_file(path, format!("{e} (the env clips an action to its bounds; this is no action)"))
+            })
         })
         .collect()
 }
@@ -131,7 +130,9 @@ mod tests {
         let err = parse("u\n1\nabc\n", 1).unwrap_err().to_string();
         assert!(err.starts_with("a.csv: row 3, column 1: 'abc' is not a number"), "{err}");
         let err = parse("1,2\n3,NaN\n", 2).unwrap_err().to_string();
-        assert!(err.contains("row 2, column 2: 'NaN' is not finite"), "{err}");
+        assert!(err.contains("row 2, column 2 = NaN: expected a finite number in [-1e9, 1e9]"), "{err}");
+        let err = parse("1\n-1e300\n", 1).unwrap_err().to_string();
+        assert!(err.contains("row 2, column 1 = -1e300: expected a finite number"), "{err}");
         let err = parse("1\ninf\n", 1).unwrap_err().to_string();
         assert!(err.contains("row 2, column 1") && err.contains("finite"), "{err}");
     }

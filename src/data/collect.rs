@@ -5,6 +5,7 @@ use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
 use super::{Dataset, DatasetLayout, DatasetMeta, Rollout, Timestep};
+use crate::data::dataset::RECORDED;
 use crate::envs::{instance_env, Env, EnvName, EnvSpec, Exploration};
 use crate::error::{Error, Result};
 use crate::run::Monitor;
@@ -128,10 +129,7 @@ pub fn replay(settings: &ReplaySettings) -> Result<Dataset> {
     // Reset even when the start is given: it also seeds the noise of noisy envs from `seed`.
     env.reset(&mut rng_for(settings.seed, &[REPLAY_STREAM]));
     if let Some(state) = &settings.init_state {
-        check_state(&spec, state)?;
-        if let Some(reason) = env.state_error(state) {
-            return Err(Error::config(format!("--init-state: {reason} ({})", spec.state_names.join(","))));
-        }
+        check_start(env.as_ref(), &spec, state)?;
         env.set_state(state);
     }
     let mut rollout = Rollout::start(env.state(), env.observe());
@@ -170,6 +168,21 @@ pub fn parse_state(text: &str, spec: &EnvSpec) -> Result<Vec<f64>> {
         .collect::<Result<Vec<f64>>>()?;
     check_state(spec, &state)?;
     Ok(state)
+}
+
+/// Whether `state` (`--init-state`) is one `env` can start from: its length, finite values, and the env's own
+/// bounds ([`Env::state_error`]).
+pub fn check_start(env: &dyn Env, spec: &EnvSpec, state: &[f64]) -> Result<()> {
+    check_state(spec, state)?;
+    if let Some(reason) = env.state_error(state) {
+        return Err(Error::config(format!("--init-state: {reason} ({})", spec.state_names.join(","))));
+    }
+    // Every env's own bounds lie inside this; it keeps the envs without any (the toy) from recording a start
+    // their dataset's readers refuse.
+    for (name, &x) in spec.state_names.iter().zip(state) {
+        RECORDED.check(name, x).map_err(|e| Error::config(format!("--init-state: {e}")))?;
+    }
+    Ok(())
 }
 
 fn check_state(spec: &EnvSpec, state: &[f64]) -> Result<()> {

@@ -85,7 +85,7 @@ pub struct Dataset {
 const DT: Domain = Domain::above(0.0, 1.0).in_unit("s");
 /// States, actions and rewards of every env stay far inside this (angles, metres, rewards per step); a value
 /// beyond it is no recording, and its square (normalizers, losses) would overflow.
-const RECORDED: Domain = Domain::closed(-1e9, 1e9);
+pub const RECORDED: Domain = Domain::closed(-1e9, 1e9);
 /// The widest action of any env (the Jaco's joints and more): bounds what an action vector may claim.
 const ACTION_DIM: Domain = Domain::count(0, 64);
 

@@ -75,7 +75,7 @@ impl fmt::Display for Domain {
 }
 
 /// A number as a reader would write it: 1e300 rather than its 301 digits.
-fn number(x: f64) -> String {
+pub fn number(x: f64) -> String {
     if x.is_finite() && x != 0.0 && (x.abs() >= 1e6 || x.abs() < 1e-4) {
         format!("{x:e}")
     } else {

@@ -23,6 +23,12 @@ fn non_finite_values_are_rejected() {
     let dir = tempfile::tempdir().unwrap();
     let out = mbrl(dir.path()).args(["collect", "--env", "pendulum:mass=nan", "--out", "x.mcap"]).output().unwrap();
     assert_one_line_error(&out, &["mass=nan", "finite"]);
+    // Finite masses far outside a pendulum's: the torque's effect (∝ 1/m) overflows, or nothing moves.
+    for mass in ["1e300", "5e-324"] {
+        let env = format!("pendulum:mass={mass}");
+        let out = mbrl(dir.path()).args(["collect", "--env", &env, "--out", "x.mcap"]).output().unwrap();
+        assert_one_line_error(&out, &[mass, "[0.001, 1000] kg"]);
+    }
     let out = mbrl(dir.path())
         .args(["plan", "--env", "pendulum", "--model", "true", "--noise", "colored", "--beta", "inf"])
         .output()

@@ -143,8 +143,10 @@ fn rejected(files: &[(&str, &str)], args: &[&str], needles: &[&str]) {
 fn bad_action_files_name_file_row_and_column() {
     let pendulum = ["--env", "pendulum", "--actions", "a.csv"];
     rejected(&[("a.csv", "u\n0.5\n1,2\n")], &pendulum, &["a.csv", "row 3", "2 column(s)", "expected 1"]);
-    rejected(&[("a.csv", "0.5\nNaN\n")], &pendulum, &["a.csv", "row 2, column 1", "'NaN' is not finite"]);
-    rejected(&[("a.csv", "0.5\n1e400\n")], &pendulum, &["a.csv", "row 2, column 1", "not finite"]);
+    rejected(&[("a.csv", "0.5\nNaN\n")], &pendulum, &["a.csv", "row 2, column 1 = NaN", "expected a finite number"]);
+    rejected(&[("a.csv", "0.5\n1e400\n")], &pendulum, &["a.csv", "row 2, column 1 = inf", "finite number"]);
+    // Finite but beyond what any dataset reader takes back: the replay would record it as given.
+    rejected(&[("a.csv", "0.5\n1e300\n")], &pendulum, &["a.csv", "row 2, column 1 = 1e300", "[-1e9, 1e9]"]);
     rejected(&[("a.csv", "u\n0.5\nfast\n")], &pendulum, &["a.csv", "row 3, column 1", "'fast' is not a number"]);
     rejected(&[("a.csv", "")], &pendulum, &["a.csv", "no action rows"]);
     rejected(&[], &pendulum, &["a.csv"]);
@@ -168,6 +170,15 @@ fn bad_init_states_are_explained() {
         &["--env", "toy:outer", "--actions", "a.csv", "--init-state", "0,zero"],
         &["'zero' is not a number"],
     );
+    // Finite starts outside the env's bounds (its clipping, its walls), or beyond what a dataset holds.
+    let pendulum = ["--env", "pendulum", "--actions", "a.csv", "--init-state"];
+    rejected(&files, &[&pendulum[..], &["0,9"]].concat(), &["theta_dot = 9", "[-8, 8] rad/s"]);
+    rejected(&files, &[&pendulum[..], &["1e300,0"]].concat(), &["theta = 1e300", "[-1000, 1000] rad"]);
+    let car = ["--env", "mountaincar", "--actions", "a.csv", "--init-state"];
+    rejected(&files, &[&car[..], &["1.5,0"]].concat(), &["x = 1.5", "[-1, 1] m"]);
+    rejected(&files, &[&car[..], &["0,-11"]].concat(), &["x_dot = -11", "[-10, 10] m/s"]);
+    let toy = ["--env", "toy:inner", "--actions", "a.csv", "--init-state", "-1e300,0"];
+    rejected(&files, &toy, &["s1 = -1e300", "[-1e9, 1e9]"]);
 }
 
 #[test]

@@ -53,6 +53,24 @@ fn collect_train_calibrate_plan() {
     let calib = read_dataset(&d.join("calib.mcap")).unwrap();
     assert_eq!(calib.steps.len(), 4);
     assert_eq!(calib.meta.env, "pendulum:quadrant");
+    // A start this pendulum cannot be in (it clips θ̇ to ±8 after every step) is refused, not calibrated from.
+    let out = mbrl(d)
+        .args([
+            "calibrate",
+            "--model",
+            "models/c",
+            "--env",
+            "pendulum:quadrant",
+            "--init-state",
+            "3,9",
+            "--instance-seed",
+            "3",
+        ])
+        .args(["--strategy", "random", "--transitions", "2", "--out", "bad.mcap", "--no-tui"])
+        .output()
+        .unwrap();
+    assert_one_line_error(&out, &["--init-state", "theta_dot = 9", "[-8, 8] rad/s"]);
+    assert!(!d.join("bad.mcap").exists());
 
     let text = run_ok(
         d,

@@ -101,9 +101,9 @@ fn bad_input_gives_one_line_and_no_file() {
     write(dir.path(), "wide.csv", "0,0,0,0\n");
     write(dir.path(), "nan.csv", "0,0,-1\n0,NaN,1\n");
     write(dir.path(), "ok.csv", "0,0,-1\n");
-    let cases: [(&[&str], &[&str]); 6] = [
+    let cases: [(&[&str], &[&str]); 7] = [
         (&["--env", "lightsout:cursor", "--actions", "wide.csv"], &["wide.csv", "row 1 has 4 column(s); expected 3"]),
-        (&["--env", "tileswap:reacher", "--actions", "nan.csv"], &["nan.csv", "row 2, column 2", "not finite"]),
+        (&["--env", "tileswap:reacher", "--actions", "nan.csv"], &["nan.csv", "row 2, column 2", "finite number"]),
         (
             &["--env", "lightsout:cursor", "--actions", "ok.csv", "--init-state", "0.5"],
             &["--init-state", "cursor_x,cursor_y"],
@@ -113,6 +113,10 @@ fn bad_input_gives_one_line_and_no_file() {
             &["cursor_y = -0.1", "[0, 1]"],
         ),
         (&["--env", "tileswap:reacher", "--actions", "ok.csv", "--init-state", "0,7,0,0"], &["wrist_angle = 7", "2π"]),
+        (
+            &["--env", "tileswap:reacher", "--actions", "ok.csv", "--init-state", "0,0,0,-51"],
+            &["wrist_velocity = -51", "[-50, 50] rad/s"],
+        ),
         (&["--env", "tileswap:cursor", "--actions", "ok.csv", "--board", "0,1,2,3,4,5,6,7,7"], &["--board", "chip 7"]),
     ];
     for (args, needles) in cases {

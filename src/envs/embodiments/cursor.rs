@@ -4,6 +4,7 @@ use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
 use super::manipulator::{BoardPoint, Manipulator, ScriptedController};
+use crate::util::domain::number;
 
 /// Largest move per step along each axis. The authors' action space is a float32 box of ±0.2 and moves are
 /// clipped to its bounds, so the bound is 0.2 rounded to float32 (0.20000000298023224): three clipped moves
@@ -61,7 +62,7 @@ impl Manipulator for Cursor {
             .iter()
             .zip(names)
             .find(|(v, _)| !(0.0..=1.0).contains(*v))
-            .map(|(v, name)| format!("{name} = {v} is off the board; expected a value in [0, 1]"))
+            .map(|(v, name)| format!("{name} = {} is off the board; expected a value in [0, 1]", number(*v)))
     }
 
     fn set_state(&mut self, state: &[f64]) {

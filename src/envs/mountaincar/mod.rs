@@ -12,6 +12,10 @@ pub use dynamics::{MountainCarDynamics, DT, MAX_ACCEL, X_LIMIT};
 pub use terrain::{Bump, Terrain, WALLS};
 
 use crate::envs::{Dynamics, Env, EnvSpec, Step};
+use crate::util::domain::Domain;
+
+/// The fastest start `--init-state` takes, in m/s either way (see [`MountainCar::state_error`]).
+const MAX_SPEED: f64 = 10.0;
 
 pub struct MountainCar {
     dynamics: MountainCarDynamics,
@@ -74,6 +78,14 @@ impl Env for MountainCar {
 
     fn set_state(&mut self, state: &[f64]) {
         self.state = [state[0], state[1]];
+    }
+
+    /// The car lives between the walls; its acceleration is at most about 13 m/s² on a 2 m track, so from the
+    /// reset's ±2 m/s it gets little past 7.5 m/s before a wall stops it.
+    fn state_error(&self, state: &[f64]) -> Option<String> {
+        let x = Domain::closed(-X_LIMIT, X_LIMIT).in_unit("m").check("x", state[0]);
+        let x_dot = Domain::closed(-MAX_SPEED, MAX_SPEED).in_unit("m/s").check("x_dot", state[1]);
+        x.and(x_dot).err().map(|e| e.to_string())
     }
 
     fn observe(&self) -> Vec<f64> {

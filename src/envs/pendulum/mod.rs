@@ -14,6 +14,10 @@ pub use params::{angle_normalize, quadrant_of, PendulumParams, QuadrantActuator}
 pub use variant::PendulumVariant;
 
 use crate::envs::{Dynamics, Env, EnvSpec, Step};
+use crate::util::domain::Domain;
+
+/// The widest start angle `--init-state` takes, in radians either way.
+const THETA_LIMIT: f64 = 1e3;
 
 /// How an episode starts.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -90,6 +94,16 @@ impl Env for Pendulum {
 
     fn set_state(&mut self, state: &[f64]) {
         self.state = [state[0], state[1]];
+    }
+
+    /// θ is not wrapped (gym keeps it as integrated), but a start wound more than ~160 turns is none a rollout
+    /// reaches and cos/sin of it keep few digits; θ̇ is clipped to ±max_speed after every step, so a faster start
+    /// is no state of this pendulum.
+    fn state_error(&self, state: &[f64]) -> Option<String> {
+        let speed = self.params.max_speed;
+        let theta = Domain::closed(-THETA_LIMIT, THETA_LIMIT).in_unit("rad").check("theta", state[0]);
+        let theta_dot = Domain::closed(-speed, speed).in_unit("rad/s").check("theta_dot", state[1]);
+        theta.and(theta_dot).err().map(|e| e.to_string())
     }
 
     fn observe(&self) -> Vec<f64> {

@@ -5,6 +5,7 @@ use rand_chacha::ChaCha8Rng;
 
 use super::params::{PendulumParams, QuadrantActuator};
 use crate::error::{Error, Result};
+use crate::util::domain::Domain;
 use crate::util::suggest::did_you_mean;
 
 #[derive(Clone, Debug, PartialEq)]
@@ -22,6 +23,10 @@ pub enum PendulumVariant {
 pub const VARIANT_HELP: &str = "light (m=0.2), heavy (m=1.5), mass=<m>, inverted, quadrant";
 
 /// The named variants (all but `mass=<m>`), as `pendulum:<name>` takes them.
+/// A gram to a tonne (the thesis' family spans 0.2-1.5 kg). The torque's effect scales as 1/m: far below a gram
+/// it overflows (and a zero action then gives NaN), far above a tonne the actuator moves nothing.
+const MASS: Domain = Domain::closed(1e-3, 1e3).in_unit("kg");
+
 pub const VARIANT_NAMES: [&str; 4] = ["light", "heavy", "inverted", "quadrant"];
 
 impl PendulumVariant {
@@ -39,13 +44,11 @@ impl PendulumVariant {
             other => {
                 let value = other.strip_prefix("mass=").ok_or_else(bad)?;
                 let mass: f64 = value.parse().map_err(|_| {
-                    Error::config(format!("pendulum variant 'mass={value}': expected a positive number"))
+                    Error::config(format!("pendulum variant 'mass={value}': expected a number, the mass in kg"))
                 })?;
-                if !mass.is_finite() || mass <= 0.0 {
-                    return Err(Error::config(format!(
-                        "pendulum variant 'mass={value}': expected a positive finite mass"
-                    )));
-                }
+                let mass = MASS
+                    .check("mass", mass)
+                    .map_err(|e| Error::config(format!("pendulum variant 'mass={value}': {e}")))?;
                 Ok(PendulumVariant::Mass(mass))
             }
         }

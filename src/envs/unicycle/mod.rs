@@ -15,6 +15,7 @@ pub use params::RobotParams;
 
 use super::terrain::TerrainMap;
 use super::{Dynamics, Env, EnvSpec, Exploration, Step};
+use crate::util::domain::number;
 
 /// The maps an instance may be drawn on: one map, or one split of a map set.
 #[derive(Debug)]
@@ -147,10 +148,10 @@ impl Env for Unicycle {
     fn state_error(&self, state: &[f64]) -> Option<String> {
         let [x, y, v] = [state[0], state[1], state[2]];
         if !((0.0..=1.0).contains(&x) && (0.0..=1.0).contains(&y)) {
-            return Some(format!("the position ({x}, {y}) is outside the map [0, 1]²"));
+            return Some(format!("the position ({}, {}) is outside the map [0, 1]²", number(x), number(y)));
         }
         if v.abs() > MAX_SPEED {
-            return Some(format!("the speed {v} is beyond ±{MAX_SPEED} m/s"));
+            return Some(format!("the speed {} is beyond ±{MAX_SPEED} m/s", number(v)));
         }
         None
     }

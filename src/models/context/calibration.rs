@@ -325,14 +325,7 @@ pub fn run_calibration(
     env.reset(&mut rng_for(request.seed, &[3]));
     let drawn_start = default_start(&request.env, &mut rng_for(request.seed, &[4]));
     if let Some(start) = request.init_state.clone().or(drawn_start) {
-        if start.len() != spec.state_dim() || start.iter().any(|x| !x.is_finite()) {
-            return Err(Error::config(format!(
-                "--init-state needs {} finite values ({}), got {}",
-                spec.state_dim(),
-                spec.state_names.join(", "),
-                start.len()
-            )));
-        }
+        crate::data::collect::check_start(env.as_ref(), &spec, &start)?;
         env.set_state(&start);
     }
     let names = spec.state_names.clone();

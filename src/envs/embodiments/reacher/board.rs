@@ -6,8 +6,9 @@ use std::f64::consts::TAU;
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
-use super::{Reacher, ACTION_REPEAT, BOARD_HALF_EXTENT, PUSH_THRESHOLD, SKILL_STEP_LIMIT, TIMESTEP};
+use super::{Reacher, ACTION_REPEAT, BOARD_HALF_EXTENT, DAMPING, GEAR, PUSH_THRESHOLD, SKILL_STEP_LIMIT, TIMESTEP};
 use crate::envs::embodiments::manipulator::{BoardPoint, Manipulator};
+use crate::util::domain::{number, Domain};
 
 /// Arm plane → board coordinates, as the authors' `ReacherEnv._get_finger_pos` normalizes MuJoCo's world
 /// x and y: both as (xy + 0.15)/0.3, so board columns grow with arm +x and board rows with arm +y.
@@ -72,12 +73,24 @@ impl Manipulator for Reacher {
         vec![self.q[0], self.q[1], self.v[0], self.v[1]]
     }
 
-    /// The shoulder turns freely. The wrist may lie past its ±160° stops (the authors' reset leaves it
-    /// there and the soft limit brings it back), but not more than a turn from zero, where the reset draws.
+    /// The shoulder turns freely, but a start wound more than ~160 turns is none an episode reaches (and
+    /// cos/sin of it keep few digits). The wrist may lie past its ±160° stops (the authors' reset leaves it there
+    /// and the soft limit brings it back), but not more than a turn from zero, where the reset draws. The motors'
+    /// top torque against the joints' damping holds a joint at GEAR / DAMPING = 5 rad/s; ten times that is
+    /// no state the arm gets into.
     fn state_problem(&self, state: &[f64]) -> Option<String> {
-        let wrist = state.get(1).copied()?;
-        (wrist.abs() > TAU)
-            .then(|| format!("wrist_angle = {wrist} is more than a full turn; expected radians in [-2π, 2π]"))
+        let speed = Domain::closed(-10.0 * GEAR / DAMPING, 10.0 * GEAR / DAMPING).in_unit("rad/s");
+        let wrist = *state.get(1)?;
+        if wrist.abs() > TAU {
+            let wrist = number(wrist);
+            return Some(format!("wrist_angle = {wrist} is more than a full turn; expected radians in [-2π, 2π]"));
+        }
+        let checks = [
+            Domain::closed(-1e3, 1e3).in_unit("rad").check("shoulder_angle", *state.first()?),
+            speed.check("shoulder_velocity", *state.get(2)?),
+            speed.check("wrist_velocity", *state.get(3)?),
+        ];
+        checks.into_iter().find_map(|c| c.err()).map(|e| e.to_string())
     }
 
     fn set_state(&mut self, state: &[f64]) {
