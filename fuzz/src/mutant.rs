@@ -36,6 +36,16 @@ pub(crate) fn mutant_rng(target: &str, index: u64, campaign: u64) -> ChaCha8Rng 
 /// Writes mutant `index` (or the unmutated seed, for `None`) of `target` into `work`.
 pub(crate) fn prepare(target: &Target, seeds: &Path, work: &Path, index: Option<u64>, campaign: u64) -> Mutant {
     let label = index.map_or("seed".to_string(), |i| i.to_string());
+    prepare_as(target, seeds, work, index, campaign, &label)
+}
+
+/// An unmutated copy of the seed under the name `label`, for a mutant that changes it afterwards: each mutant
+/// its own name, so that mutants of one target prepared side by side never share a path.
+pub(crate) fn unmutated_copy(target: &Target, seeds: &Path, work: &Path, label: &str) -> Mutant {
+    prepare_as(target, seeds, work, None, 0, label)
+}
+
+fn prepare_as(target: &Target, seeds: &Path, work: &Path, index: Option<u64>, campaign: u64, label: &str) -> Mutant {
     let mut rng = mutant_rng(target.name, index.unwrap_or(u64::MAX), campaign);
     match target.input {
         Input::File { seed, kind } => {

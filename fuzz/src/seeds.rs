@@ -116,6 +116,10 @@ pub(crate) fn generate_seeds(dir: &Path) -> Result<(), String> {
     make(dir, "train --method tradyn --data uni.mcap --config context.toml --steps 3 --out tradyn-model")?;
     make(
         dir,
+        "train --method tradyn --data uni.mcap --config context.toml --steps 3 --no-terrain --out tradyn-model-nt",
+    )?;
+    make(
+        dir,
         "calibrate --model tradyn-model --env unicycle --map map.png --instance-seed 1 --strategy random --transitions 3 \
          --out calib-uni.mcap",
     )?;

@@ -72,6 +72,7 @@ macro_rules! cheap_plan {
 /// Every reader, with a cheap command that reaches it.
 pub(crate) fn targets() -> Vec<Target> {
     const MODEL_FILES: &[&str] = &["checkpoint.json", "config.json", "model.safetensors"];
+    const EKF_FILES: &[&str] = &["checkpoint.json", "config.json", "params.json", "spin_net.json", "model.safetensors"];
     vec![
         // Datasets of each kind.
         target("rollouts-eval", mcap("roll.mcap"), "eval dataset --input {in} --out {out}"),
@@ -123,7 +124,7 @@ pub(crate) fn targets() -> Vec<Target> {
         },
         Target { program: Program::BoardSetReader, ..target("boardset-read", mcap("boards.mcap"), "read-board-set {in}") },
         target("ball-filter", mcap("ball.mcap"), "filter --model thesis --input {in} --out {out}"),
-        target("ball-predict", mcap("ball.mcap"), "predict --model ekf --input {in} --horizon 0.2s"),
+        target("ball-predict", mcap("ball.mcap"), "predict --model ekf --input {in} --horizon 0.2s --out {out}"),
         target("ball-train", mcap("ball.mcap"), "train --method ball-ekf --data {in} --steps 1 --batch 4 --out {out}"),
         // Text files.
         target("estimates-export", mcap("filtered.mcap"), "export --input {in} --format npz --out {out}"),
@@ -295,11 +296,8 @@ pub(crate) fn targets() -> Vec<Target> {
         ),
         target(
             "ekf-predict",
-            Input::Checkpoint {
-                dir: "ekf",
-                files: &["checkpoint.json", "config.json", "params.json", "spin_net.json", "model.safetensors"],
-            },
-            "predict --model {in} --input ball.mcap --horizon 0.2s",
+            Input::Checkpoint { dir: "ekf", files: EKF_FILES },
+            "predict --model {in} --input ball.mcap --horizon 0.2s --out {out}",
         ),
         target(
             "ekf-resume",
@@ -331,6 +329,33 @@ pub(crate) fn targets() -> Vec<Target> {
             "seads-eval-incomplete",
             Input::Checkpoint { dir: "seads-resume", files: MODEL_FILES },
             "eval seads --model {in} --max-depth 1 --boards 1 --coverage-boards 1 --allow-incomplete --out {out}",
+        ),
+        // The evals that plan or fit with tiny settings, for their numeric flags and the models they load.
+        target(
+            "swingup-eval",
+            Input::Checkpoint { dir: "pets", files: MODEL_FILES },
+            concat!(
+                "eval pendulum-swingup --model {in} --episodes 1 --steps 25 --particles 2 --horizon 3 ",
+                "--candidates 16 --elites 4 --iters 1 --out {out}"
+            ),
+        ),
+        target(
+            "tradyn-eval",
+            Input::Checkpoint { dir: "tradyn-model-nt", files: MODEL_FILES },
+            concat!(
+                "eval tradyn --model-terrain tradyn-model --model-no-terrain {in} --maps terrain --tasks 2 ",
+                "--transitions 2 --steps 2 --horizon 3 --candidates 16 --elites 4 --iters 1 --prediction-steps 2 --out {out}"
+            ),
+        ),
+        target(
+            "ekf-eval",
+            Input::Checkpoint { dir: "ekf", files: EKF_FILES },
+            "eval ball --model {in} --train-shots 2 --test-shots 1 --unseen-shots 1 --augment-rotations 0 --out {out}",
+        ),
+        target(
+            "embodied-eval",
+            Input::Arg { seed: "lightsout" },
+            "eval embodied --game={in} --embodiment cursor --max-depth 1 --boards 1 --out {out}",
         ),
     ]
 }

@@ -58,7 +58,19 @@ pub fn run_episode<E: Env + ?Sized, A: Agent + ?Sized>(
         }
         let state = env.state();
         let action = agent.act(t, &state, &observation)?;
+        if let Some(bad) = action.iter().find(|a| !a.is_finite()) {
+            return Err(Error::diverged(format!("episode step {t}: the agent chose a non-finite action ({bad})")));
+        }
         let step = env.step(&action);
+        // Caught where it first appears: past this step every later state, plan and report would carry it.
+        if !step.reward.is_finite() || env.state().iter().any(|x| !x.is_finite()) {
+            return Err(Error::diverged(format!(
+                "episode step {t}: the simulator's state or reward became non-finite (state {:?}, reward {}) \
+                 after action {action:?}",
+                env.state(),
+                step.reward
+            )));
+        }
         let transition = Transition {
             t,
             state,
@@ -148,5 +160,41 @@ mod tests {
         });
         assert!(out.as_ref().is_err_and(|e| e.is_cancelled()));
         assert_eq!(agent.seen, vec![0, 1]);
+    }
+
+    /// Acts 0.5 until step 2, then NaN.
+    struct Broken;
+
+    impl Agent for Broken {
+        fn reset(&mut self) -> Result<()> {
+            Ok(())
+        }
+
+        fn act(&mut self, t: usize, _state: &[f64], _observation: &[f64]) -> Result<Vec<f64>> {
+            Ok(vec![if t < 2 { 0.5 } else { f64::NAN }])
+        }
+    }
+
+    #[test]
+    fn a_non_finite_action_stops_the_episode_at_its_step() {
+        let mut env = Pendulum::new(PendulumVariant::parse("").unwrap());
+        let mut steps = 0;
+        let err = run_episode(&mut env, &mut Broken, 5, &NullMonitor, |_, _, _| {
+            steps += 1;
+            Ok(())
+        })
+        .unwrap_err();
+        assert!(err.to_string().contains("episode step 2: the agent chose a non-finite action"), "{err}");
+        assert_eq!(steps, 2, "the two finite steps ran");
+    }
+
+    #[test]
+    fn a_simulator_state_turning_non_finite_stops_the_episode_at_that_step() {
+        let mut env = Pendulum::new(PendulumVariant::parse("").unwrap());
+        env.set_state(&[f64::INFINITY, 0.0]);
+        let mut agent = Bang { resets: 0, seen: Vec::new() };
+        let err = run_episode(&mut env, &mut agent, 5, &NullMonitor, |_, _, _| Ok(())).unwrap_err();
+        assert!(err.to_string().contains("episode step 0: the simulator's state or reward became non-finite"), "{err}");
+        assert!(agent.seen.is_empty());
     }
 }

@@ -79,4 +79,43 @@ mod tests {
         assert!(collect.iter().any(|f| f == "--rollouts"), "{collect:?}");
         assert!(numeric_flags("watch {in}").is_empty());
     }
+
+    /// Every numeric flag of every subcommand (a method's or eval protocol's own, or one it inherits from its
+    /// command) is a site of some target, so each gets the extremes.
+    #[test]
+    fn every_numeric_flag_of_every_subcommand_is_fuzzed() {
+        fn declared(command: &Command, path: String, found: &mut Vec<(String, String)>) {
+            for arg in command.get_arguments().filter(|a| numeric(a)) {
+                found.push((path.clone(), format!("--{}", arg.get_long().unwrap())));
+            }
+            for sub in command.get_subcommands() {
+                declared(sub, format!("{path} {}", sub.get_name()), found);
+            }
+        }
+        let root = mbrl();
+        let mut all = Vec::new();
+        declared(&root, String::new(), &mut all);
+        // Each target's command path (` eval tradyn`) with the flags it reaches there, its ancestors' included.
+        let mut reached = Vec::new();
+        for target in crate::targets::targets() {
+            let (mut command, mut path) = (&root, String::new());
+            let mut tokens = target.args.split_whitespace();
+            while let Some(token) = tokens.next() {
+                let name = if token == "--method" { tokens.next() } else { Some(token) };
+                if let Some(sub) = name.filter(|n| !n.starts_with('-')).and_then(|n| command.find_subcommand(n)) {
+                    command = sub;
+                    path = format!("{path} {}", sub.get_name());
+                }
+            }
+            reached.push((path, numeric_flags(target.args)));
+        }
+        let missed: Vec<String> = all
+            .iter()
+            .filter(|(path, flag)| {
+                !reached.iter().any(|(p, flags)| p.starts_with(path.as_str()) && flags.contains(flag))
+            })
+            .map(|(path, flag)| format!("{path} {flag}"))
+            .collect();
+        assert!(missed.is_empty(), "numeric flags no target reaches: {missed:?}");
+    }
 }

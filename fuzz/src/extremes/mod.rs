@@ -178,7 +178,8 @@ fn pair(index: u64, campaign: u64, pairs: u64) -> u64 {
 /// Writes extreme mutant `index` of `target` into `work`.
 pub(crate) fn prepare(target: &Target, seeds: &Path, work: &Path, index: u64, campaign: u64) -> Mutant {
     let plan = plan(target, seeds);
-    let mut mutant = crate::mutant::prepare(target, seeds, work, None, campaign);
+    let label = index.to_string();
+    let mut mutant = crate::mutant::unmutated_copy(target, seeds, work, &label);
     if plan.pairs == 0 {
         mutant.description = "no numeric field or flag: seed unmutated".into();
         return mutant;
@@ -196,7 +197,6 @@ pub(crate) fn prepare(target: &Target, seeds: &Path, work: &Path, index: u64, ca
             }
         })
         .unwrap();
-    let label = format!("{index}");
     let what = format!("{} = {}", site.shown(), extreme.shown());
     match site {
         Site::Flag(flag) => {
@@ -213,7 +213,7 @@ pub(crate) fn prepare(target: &Target, seeds: &Path, work: &Path, index: u64, ca
             };
             let Some(new) = fields::apply(*format, &bytes, field, extreme) else {
                 mutant.description = format!("{what}: not writable, seed unmutated");
-                return relabel(mutant, work, &label);
+                return mutant;
             };
             match (target.input, file) {
                 (Input::Arg { .. }, _) => {
@@ -231,19 +231,6 @@ pub(crate) fn prepare(target: &Target, seeds: &Path, work: &Path, index: u64, ca
         }
     }
     mutant.description = what;
-    relabel(mutant, work, &label)
-}
-
-/// The mutant is made from the seed's copy; it is renamed to its index so that failures keep their numbers.
-fn relabel(mut mutant: Mutant, work: &Path, label: &str) -> Mutant {
-    let name = mutant.path.file_name().unwrap().to_string_lossy().replacen("seed", label, 1);
-    let to = work.join(name);
-    let _ = fs::remove_dir_all(&to).or_else(|_| fs::remove_file(&to));
-    fs::rename(&mutant.path, &to).unwrap();
-    if mutant.input == mutant.path.as_os_str() {
-        mutant.input = to.clone().into_os_string();
-    }
-    mutant.path = to;
     mutant
 }
 

@@ -10,6 +10,17 @@
 use serde::{Deserialize, Serialize};
 
 use super::BallModelError;
+use crate::util::domain::Domain;
+
+/// Entries of the impact matrix C (eq. 6.26): the thesis' trained ones lie within ±1.5; ten would multiply a
+/// velocity or spin tenfold at every bounce.
+const IMPACT_COEFFICIENT: Domain = Domain::closed(-10.0, 10.0);
+/// Every variance of the model (positions in m², velocities in (m/s)², spins and coefficients in their units²):
+/// positive, from far below any camera's noise to far above any flight's spread.
+const VARIANCE: Domain = Domain::closed(1e-20, 1e6);
+/// a_d and a_m, whose squares (plus ε) are the drag and Magnus coefficients: the thesis' are 0.22 and 1.2e-5;
+/// at 10 drag would stop a 20 m/s ball within a frame.
+const COEFFICIENT_ROOT: Domain = Domain::closed(-10.0, 10.0);
 
 /// Constants of the recording setup, not learned.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -125,14 +136,19 @@ impl BallModelParams {
         }
     }
 
-    /// Rejects what would break the filter later far from its cause: non-finite entries, non-positive variances,
-    /// a non-positive step.
+    /// Rejects what would break the filter later far from its cause, or make it predict nonsense: each value
+    /// within a range no table-tennis set-up (nor the thesis' trained model) comes near the ends of.
     pub fn validate(&self) -> Result<(), BallModelError> {
-        let bad = |field: &'static str, message: &str| {
-            Err(BallModelError::InvalidParameter { field, message: message.to_string() })
+        let check = |field: &'static str, path: String, domain: Domain, x: f64| {
+            domain
+                .check(&path, x)
+                .map(|_| ())
+                .map_err(|e| BallModelError::InvalidParameter { field, message: e.to_string() })
         };
-        if self.c.iter().flatten().any(|x| !x.is_finite()) {
-            return bad("c", "entries must be finite");
+        for (i, row) in self.c.iter().enumerate() {
+            for (j, &x) in row.iter().enumerate() {
+                check("c", format!("c[{i}][{j}]"), IMPACT_COEFFICIENT, x)?;
+            }
         }
         let variances: [(&'static str, &[f64]); 8] = [
             ("q_diag", &self.q_diag),
@@ -145,37 +161,25 @@ impl BallModelParams {
             ("a_m_var", std::slice::from_ref(&self.a_m_var)),
         ];
         for (field, values) in variances {
-            if values.iter().any(|&x| !(x.is_finite() && x > 0.0)) {
-                return bad(field, "variances must be finite and > 0");
+            for (i, &x) in values.iter().enumerate() {
+                let path = if values.len() == 1 { field.to_string() } else { format!("{field}[{i}]") };
+                check(field, path, VARIANCE, x)?;
             }
         }
         for (field, x) in [("a_d0", self.a_d0), ("a_m0", self.a_m0)] {
-            if !x.is_finite() {
-                return bad(field, "must be finite");
-            }
+            check(field, field.to_string(), COEFFICIENT_ROOT, x)?;
         }
         let p = &self.physics;
-        for (field, x) in [("physics.dt", p.dt), ("physics.gravity", p.gravity), ("physics.ball_radius", p.ball_radius)]
-        {
-            if !(x.is_finite() && x > 0.0) {
-                return bad(field, "must be finite and > 0");
-            }
-        }
-        // Bounds that any table-tennis set-up meets; beyond them the flight arithmetic overflows or the
-        // time-of-impact search never ends.
-        for (field, x, range) in [
-            ("physics.dt", p.dt, 1e-5..=0.1),
-            ("physics.gravity", p.gravity, 1e-3..=100.0),
-            ("physics.ball_radius", p.ball_radius, 1e-4..=1.0),
-        ] {
-            if !range.contains(&x) {
-                return bad(field, &format!("{x} is outside [{}, {}]", range.start(), range.end()));
-            }
-        }
-        for (field, x) in [("physics.coeff_offset", p.coeff_offset), ("physics.table_z", p.table_z)] {
-            if !x.is_finite() {
-                return bad(field, "must be finite");
-            }
+        // Beyond these the flight arithmetic overflows or the time-of-impact search never ends.
+        let physics = [
+            ("physics.dt", p.dt, Domain::closed(1e-5, 0.1).in_unit("s")),
+            ("physics.gravity", p.gravity, Domain::closed(1e-3, 100.0).in_unit("m/s²")),
+            ("physics.ball_radius", p.ball_radius, Domain::closed(1e-4, 1.0).in_unit("m")),
+            ("physics.coeff_offset", p.coeff_offset, Domain::closed(0.0, 1.0)),
+            ("physics.table_z", p.table_z, Domain::closed(-10.0, 10.0).in_unit("m")),
+        ];
+        for (field, x, domain) in physics {
+            check(field, field.to_string(), domain, x)?;
         }
         Ok(())
     }

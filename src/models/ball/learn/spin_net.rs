@@ -14,8 +14,15 @@ use super::positive::{softplus, softplus_tensor};
 use super::rotation::{launch_rotation, motor_actuations};
 use crate::error::{Error, Result};
 use crate::models::ball::SpinPrior;
+use crate::util::domain::Domain;
 
 pub const HIDDEN: usize = 256;
+/// A weight far beyond what training from the small initial weights reaches.
+const WEIGHT: Domain = Domain::closed(-1e6, 1e6);
+/// The most an output (a canonical spin component, in the model's units, or a variance's softplus input) may
+/// reach for some actuation: a trained network's stay within tens; beyond this the filter would start from a
+/// spin no launcher gives.
+const OUTPUT_LIMIT: f64 = 1e4;
 
 /// Weights stored transposed (\[3, 256\] and \[256, 6\]) so that a batch of row vectors multiplies from the left.
 #[derive(Module, Debug)]
@@ -89,8 +96,24 @@ impl SpinNetWeights {
                 6 * HIDDEN
             )));
         }
-        if self.w1.iter().chain(&self.w2).any(|x| !x.is_finite()) {
-            return Err(Error::data("spin network weights must be finite"));
+        for (name, weights) in [("w1", &self.w1), ("w2", &self.w2)] {
+            for (i, &x) in weights.iter().enumerate() {
+                WEIGHT
+                    .check(&format!("{name}[{i}]"), x)
+                    .map_err(|e| Error::data(format!("spin network weights: {e}")))?;
+            }
+        }
+        // Over s_m ∈ [0, 1]³, |max(W₁ s_m, 0)ⱼ| ≤ Σₖ |W₁ⱼₖ|, so output i stays within Σⱼ |W₂ᵢⱼ| Σₖ |W₁ⱼₖ|.
+        let reach: Vec<f64> = (0..HIDDEN).map(|j| (0..3).map(|k| self.w1[3 * j + k].abs()).sum()).collect();
+        for i in 0..6 {
+            let bound: f64 = (0..HIDDEN).map(|j| self.w2[HIDDEN * i + j].abs() * reach[j]).sum();
+            if bound > OUTPUT_LIMIT {
+                return Err(Error::data(format!(
+                    "spin network weights: output {i} can reach {} over actuations in [0, 1]³; a trained network's \
+                     canonical spin and variance inputs stay within ±{OUTPUT_LIMIT:e}",
+                    crate::util::domain::number(bound)
+                )));
+            }
         }
         Ok(())
     }

@@ -118,6 +118,22 @@ fn thesis_values_are_where_the_thesis_puts_them() {
     }
 }
 
+/// Finite but absurd values are refused by name and index, with the accepted range.
+#[test]
+fn parameters_outside_their_physical_ranges_are_refused() {
+    let refused = |change: fn(&mut BallModelParams), expected: &str| {
+        let mut params = BallModelParams::thesis_learned();
+        change(&mut params);
+        let err = params.validate().unwrap_err().to_string();
+        assert!(err.contains(expected), "{err}");
+    };
+    refused(|p| p.c[1][4] = 1.8e19, "c[1][4] = 1.8e19: expected a finite number in [-10, 10]");
+    refused(|p| p.q_diag[3] = 0.0, "q_diag[3] = 0: expected a finite number in [1e-20, 1e6]");
+    refused(|p| p.a_m_var = 5e-324, "a_m_var = 5e-324");
+    refused(|p| p.a_d0 = -1e300, "a_d0 = -1e300");
+    refused(|p| p.physics.table_z = 4294967296.0, "physics.table_z = 4.294967296e9");
+}
+
 /// The simulator's ground truth is the thesis' learned model in the thesis' recording setup, so the two
 /// transcriptions must agree there; the model keeps its own so that retuning the simulator is a visible choice.
 #[test]
