@@ -41,6 +41,7 @@ pub fn collect_random(settings: &CollectSettings, monitor: &dyn Monitor) -> Resu
         let mut rng = rng_for(settings.seed, &[k as u64]);
         env.sample_instance(&mut rng);
         let rollout = random_rollout(env.as_mut(), &spec, &mut rng, settings.steps);
+        check_finite(&rollout, k as u64)?;
         instances.push(env.params());
         steps.extend(timesteps(&spec, &rollout, k as u32));
         monitor.progress("collect rollouts", k as u64 + 1, settings.rollouts as u64);
@@ -85,6 +86,7 @@ pub fn collect_instance_pairs(settings: &InstancePairSettings, monitor: &dyn Mon
         for role in 0..2 {
             let mut rng = rng_for(settings.seed, &[k, role]);
             let rollout = random_rollout(env.as_mut(), &spec, &mut rng, settings.steps);
+            check_finite(&rollout, 2 * k + role)?;
             steps.extend(timesteps(&spec, &rollout, (2 * k + role) as u32));
             instances.push(env.params());
         }
@@ -137,6 +139,7 @@ pub fn replay(settings: &ReplaySettings) -> Result<Dataset> {
         let step = env.step(action);
         rollout.push(action.clone(), step.reward, env.state(), step.obs);
     }
+    check_finite(&rollout, 0)?;
     let steps = timesteps(&spec, &rollout, 0).collect();
     Ok(Dataset {
         meta: DatasetMeta::for_env(
@@ -149,6 +152,18 @@ pub fn replay(settings: &ReplaySettings) -> Result<Dataset> {
         steps,
         frames: Vec::new(),
     })
+}
+
+/// A simulator gone non-finite is stopped at the step where it happened, not written as a dataset no reader
+/// takes back.
+fn check_finite(rollout: &Rollout, id: u64) -> Result<()> {
+    match rollout.first_non_finite_step() {
+        Some(t) => Err(Error::diverged(format!(
+            "rollout {id}, step {t}: the simulator's state or reward became non-finite (state {:?}, action {:?})",
+            rollout.states[t], rollout.actions[t]
+        ))),
+        None => Ok(()),
+    }
 }
 
 /// Parses `--init-state`: comma-separated finite numbers, one per state dimension.

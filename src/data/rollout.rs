@@ -47,6 +47,14 @@ impl Rollout {
         self.actions.is_empty()
     }
 
+    /// The first step t whose outcome (reward, next state or observation) holds a non-finite number.
+    pub fn first_non_finite_step(&self) -> Option<usize> {
+        let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+        (0..self.len()).find(|&t| {
+            !(self.rewards[t].is_finite() && finite(&self.states[t + 1]) && finite(&self.observations[t + 1]))
+        })
+    }
+
     pub fn total_reward(&self) -> f64 {
         self.rewards.iter().sum()
     }
@@ -105,6 +113,17 @@ mod tests {
         r.push(vec![0.5], -1.0, vec![0.1, 1.1], vec![2.0]);
         r.push(vec![-0.5], -2.0, vec![0.2, 1.2], vec![3.0]);
         r
+    }
+
+    #[test]
+    fn the_first_step_with_a_non_finite_outcome_is_found() {
+        let mut r = sample();
+        assert_eq!(r.first_non_finite_step(), None);
+        r.push(vec![0.0], 0.0, vec![f64::NAN, 0.0], vec![0.0]);
+        r.push(vec![0.0], f64::INFINITY, vec![0.0, 0.0], vec![0.0]);
+        assert_eq!(r.first_non_finite_step(), Some(2));
+        r.observations[2][0] = f64::NEG_INFINITY;
+        assert_eq!(r.first_non_finite_step(), Some(1));
     }
 
     #[test]

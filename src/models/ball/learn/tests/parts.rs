@@ -99,13 +99,13 @@ fn spin_network_weights_round_trip_and_agree_with_the_tensor_net() {
 }
 
 /// Weights are checked one by one, and together by how far the outputs can reach over actuations in [0, 1]³:
-/// all ones reach 256 · 3 = 768, all tens 76 800, past what any launcher's spin needs.
+/// all ones reach 256 · 3 = 768, all twenties 307 200, past what any launcher's spin needs.
 #[test]
 fn spin_network_weights_are_refused_where_their_outputs_could_run_away() {
     let weights = |w1: f64, w2: f64| SpinNetWeights { w1: vec![w1; 3 * HIDDEN], w2: vec![w2; 6 * HIDDEN] };
     weights(1.0, 1.0).check().unwrap();
-    let err = weights(10.0, 10.0).check().unwrap_err().to_string();
-    assert!(err.contains("output 0 can reach 76800") && err.contains("±1e4"), "{err}");
+    let err = weights(20.0, 20.0).check().unwrap_err().to_string();
+    assert!(err.contains("output 0 can reach 307200") && err.contains("±1e5"), "{err}");
     let mut absurd = weights(0.1, 0.1);
     absurd.w2[1256] = 1e19;
     let err = absurd.check().unwrap_err().to_string();
