@@ -9,7 +9,7 @@ use std::time::Instant;
 
 /// Tiny PETS network (as tests/cli/pets.rs).
 pub(crate) const SWEEP_TOML: &str = "[sweep]\nname = \"fuzz\"\n[[stage]]\nname = \"train\"\n\
-    command = \"train context --data ctx.mcap --config context.toml --steps 2 lambda_kl=1\"\n\
+    command = \"train context --data ctx.mcap --config context.toml --steps 2 kl_weight=1\"\n\
     [stage.grid]\nseed = [0, 1]\n\"--preset\" = [\"small\"]\n[[stage]]\nname = \"eval\"\nafter = \"train\"\n\
     command = \"eval context --model {train} --env toy:inner --contexts 2\"\n[stage.grid]\n\"--transitions\" = [1, 2]\n\
     [slurm]\nmemory = \"1G\"\ntime = \"00:05:00\"\nmax_running = 2\n[[compare]]\nstage = \"eval\"\n\
@@ -127,6 +127,17 @@ pub(crate) fn generate_seeds(dir: &Path) -> Result<(), String> {
     make(dir, "train --method ball-ekf --data ball.mcap --launcher-prior --steps 3 --batch 8 --out ekf")?;
     make(dir, "train --method seads --env tileswap:cursor --config seads.toml --env-steps 100 --out seads")?;
     make(dir, "eval pendulum-swingup --model true --episodes 1 --steps 25 --candidates 16 --elites 4 --out swingup")?;
+    // A finished two-stage sweep, for `sweep status` and `sweep report`.
+    make(dir, "sweep plan sweep.toml --out sweep-done")?;
+    let run = Command::new("bash")
+        .args(["sweep-done/run-local.sh", "1"])
+        .current_dir(dir)
+        .env("NO_COLOR", "1")
+        .output()
+        .map_err(|e| format!("seeding: sweep-done/run-local.sh: {e}"))?;
+    if !run.status.success() {
+        return Err(format!("seeding failed: sweep-done/run-local.sh\n{}", String::from_utf8_lossy(&run.stdout)));
+    }
 
     // More MCAP writers, for the check with the official reader.
     make(dir, "plan --env pendulum --model true --steps 3 --candidates 16 --elites 4 --out plan.mcap")?;

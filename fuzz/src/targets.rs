@@ -72,6 +72,12 @@ macro_rules! cheap_plan {
 /// Every reader, with a cheap command that reaches it.
 pub(crate) fn targets() -> Vec<Target> {
     const MODEL_FILES: &[&str] = &["checkpoint.json", "config.json", "model.safetensors"];
+    const SWEEP_FILES: &[&str] = &[
+        "sweep.json",
+        "runs/train/preset-small_seed-0/job.json",
+        "runs/eval/preset-small_seed-1_transitions-2/job.json",
+        "runs/eval/preset-small_seed-1_transitions-2/report/summary.json",
+    ];
     const EKF_FILES: &[&str] = &["checkpoint.json", "config.json", "params.json", "spin_net.json", "model.safetensors"];
     vec![
         // Datasets of each kind.
@@ -356,6 +362,14 @@ pub(crate) fn targets() -> Vec<Target> {
             "embodied-eval",
             Input::Arg { seed: "lightsout" },
             "eval embodied --game={in} --embodiment cursor --max-depth 1 --boards 1 --out {out}",
+        ),
+        // A finished sweep: its plan, jobs' outcomes and an eval summary, read by `status` and `report` from
+        // the copy (a sweep is read where it lies).
+        target("sweep-status", Input::Checkpoint { dir: "sweep-done", files: SWEEP_FILES }, "sweep status {in}"),
+        target(
+            "sweep-report",
+            Input::Checkpoint { dir: "sweep-done", files: SWEEP_FILES },
+            "sweep report {in} --out {out}",
         ),
     ]
 }

@@ -114,7 +114,28 @@ impl Plan {
                 format!("version {} is not {PLAN_VERSION}, the one this mbrl reads", plan.version),
             ));
         }
-        Ok(plan)
+        let here = dir.canonicalize().map_err(|e| Error::bad_file(dir, e.to_string()))?;
+        Ok(plan.moved_to(&here))
+    }
+
+    /// The plan of a sweep directory that now lies at `here` (results copied back from a cluster, a sweep
+    /// moved or archived): the run directories and outputs under the recorded directory are read where they
+    /// lie now. The job lines keep the paths they were planned with, since they run where they were planned.
+    fn moved_to(mut self, here: &Path) -> Plan {
+        if self.dir == here {
+            return self;
+        }
+        let rebase = |path: &mut PathBuf| {
+            if let Ok(rest) = path.strip_prefix(&self.dir) {
+                *path = here.join(rest);
+            }
+        };
+        for job in self.stages.iter_mut().flat_map(|stage| stage.jobs.iter_mut()) {
+            rebase(&mut job.run_dir);
+            rebase(&mut job.output);
+        }
+        self.dir = here.to_path_buf();
+        self
     }
 }
 

@@ -107,6 +107,15 @@ fn a_local_sweep_runs_reruns_and_reports_failures() {
     let rerun = std::process::Command::new("bash").arg("-c").arg(line).output().unwrap();
     assert!(rerun.status.success() && stdout_of(&rerun).contains("done already"), "{}", stderr_of(&rerun));
     assert_eq!(weights, std::fs::read(model.join("metrics.jsonl")).unwrap());
+
+    // A sweep moved elsewhere (results fetched from a cluster) is followed and reported where it lies now.
+    std::fs::rename(d.join("s"), d.join("moved")).unwrap();
+    let (code, text) = sweep_status(d, "moved");
+    assert_eq!(code, 1, "{text}");
+    assert!(text.contains("8/12 jobs done, 4 failed"), "{text}");
+    let report = mbrl(d).args(["sweep", "report", "moved", "--out", "moved-report"]).output().unwrap();
+    assert!(stdout_of(&report).contains("eval: 4 of 8 runs done"), "{}", stderr_of(&report));
+    assert_eq!(cells, std::fs::read_to_string(d.join("moved-report/cells.csv")).unwrap());
 }
 
 /// Whether the training at `model` checkpoints step `step` or later within `timeout`.

@@ -12,6 +12,7 @@ use crate::run::follow::MetricsFollower;
 use crate::run::job_record::{JobRecord, JobState};
 use crate::run::Event;
 use crate::sweep::plan::{JobPlan, StagePlan};
+use crate::util::domain::Domain;
 
 /// Arrays longer than this are per-episode or per-step data, not results to average over seeds.
 const MAX_SCALAR_ARRAY: usize = 8;
@@ -105,6 +106,10 @@ impl Run<'_> {
 
 type Read = (Vec<(String, f64)>, BTreeMap<String, BTreeMap<u64, f64>>);
 
+/// No summary value or training metric this tool writes comes near this; a run that claims one beyond it is
+/// reported as unreadable rather than averaged (its square would swamp, or overflow, every interval).
+const METRIC: Domain = Domain::closed(-1e12, 1e12);
+
 /// A report directory gives its summary's scalars, a training directory its metrics; anything else (a
 /// dataset file) gives nothing and still counts as done.
 fn read_output(output: &Path) -> Result<Read> {
@@ -115,6 +120,9 @@ fn read_output(output: &Path) -> Result<Read> {
             serde_json::from_slice(&bytes).map_err(|e| Error::bad_file(&summary, format!("is not JSON: {e}")))?;
         let mut scalars = Vec::new();
         leaves(&value, &mut String::new(), &mut scalars);
+        for (name, x) in &scalars {
+            METRIC.check(name, *x).map_err(|e| Error::bad_file(&summary, e.to_string()))?;
+        }
         return Ok((scalars, BTreeMap::new()));
     }
     let metrics = output.join("metrics.jsonl");
@@ -123,6 +131,9 @@ fn read_output(output: &Path) -> Result<Read> {
         let mut curves: BTreeMap<String, BTreeMap<u64, f64>> = BTreeMap::new();
         for event in MetricsFollower::open(&metrics)?.poll()? {
             if let Event::Scalar { name, step, value } = event {
+                METRIC
+                    .check(&format!("{name} at step {step}"), value)
+                    .map_err(|e| Error::bad_file(&metrics, e.to_string()))?;
                 curves.entry(name.clone()).or_default().insert(step, value);
                 match last.iter_mut().find(|(n, _)| *n == name) {
                     Some(entry) => entry.1 = value,
@@ -191,5 +202,18 @@ mod tests {
         // true/false count as 1/0 (a success flag's mean is a success rate).
         assert_eq!(names, ["angular", "mean_mse[0]", "mean_mse[1]", "prior_entropy", "tests[0].n", "tests[0].p_value"]);
         assert_eq!((out[0].1, out[2].1), (0.0, 0.5));
+    }
+
+    /// A summary claiming an absurd value makes its run unreadable (named in the report), not a mean of 1e300.
+    #[test]
+    fn a_summary_value_beyond_any_measurement_is_refused_by_name() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("summary.json"), r#"{"prior_entropy": 1.5, "mean_mse": [0.25, 1e300]}"#)
+            .unwrap();
+        let err = read_output(dir.path()).unwrap_err().to_string();
+        assert!(err.contains("summary.json: mean_mse[1] = 1e300: expected a finite number in [-1e12, 1e12]"), "{err}");
+        std::fs::write(dir.path().join("summary.json"), r#"{"prior_entropy": 1.5, "mean_mse": [0.25, 1e11]}"#)
+            .unwrap();
+        assert_eq!(read_output(dir.path()).unwrap().0.len(), 3);
     }
 }
