@@ -127,6 +127,20 @@ pub(crate) fn generate_seeds(dir: &Path) -> Result<(), String> {
     make(dir, "train --method ball-ekf --data ball.mcap --launcher-prior --steps 3 --batch 8 --out ekf")?;
     make(dir, "train --method seads --env tileswap:cursor --config seads.toml --env-steps 100 --out seads")?;
     make(dir, "eval pendulum-swingup --model true --episodes 1 --steps 25 --candidates 16 --elites 4 --out swingup")?;
+    make(
+        dir,
+        "eval ball --model ekf --train-shots 2 --test-shots 1 --unseen-shots 1 --augment-rotations 0 --out ball-report",
+    )?;
+    // Reports whose config.json `eval --config` reruns.
+    make(dir, "eval context --model context-model --env toy:inner --contexts 2 --transitions 2 --out context-report")?;
+    make(dir, "eval dlgpd --model dlgpd --env pendulum --evidence-rollouts 1 --prediction-only --out dlgpd-report")?;
+    make(dir, "eval seads --model seads --max-depth 1 --boards 1 --coverage-boards 1 --out seads-report")?;
+    make(
+        dir,
+        "eval tradyn --model-terrain tradyn-model --model-no-terrain tradyn-model-nt --maps terrain --tasks 2 \
+         --transitions 2 --steps 2 --horizon 3 --candidates 16 --elites 4 --iters 1 --prediction-steps 2 --out tradyn-report",
+    )?;
+    make(dir, "eval embodied --game lightsout --embodiment cursor --max-depth 1 --boards 1 --out embodied-report")?;
     // A finished two-stage sweep, for `sweep status` and `sweep report`.
     make(dir, "sweep plan sweep.toml --out sweep-done")?;
     let run = Command::new("bash")

@@ -371,6 +371,33 @@ pub(crate) fn targets() -> Vec<Target> {
             Input::Checkpoint { dir: "sweep-done", files: SWEEP_FILES },
             "sweep report {in} --out {out}",
         ),
+        // A report's config.json, rerun with `--config`; and KEY=VALUE settings, whose numbers are arguments.
+        target("report-config-swingup", text("swingup/config.json"), "eval pendulum-swingup --config {in} --out {out}"),
+        target("report-config-ball", text("ball-report/config.json"), "eval ball --config {in} --out {out}"),
+        target("report-config-context", text("context-report/config.json"), "eval context --config {in} --out {out}"),
+        target("report-config-dlgpd", text("dlgpd-report/config.json"), "eval dlgpd --config {in} --out {out}"),
+        target("report-config-seads", text("seads-report/config.json"), "eval seads --config {in} --out {out}"),
+        target("report-config-tradyn", text("tradyn-report/config.json"), "eval tradyn --config {in} --out {out}"),
+        target(
+            "report-config-embodied",
+            text("embodied-report/config.json"),
+            "eval embodied --config {in} --out {out}",
+        ),
+        target(
+            "override-eval",
+            Input::Arg { seed: "1" },
+            "eval ball --config ball-report/config.json --out {out} settings.test_shots_default={in}",
+        ),
+        target(
+            "override-learning-rate",
+            Input::Arg { seed: "0.001" },
+            "train --method context --data ctx.mcap --config context.toml --steps 1 --out {out} optimizer.learning_rate={in}",
+        ),
+        target(
+            "override-size",
+            Input::Arg { seed: "16" },
+            "train --method pets --data roll.mcap --config pets.toml --ensemble 1 --steps 1 --out {out} hidden_units={in}",
+        ),
     ]
 }
 

@@ -23,6 +23,7 @@ use crate::models::ball::BallModelParams;
 use crate::run::dir::{Provenance, RunDir};
 use crate::run::{Event, Monitor, Tee};
 use crate::util::atomic::write_text;
+use crate::util::domain::Domain;
 use crate::util::seeding::derive_seed;
 use crate::util::table::write_csv;
 
@@ -89,12 +90,18 @@ pub struct ErrorSummary {
     pub failed: usize,
     /// Shots too short for this horizon (left out).
     pub too_short: usize,
-    #[serde(with = "num::real")]
-    pub q10: f64,
-    #[serde(with = "num::real")]
-    pub median: f64,
-    #[serde(with = "num::real")]
-    pub q90: f64,
+    /// The quantiles; `None` when no shot was long enough for this horizon (`count` 0).
+    #[serde(with = "num::opt")]
+    pub q10: Option<f64>,
+    #[serde(with = "num::opt")]
+    pub median: Option<f64>,
+    #[serde(with = "num::opt")]
+    pub q90: Option<f64>,
+}
+
+/// A quantile in centimetres as tables show it: "—" when no shot was scored.
+fn centimetres(q: Option<f64>, decimals: usize) -> String {
+    q.map_or("—".to_string(), |q| format!("{:.*}", decimals, 100.0 * q))
 }
 
 fn shots(
@@ -159,11 +166,35 @@ pub struct BallConfig {
     pub settings: BallEvalSettings,
 }
 
+/// The most shots of one kind an evaluation simulates.
+const MAX_SHOTS: usize = 100_000;
+
 impl BallConfig {
     pub fn validate(&self) -> Result<()> {
         let s = &self.settings;
         if s.train_shots == 0 || s.test_shots_default == 0 || s.test_shots_unseen == 0 {
             return Err(Error::config("--train-shots, --test-shots and --unseen-shots must be at least 1"));
+        }
+        // The thesis' counts are 108, 19, 163 and 30; each shot is simulated and filtered, so these bound the time
+        // and the memory a run may ask for.
+        let counts = [
+            ("settings.train_shots", s.train_shots, MAX_SHOTS),
+            ("settings.augment_rotations", s.augment_rotations, 1000),
+            ("settings.test_shots_default", s.test_shots_default, MAX_SHOTS),
+            ("settings.test_shots_unseen", s.test_shots_unseen, MAX_SHOTS),
+            ("settings.horizons (their number)", s.horizons.len(), 100),
+        ];
+        for (field, value, max) in counts {
+            Domain::count(0, max as u64).check_count(field, value as u64).map_err(|e| Error::config(e.to_string()))?;
+        }
+        if s.horizons.is_empty() {
+            return Err(Error::config("settings.horizons: expected at least one horizon"));
+        }
+        // A shot lasts about a second and a half; ten seconds of camera frames is past every recording.
+        for (i, &h) in s.horizons.iter().enumerate() {
+            Domain::count(1, 10 * FRAME_RATE as u64)
+                .check_count(&format!("settings.horizons[{i}]"), h)
+                .map_err(|e| Error::config(format!("{e} camera frames")))?;
         }
         Ok(())
     }
@@ -213,12 +244,12 @@ impl std::fmt::Display for BallEvalSummary {
         for r in self.rows.iter().filter(|r| (r.horizon_s - 1.0).abs() < 1e-9) {
             write!(
                 f,
-                "\n  {:<32} {:<8} {:6.1} cm  (10-90 %: {:.1}-{:.1} cm, n = {}, failed {}, too short {})",
+                "\n  {:<32} {:<8} {:>6} cm  (10-90 %: {}-{} cm, n = {}, failed {}, too short {})",
                 r.method,
                 r.group,
-                100.0 * r.median,
-                100.0 * r.q10,
-                100.0 * r.q90,
+                centimetres(r.median, 1),
+                centimetres(r.q10, 1),
+                centimetres(r.q90, 1),
                 r.count,
                 r.failed,
                 r.too_short
@@ -233,7 +264,7 @@ impl BallEvalSummary {
         self.rows
             .iter()
             .find(|r| r.method == method && r.group == group && (r.horizon_s - horizon_s).abs() < 1e-9)
-            .map(|r| r.median)
+            .and_then(|r| r.median)
     }
 }
 
@@ -313,7 +344,7 @@ pub fn evaluate(
                     });
                     errs.push(err);
                 }
-                let q = |p| quantile_counting_failures(&errs, p).unwrap_or(f64::NAN);
+                let q = |p| quantile_counting_failures(&errs, p);
                 rows.push(ErrorSummary {
                     method: method.name.clone(),
                     group: group.clone(),
@@ -383,9 +414,9 @@ pub fn render(summary: &BallEvalSummary, dir: &Path) -> Result<()> {
                 r.count.to_string(),
                 r.failed.to_string(),
                 r.too_short.to_string(),
-                format!("{:.4}", r.q10),
-                format!("{:.4}", r.median),
-                format!("{:.4}", r.q90),
+                r.q10.map_or(String::new(), |q| format!("{q:.4}")),
+                r.median.map_or(String::new(), |q| format!("{q:.4}")),
+                r.q90.map_or(String::new(), |q| format!("{q:.4}")),
             ]
         })
         .collect();
@@ -407,7 +438,7 @@ pub fn render(summary: &BallEvalSummary, dir: &Path) -> Result<()> {
                     points: rows
                         .iter()
                         .filter(|r| r.method == m.name && &r.group == group)
-                        .map(|r| (r.horizon_s, 100.0 * r.q10, 100.0 * r.median, 100.0 * r.q90.min(2.0)))
+                        .filter_map(|r| Some((r.horizon_s, 100.0 * r.q10?, 100.0 * r.median?, 100.0 * r.q90?.min(2.0))))
                         .collect(),
                 })
                 .collect();
@@ -496,16 +527,16 @@ fn report_markdown(settings: &BallEvalSettings, methods: &[MethodRecord], rows: 
     );
     for r in rows.iter().filter(|r| (r.horizon_s * 10.0).round() as i64 % 5 == 0) {
         md.push_str(&format!(
-            "| {} | {} | {:.1} | {} | {} | {} | {:.1} | {:.1} | {:.1} |\n",
+            "| {} | {} | {:.1} | {} | {} | {} | {} | {} | {} |\n",
             r.method,
             r.group,
             r.horizon_s,
             r.count,
             r.failed,
             r.too_short,
-            100.0 * r.q10,
-            100.0 * r.median,
-            100.0 * r.q90
+            centimetres(r.q10, 1),
+            centimetres(r.median, 1),
+            centimetres(r.q90, 1)
         ));
     }
     md.push_str("\nAll horizons: `summary.csv`; per trajectory: `errors.csv`.\n\n![error vs horizon](error_vs_horizon.png)\n\n![trajectories](trajectories.png)\n");
@@ -526,6 +557,28 @@ mod tests {
     use super::*;
     use crate::models::ball::BallModel;
     use crate::run::monitor::NullMonitor;
+
+    /// A horizon no shot was long enough for has no quantiles: the table shows a dash, not NaN.
+    #[test]
+    fn a_horizon_without_scored_shots_shows_no_quantiles() {
+        let row = ErrorSummary {
+            method: "ekf".into(),
+            group: "default".into(),
+            horizon_s: 1.0,
+            count: 0,
+            failed: 0,
+            too_short: 1,
+            q10: None,
+            median: None,
+            q90: None,
+        };
+        let md = report_markdown(&BallEvalSettings::default(), &[], std::slice::from_ref(&row));
+        assert!(md.contains("| ekf | default | 1.0 | 0 | 0 | 1 | — | — | — |"), "{md}");
+        assert!(!md.to_lowercase().contains("nan"), "{md}");
+        let json = serde_json::to_string(&row).unwrap();
+        assert!(json.contains("\"median\":null"), "{json}");
+        assert_eq!(serde_json::from_str::<ErrorSummary>(&json).unwrap().median, None);
+    }
 
     /// The side view's predicted points stay where the shot was measured (the plot once drew (x, y) on
     /// the (y, z) axes: predictions seemed to climb to 2.5 m while the CSV never passed 0.35 m).

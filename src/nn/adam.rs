@@ -7,6 +7,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
+use crate::util::domain::number;
 
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -24,23 +25,27 @@ pub struct AdamConfig {
 impl AdamConfig {
     pub fn validate(&self) -> Result<()> {
         let bad = |m: String| Err(Error::config(format!("optimizer: {m}")));
-        if !(self.learning_rate.is_finite() && self.learning_rate > 0.0) {
-            return bad(format!("learning_rate must be finite and > 0, got {}", self.learning_rate));
+        // Every method here trains with rates of 1e-4 to 1e-2; past 1 an f32 update overshoots any weight, and
+        // 1e300 is infinity in f32.
+        if !(self.learning_rate.is_finite() && self.learning_rate > 0.0 && self.learning_rate <= 1.0) {
+            return bad(format!("learning_rate must lie in (0, 1], got {}", number(self.learning_rate)));
         }
         for (name, beta) in [("beta1", self.beta1), ("beta2", self.beta2)] {
             if !(0.0..1.0).contains(&beta) {
                 return bad(format!("{name} must lie in [0, 1), got {beta}"));
             }
         }
-        if !(self.epsilon.is_finite() && self.epsilon > 0.0) {
-            return bad(format!("epsilon must be finite and > 0, got {}", self.epsilon));
+        // ε guards a division by √v̂; beyond 1 it would swamp every gradient's scale.
+        if !(self.epsilon.is_finite() && self.epsilon > 0.0 && self.epsilon <= 1.0) {
+            return bad(format!("epsilon must lie in (0, 1], got {}", number(self.epsilon)));
         }
-        if !(self.weight_decay.is_finite() && self.weight_decay >= 0.0) {
-            return bad(format!("weight_decay must be finite and ≥ 0, got {}", self.weight_decay));
+        // An L2 penalty of 1 already pulls every weight to zero faster than any loss pushes it away.
+        if !(self.weight_decay.is_finite() && (0.0..=1.0).contains(&self.weight_decay)) {
+            return bad(format!("weight_decay must lie in [0, 1], got {}", number(self.weight_decay)));
         }
         if let Some(c) = self.clip_grad_norm {
-            if !(c.is_finite() && c > 0.0) {
-                return bad(format!("clip_grad_norm must be finite and > 0, got {c}"));
+            if !(c.is_finite() && c > 0.0 && c <= 1e12) {
+                return bad(format!("clip_grad_norm must lie in (0, 1e12], got {}", number(c)));
             }
         }
         Ok(())
@@ -150,6 +155,22 @@ mod tests {
             weight_decay: 0.0,
             clip_grad_norm: None,
         }
+    }
+
+    /// 1e300 is a finite f64 but infinity as the f32 the networks update with.
+    #[test]
+    fn absurd_settings_are_refused_with_their_range() {
+        let refused = |change: fn(&mut AdamConfig), expected: &str| {
+            let mut c = config();
+            change(&mut c);
+            let err = c.validate().unwrap_err().to_string();
+            assert!(err.contains(expected), "{err}");
+        };
+        refused(|c| c.learning_rate = 1e300, "learning_rate must lie in (0, 1], got 1e300");
+        refused(|c| c.epsilon = 5.0, "epsilon must lie in (0, 1]");
+        refused(|c| c.weight_decay = 1e19, "weight_decay must lie in [0, 1]");
+        refused(|c| c.clip_grad_norm = Some(1e300), "clip_grad_norm must lie in (0, 1e12]");
+        config().validate().unwrap();
     }
 
     #[test]

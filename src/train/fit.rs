@@ -5,7 +5,7 @@
 use std::collections::BTreeMap;
 
 use super::checkpoint::{CheckpointDir, FileEntry, Manifest, CHECKPOINT_FORMAT};
-use super::tensors::{to_bytes, StoredTensor};
+use super::tensors::{to_bytes, StoredTensor, TensorData};
 use crate::error::{Error, Result};
 use crate::run::{JsonlMonitor, Monitor};
 
@@ -277,6 +277,16 @@ pub fn fit(
                 live = method.weights();
                 &live
             };
+            // The loss of the last update is never computed, and an update can overflow on its own (an absurd
+            // learning rate): caught here, before a checkpoint no loader would take back is written.
+            if let Some(name) = non_finite_tensor(weights) {
+                let saved = saved_note(last_checkpoint, checkpoints.persists());
+                return Err(Error::diverged(format!(
+                    "{} diverged: weight tensor '{name}' holds a non-finite value at step {step}; {saved}. Lower \
+                     the learning rate or check the data for outliers",
+                    settings.method
+                )));
+            }
             checkpoints.save(Snapshot {
                 method: &*method,
                 settings,
@@ -296,11 +306,23 @@ pub fn fit(
     Ok(FitOutcome { steps: steps_done, best_step: best.step, best_valid_loss: best.loss, last_train_loss: last_loss })
 }
 
-fn diverged(settings: &FitSettings, step: u64, what: &str, value: f64, checkpoint: u64, persists: bool) -> Error {
-    let saved = match (checkpoint, persists) {
+fn saved_note(checkpoint: u64, persists: bool) -> String {
+    match (checkpoint, persists) {
         (0, _) | (_, false) => "no checkpoint was written".to_string(),
         _ => format!("the checkpoint of step {checkpoint} is intact and can be resumed"),
+    }
+}
+
+fn non_finite_tensor(weights: &[StoredTensor]) -> Option<&str> {
+    let finite = |t: &StoredTensor| match &t.data {
+        TensorData::F32(v) => v.iter().all(|x| x.is_finite()),
+        TensorData::F64(v) => v.iter().all(|x| x.is_finite()),
     };
+    weights.iter().find(|t| !finite(t)).map(|t| t.name.as_str())
+}
+
+fn diverged(settings: &FitSettings, step: u64, what: &str, value: f64, checkpoint: u64, persists: bool) -> Error {
+    let saved = saved_note(checkpoint, persists);
     let message = format!(
         "{} diverged: {what} loss {value} at step {step}; {saved}. Lower the learning rate or check the data for outliers",
         settings.method
@@ -377,6 +399,30 @@ mod tests {
 
     fn run(nan_at: u64, dir: &std::path::Path) -> Result<FitOutcome> {
         run_counter(&mut Counter { w: 0.0, nan_at, budget_per_step: 0 }, dir, &NullMonitor)
+    }
+
+    /// An update that overflows the weights while the loss it was computed from was finite.
+    #[test]
+    fn non_finite_weights_stop_the_run_before_their_checkpoint() {
+        let dir = tempfile::tempdir().unwrap();
+        let settings = FitSettings {
+            method: "counter".into(),
+            env: None,
+            total_steps: 8,
+            validate_every: 100,
+            checkpoint_every: 2,
+        };
+        let ckpt = CheckpointDir::start(dir.path()).unwrap();
+        let entry = ckpt.write_file(CONFIG_FILE, b"{}").unwrap();
+        let metrics = JsonlMonitor::create(&dir.path().join("metrics.jsonl")).unwrap();
+        let mut checkpoints = DirCheckpointer { dir: &ckpt, config_entry: &entry, metrics: &metrics };
+        let mut counter = Counter { w: f32::INFINITY, nan_at: u64::MAX, budget_per_step: 0 };
+        let err = fit(&mut counter, &settings, &mut checkpoints, None, &NullMonitor).unwrap_err().to_string();
+        assert!(
+            err.contains("weight tensor 'w' holds a non-finite value at step 2; no checkpoint was written"),
+            "{err}"
+        );
+        assert!(!dir.path().join(MODEL_FILE).exists());
     }
 
     #[test]

@@ -212,8 +212,7 @@ mod tests {
             .unwrap();
         let err = read_output(dir.path()).unwrap_err().to_string();
         assert!(err.contains("summary.json: mean_mse[1] = 1e300: expected a finite number in [-1e12, 1e12]"), "{err}");
-        std::fs::write(dir.path().join("summary.json"), r#"{"prior_entropy": 1.5, "mean_mse": [0.25, 1e11]}"#)
-            .unwrap();
+        std::fs::write(dir.path().join("summary.json"), r#"{"prior_entropy": 1.5, "mean_mse": [0.25, 1e11]}"#).unwrap();
         assert_eq!(read_output(dir.path()).unwrap().0.len(), 3);
     }
 }
