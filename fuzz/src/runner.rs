@@ -43,7 +43,9 @@ impl Verdict {
     }
 }
 
-pub(crate) fn classify(status: Option<ExitStatus>, stderr: &str) -> Verdict {
+/// `outcomes`: exit codes the command documents as results rather than errors (`sweep status` exits 1 when a
+/// job failed and 3 when some are unfinished); they count as ok.
+pub(crate) fn classify(status: Option<ExitStatus>, stderr: &str, outcomes: &[i32]) -> Verdict {
     let Some(status) = status else { return Verdict::Hang };
     if let Some(signal) = status.signal() {
         return Verdict::Abort(signal);
@@ -56,6 +58,7 @@ pub(crate) fn classify(status: Option<ExitStatus>, stderr: &str) -> Verdict {
     let first = stderr.lines().find(|l| !l.trim().is_empty() && !l.starts_with("warning:")).unwrap_or("");
     match code {
         0 => Verdict::Ok,
+        code if outcomes.contains(&code) && !first.starts_with("error:") => Verdict::Ok,
         1 | 2 if first.starts_with("error:") => Verdict::CleanError,
         _ => Verdict::Unclean(code),
     }
@@ -133,7 +136,7 @@ pub(crate) fn run_bounded(target: &Target, mutant: &Mutant, cwd: &Path, out: &Pa
     let seconds = start.elapsed().as_secs_f64();
     let stderr = String::from_utf8_lossy(&fs::read(stderr_path).unwrap_or_default()).into_owned();
     let _ = fs::remove_file(stderr_path);
-    Run { verdict: classify(status, &stderr), stderr, seconds }
+    Run { verdict: classify(status, &stderr, target.outcomes), stderr, seconds }
 }
 
 #[cfg(test)]
@@ -145,16 +148,21 @@ mod tests {
     fn classification_of_endings() {
         let exit = |code: i32| Some(ExitStatus::from_raw(code << 8));
         let signal = |sig: i32| Some(ExitStatus::from_raw(sig));
-        assert_eq!(classify(exit(0), ""), Verdict::Ok);
-        assert_eq!(classify(exit(1), "error: x.mcap: not a readable MCAP file\n"), Verdict::CleanError);
-        assert_eq!(classify(exit(2), "error: unexpected argument '--x' (see 'mbrl --help')\n"), Verdict::CleanError);
-        assert_eq!(classify(exit(101), ""), Verdict::Panic);
-        assert_eq!(classify(exit(1), "thread 'main' panicked at src/x.rs:1:1:\nerror: x\n"), Verdict::Panic);
-        assert_eq!(classify(signal(6), "memory allocation of 68719476736 bytes failed\n"), Verdict::Abort(6));
-        assert_eq!(classify(signal(11), ""), Verdict::Abort(11));
-        assert_eq!(classify(None, ""), Verdict::Hang);
-        assert_eq!(classify(exit(1), "progress 3/5\nerror: late\n"), Verdict::Unclean(1));
-        assert_eq!(classify(exit(1), "warning: x: 5 of 5 steps\nerror: y\n"), Verdict::CleanError);
-        assert_eq!(classify(exit(3), "error: x\n"), Verdict::Unclean(3));
+        assert_eq!(classify(exit(0), "", &[]), Verdict::Ok);
+        assert_eq!(classify(exit(1), "error: x.mcap: not a readable MCAP file\n", &[]), Verdict::CleanError);
+        assert_eq!(
+            classify(exit(2), "error: unexpected argument '--x' (see 'mbrl --help')\n", &[]),
+            Verdict::CleanError
+        );
+        assert_eq!(classify(exit(101), "", &[]), Verdict::Panic);
+        assert_eq!(classify(exit(1), "thread 'main' panicked at src/x.rs:1:1:\nerror: x\n", &[]), Verdict::Panic);
+        assert_eq!(classify(signal(6), "memory allocation of 68719476736 bytes failed\n", &[]), Verdict::Abort(6));
+        assert_eq!(classify(signal(11), "", &[]), Verdict::Abort(11));
+        assert_eq!(classify(None, "", &[]), Verdict::Hang);
+        assert_eq!(classify(exit(1), "progress 3/5\nerror: late\n", &[]), Verdict::Unclean(1));
+        assert_eq!(classify(exit(1), "warning: x: 5 of 5 steps\nerror: y\n", &[]), Verdict::CleanError);
+        assert_eq!(classify(exit(3), "error: x\n", &[]), Verdict::Unclean(3));
+        assert_eq!(classify(exit(3), "", &[1, 3]), Verdict::Ok, "a documented outcome");
+        assert_eq!(classify(exit(3), "", &[]), Verdict::Unclean(3));
     }
 }

@@ -59,15 +59,17 @@ pub(crate) fn generate(binary: &Path) -> Result<(), String> {
 
 /// Runs the binary to make a seed (`args` split at spaces); seeds must come out, so a failure stops the campaign.
 pub(crate) fn make(dir: &Path, args: &str) -> Result<(), String> {
-    let out = Command::new(dir.join(SNAPSHOT))
-        .args(["--threads", "1", "-q", "--no-tui"])
-        .args(args.split_whitespace())
-        .current_dir(dir)
-        .env("NO_COLOR", "1")
-        .output()
-        .map_err(|e| format!("seeding: mbrl {args}: {e}"))?;
+    let mut command = Command::new(dir.join(SNAPSHOT));
+    command.args(["--threads", "1", "-q", "--no-tui"]).args(args.split_whitespace());
+    run_seeding(command, dir, &format!("mbrl {args}"))
+}
+
+/// Runs `command` in the seed directory; `what` names it in the error, with what it printed.
+fn run_seeding(mut command: Command, dir: &Path, what: &str) -> Result<(), String> {
+    let out = command.current_dir(dir).env("NO_COLOR", "1").output().map_err(|e| format!("seeding: {what}: {e}"))?;
     if !out.status.success() {
-        return Err(format!("seeding failed: mbrl {args}\n{}", String::from_utf8_lossy(&out.stderr)));
+        let printed = String::from_utf8_lossy(&out.stderr) + String::from_utf8_lossy(&out.stdout);
+        return Err(format!("seeding failed: {what}\n{printed}"));
     }
     Ok(())
 }
@@ -143,15 +145,9 @@ pub(crate) fn generate_seeds(dir: &Path) -> Result<(), String> {
     make(dir, "eval embodied --game lightsout --embodiment cursor --max-depth 1 --boards 1 --out embodied-report")?;
     // A finished two-stage sweep, for `sweep status` and `sweep report`.
     make(dir, "sweep plan sweep.toml --out sweep-done")?;
-    let run = Command::new("bash")
-        .args(["sweep-done/run-local.sh", "1"])
-        .current_dir(dir)
-        .env("NO_COLOR", "1")
-        .output()
-        .map_err(|e| format!("seeding: sweep-done/run-local.sh: {e}"))?;
-    if !run.status.success() {
-        return Err(format!("seeding failed: sweep-done/run-local.sh\n{}", String::from_utf8_lossy(&run.stdout)));
-    }
+    let mut run_local = Command::new("bash");
+    run_local.args(["sweep-done/run-local.sh", "1"]);
+    run_seeding(run_local, dir, "sweep-done/run-local.sh 1")?;
 
     // More MCAP writers, for the check with the official reader.
     make(dir, "plan --env pendulum --model true --steps 3 --candidates 16 --elites 4 --out plan.mcap")?;

@@ -44,10 +44,12 @@ pub(crate) struct Target {
     pub(crate) args: &'static str,
     /// The unmutated seed is refused with a clean error by design (a board set is not a dataset).
     pub(crate) seed_is_refused: bool,
+    /// Exit codes the command documents as results, not errors (see `runner::classify`).
+    pub(crate) outcomes: &'static [i32],
 }
 
 pub(crate) const fn target(name: &'static str, input: Input, args: &'static str) -> Target {
-    Target { name, input, program: Program::Mbrl, args, seed_is_refused: false }
+    Target { name, input, program: Program::Mbrl, args, seed_is_refused: false, outcomes: &[] }
 }
 
 pub(crate) const fn mcap(seed: &'static str) -> Input {
@@ -365,7 +367,11 @@ pub(crate) fn targets() -> Vec<Target> {
         ),
         // A finished sweep: its plan, jobs' outcomes and an eval summary, read by `status` and `report` from
         // the copy (a sweep is read where it lies).
-        target("sweep-status", Input::Checkpoint { dir: "sweep-done", files: SWEEP_FILES }, "sweep status {in}"),
+        // `sweep status` exits 1 when a job failed and 3 when some are unfinished: a damaged record is either.
+        Target {
+            outcomes: &[1, 3],
+            ..target("sweep-status", Input::Checkpoint { dir: "sweep-done", files: SWEEP_FILES }, "sweep status {in}")
+        },
         target(
             "sweep-report",
             Input::Checkpoint { dir: "sweep-done", files: SWEEP_FILES },

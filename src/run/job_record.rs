@@ -37,8 +37,18 @@ pub struct JobRecord {
 impl JobRecord {
     /// The record in `dir`, if one is there and readable.
     pub fn read(dir: &Path) -> Option<JobRecord> {
-        let bytes = crate::util::bounded_read::read_bounded(&dir.join(RECORD_FILE), 1 << 20).ok()?;
-        serde_json::from_slice(&bytes).ok()
+        Self::read_checked(dir).ok().flatten()
+    }
+
+    /// The record in `dir`: `None` when there is none, an error (why, in a few words) when the file is there
+    /// but no record, so a follower can tell a damaged record from a job that never started.
+    pub fn read_checked(dir: &Path) -> std::result::Result<Option<JobRecord>, String> {
+        let path = dir.join(RECORD_FILE);
+        if !path.exists() {
+            return Ok(None);
+        }
+        let bytes = crate::util::bounded_read::read_bounded(&path, 1 << 20).map_err(|e| e.to_string())?;
+        serde_json::from_slice(&bytes).map(Some).map_err(|e| format!("{RECORD_FILE} is not a job record: {e}"))
     }
 
     fn write(&self, dir: &Path) -> Result<()> {
@@ -126,5 +136,16 @@ mod tests {
         guard.finish(Err(("error: boom".into(), false))).unwrap();
         let record = JobRecord::read(dir.path()).unwrap();
         assert_eq!((record.state, record.error.as_deref()), (JobState::Failed, Some("error: boom")));
+    }
+
+    /// A damaged record is told apart from none (a sweep's status showed it as "not started").
+    #[test]
+    fn a_damaged_record_is_not_a_missing_one() {
+        let dir = tempfile::tempdir().unwrap();
+        assert_eq!(JobRecord::read_checked(dir.path()), Ok(None));
+        std::fs::write(dir.path().join(RECORD_FILE), "{\"state\":\"donedone\"}").unwrap();
+        let why = JobRecord::read_checked(dir.path()).unwrap_err();
+        assert!(why.contains("job.json is not a job record"), "{why}");
+        assert!(JobRecord::read(dir.path()).is_none(), "a rerun starts afresh over it");
     }
 }

@@ -31,9 +31,10 @@ pub fn standing(job: &JobPlan) -> Standing {
     if RunLock::is_held(&job.run_dir) {
         return Standing::Running { step: step() };
     }
-    match JobRecord::read(&job.run_dir) {
-        None => Standing::NotStarted,
-        Some(record) => match record.state {
+    match JobRecord::read_checked(&job.run_dir) {
+        Err(why) => Standing::Failed { error: format!("{why}; rerun the job's line to redo it") },
+        Ok(None) => Standing::NotStarted,
+        Ok(Some(record)) => match record.state {
             JobState::Done => Standing::Done,
             JobState::Failed => Standing::Failed { error: record.error.unwrap_or_default() },
             JobState::Stopped => Standing::Stopped { step: step(), killed: false },

@@ -156,8 +156,12 @@ impl SeadsConfig {
                 return bad(format!("{name} must lie in [0, 1], got {p}"));
             }
         }
-        if self.sac_hidden.is_empty() || self.sac_hidden.iter().any(|&h| h == 0 || h > 4096) {
-            return bad(format!("sac_hidden must list 1..=4096 units per layer, got {:?}", self.sac_hidden));
+        // The thesis' networks have two hidden layers; sixteen is far past any SAC network, and a list read
+        // from a file may claim millions.
+        let layers = self.sac_hidden.len();
+        if !(1..=16).contains(&layers) || self.sac_hidden.iter().any(|&h| h == 0 || h > 4096) {
+            let shown = if layers <= 16 { format!("{:?}", self.sac_hidden) } else { format!("{layers} layers") };
+            return bad(format!("sac_hidden must list 1-16 layers of 1..=4096 units each, got {shown}"));
         }
         for (name, v) in [
             ("model_learning_rate", self.model_learning_rate),
@@ -220,5 +224,15 @@ mod tests {
         let mut bad = paper.clone();
         bad.skills = 1;
         assert!(bad.validate().unwrap_err().to_string().contains("skills"));
+    }
+
+    /// A config file's million hidden layers of eight units each aborted on allocation before this check.
+    #[test]
+    fn a_network_of_absurd_depth_is_refused_without_listing_it() {
+        let mut deep = SeadsConfig::preset(Preset::Small, 25, Embodiment::Cursor);
+        deep.sac_hidden = vec![8; 1_000_000];
+        let err = deep.validate().unwrap_err().to_string();
+        assert!(err.contains("sac_hidden must list 1-16 layers") && err.contains("got 1000000 layers"), "{err}");
+        assert!(err.len() < 300, "{err}");
     }
 }

@@ -51,10 +51,11 @@ impl<'a> StageRuns<'a> {
         let mut runs = Vec::new();
         let mut missing = Vec::new();
         for job in &stage.jobs {
-            let record = JobRecord::read(&job.run_dir);
+            let record = JobRecord::read_checked(&job.run_dir);
             let why = match &record {
-                None => "not started (no job.json)".to_string(),
-                Some(r) => match r.state {
+                Err(why) => format!("unreadable: {why}"),
+                Ok(None) => "not started (no job.json)".to_string(),
+                Ok(Some(r)) => match r.state {
                     JobState::Done => match read_output(&job.output) {
                         Ok((scalars, curves)) => {
                             runs.push(Run { job, scalars, curves });
