@@ -76,10 +76,8 @@ const RECORDED_LIMIT: f64 = mbrl::data::dataset::RECORDED.hi;
 /// message.
 fn scan_magnitudes(value: &serde_json::Value, found: &mut BTreeSet<String>) {
     match value {
-        serde_json::Value::Number(n) if n.is_f64() => {
-            if n.as_f64().is_some_and(|x| x.abs() > RECORDED_LIMIT) {
-                found.insert(format!("a dataset value beyond ±{RECORDED_LIMIT:e}"));
-            }
+        serde_json::Value::Number(n) if n.is_f64() && n.as_f64().is_some_and(|x| x.abs() > RECORDED_LIMIT) => {
+            found.insert(format!("a dataset value beyond ±{RECORDED_LIMIT:e}"));
         }
         serde_json::Value::Array(items) => items.iter().for_each(|v| scan_magnitudes(v, found)),
         serde_json::Value::Object(fields) => fields.values().for_each(|v| scan_magnitudes(v, found)),
