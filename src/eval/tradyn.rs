@@ -206,6 +206,16 @@ pub struct TradynEvalSummary {
     pub prediction_tests: Option<(f64, f64)>,
 }
 
+/// A p-value as the reports print it; a test with no non-zero difference (every task equal) has none, shown
+/// as "—" rather than NaN.
+fn p_shown(p: f64, digits: usize) -> String {
+    if p.is_nan() {
+        "— (no non-zero difference)".to_string()
+    } else {
+        format!("{p:.digits$e}")
+    }
+}
+
 impl std::fmt::Display for TradynEvalSummary {
     fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
         for (v, variant) in VARIANTS.iter().enumerate() {
@@ -223,16 +233,18 @@ impl std::fmt::Display for TradynEvalSummary {
         let (without, with) = self.prediction_tests.unwrap_or((f64::NAN, f64::NAN));
         write!(
             f,
-            "Wilcoxon: terrain lookup lowers the mean position error: p = {without:.3e} without calibration, {with:.3e} with it"
+            "Wilcoxon: terrain lookup lowers the mean position error: p = {} without calibration, {} with it",
+            p_shown(without, 3),
+            p_shown(with, 3)
         )?;
         for t in &self.energy_tests {
             if t.row > t.column && t.row < VARIANTS.len() {
                 write!(
                     f,
-                    "\nWilcoxon: {} less energy than {}: p = {:.3e}",
+                    "\nWilcoxon: {} less energy than {}: p = {}",
                     variant_name(VARIANTS[t.row]),
                     variant_name(VARIANTS[t.column]),
-                    t.p_value
+                    p_shown(t.p_value, 3)
                 )?;
             }
         }
@@ -632,7 +644,7 @@ pub fn render(summary: &TradynEvalSummary, dir: &Path) -> Result<()> {
                 format!("{:.4}", t.diff_p20),
                 format!("{:.4}", t.diff_median),
                 format!("{:.4}", t.diff_p80),
-                format!("{:.3e}", t.p_value),
+                if t.p_value.is_nan() { String::new() } else { format!("{:.3e}", t.p_value) },
             ]
         })
         .collect();
@@ -766,8 +778,10 @@ fn markdown(
     let _ = writeln!(
         md,
         "\nPrediction (mean position error over a {}-step open-loop prediction per task): terrain lookup lowers it \
-         with p = {:.2e} without calibration and p = {:.2e} with it (one-sided Wilcoxon signed-rank over tasks).",
-        settings.prediction_steps, prediction_tests[0], prediction_tests[1]
+         with p = {} without calibration and p = {} with it (one-sided Wilcoxon signed-rank over tasks).",
+        settings.prediction_steps,
+        p_shown(prediction_tests[0], 2),
+        p_shown(prediction_tests[1], 2)
     );
     let _ = writeln!(md, "\nThesis Table 5.2 (150 tasks × 5 models): −T,−C 5.19 mm median, 6/750 failed; −T,+C 5.23, 0/750; +T,−C 4.22, 14/750; +T,+C 3.85, 0/750.\n");
     let _ = writeln!(md, "## Pairwise energy comparison (Fig. 5.7 analogue)\n");
@@ -784,7 +798,7 @@ fn markdown(
             .map(|c| {
                 pairs.iter().find(|p| &p[0] == r && &p[1] == c).map_or("·".to_string(), |p| {
                     let significant = p[5].parse::<f64>().is_ok_and(|x| x < 0.05);
-                    let text = format!("{} (p {})", p[3], p[5]);
+                    let text = format!("{} (p {})", p[3], if p[5].is_empty() { "—" } else { &p[5] });
                     if significant {
                         format!("**{text}**")
                     } else {
@@ -801,4 +815,18 @@ fn markdown(
          (Fig. 5.5 analogue), paths.png (Fig. 5.6 analogue), config.json, metrics.jsonl."
     );
     md
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every task equal gives no Wilcoxon p-value: the reports say so instead of printing NaN.
+    #[test]
+    fn an_undefined_p_value_is_shown_as_a_dash() {
+        let equal = wilcoxon_signed_rank(&[1.0, 2.0], &[1.0, 2.0], Alternative::Less).map(|w| w.p_value);
+        let p = equal.unwrap_or(f64::NAN);
+        assert_eq!(p_shown(p, 3), "— (no non-zero difference)");
+        assert_eq!(p_shown(0.25, 3), "2.500e-1");
+    }
 }
