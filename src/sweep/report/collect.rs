@@ -132,9 +132,10 @@ fn read_output(output: &Path) -> Result<Read> {
         let mut curves: BTreeMap<String, BTreeMap<u64, f64>> = BTreeMap::new();
         for event in MetricsFollower::open(&metrics)?.poll()? {
             if let Event::Scalar { name, step, value } = event {
-                METRIC
-                    .check(&format!("{name} at step {step}"), value)
-                    .map_err(|e| Error::bad_file(&metrics, e.to_string()))?;
+                if !METRIC.contains(value) {
+                    let e = METRIC.check(&format!("{name} at step {step}"), value).unwrap_err();
+                    return Err(Error::bad_file(&metrics, e.to_string()));
+                }
                 curves.entry(name.clone()).or_default().insert(step, value);
                 match last.iter_mut().find(|(n, _)| *n == name) {
                     Some(entry) => entry.1 = value,

@@ -98,10 +98,9 @@ impl SpinNetWeights {
             )));
         }
         for (name, weights) in [("w1", &self.w1), ("w2", &self.w2)] {
-            for (i, &x) in weights.iter().enumerate() {
-                WEIGHT
-                    .check(&format!("{name}[{i}]"), x)
-                    .map_err(|e| Error::data(format!("spin network weights: {e}")))?;
+            if let Some((i, &x)) = weights.iter().enumerate().find(|(_, &x)| !WEIGHT.contains(x)) {
+                let e = WEIGHT.check(&format!("{name}[{i}]"), x).unwrap_err();
+                return Err(Error::data(format!("spin network weights: {e}")));
             }
         }
         // Over s_m ∈ [0, 1]³, |max(W₁ s_m, 0)ⱼ| ≤ Σₖ |W₁ⱼₖ|, so output i stays within Σⱼ |W₂ᵢⱼ| Σₖ |W₁ⱼₖ|.
