@@ -9,6 +9,7 @@ pub mod activation;
 pub mod adam;
 pub mod backprop;
 pub mod conv;
+pub mod conv_backprop;
 pub mod dense;
 pub mod ensemble;
 pub mod fast;

@@ -6,6 +6,7 @@ pub mod control;
 pub mod data;
 pub mod dynamics;
 pub mod evidence;
+pub mod grad;
 pub mod job;
 pub mod latent_gp;
 pub mod loss;

@@ -6,6 +6,7 @@ use burn::tensor::{Device, Tensor};
 use rand::Rng;
 use rand_distr::StandardNormal;
 
+use super::grad::images_loss_and_gradients;
 use super::latent_gp::{gp_terms, GpTerms, LatentScale};
 use super::loss::{entropy_term, injected};
 use super::vae::VaeNet;
@@ -75,8 +76,25 @@ pub enum Gradients {
 }
 
 /// Loss (and, when wanted, gradients) of one batch. `noise` = the standard-normal draws of the current and
-/// next latents.
+/// next latents. The image VAE runs on its hand-written path (`grad.rs`); the angle VAE through burn.
 pub fn loss_and_gradients(
+    vae: &VaeNet,
+    transition: &[GpHypers],
+    reward: &GpHypers,
+    batch: &Batch,
+    noise: (&[f32], &[f32]),
+    gradients: Gradients,
+    device: &Device,
+) -> Result<StepLoss> {
+    match vae {
+        VaeNet::Images { .. } => images_loss_and_gradients(&vae.params(), transition, reward, batch, noise, gradients),
+        VaeNet::Angles(_) => burn_loss_and_gradients(vae, transition, reward, batch, noise, gradients, device),
+    }
+}
+
+/// [`loss_and_gradients`] through burn's autodiff, for either VAE: the angle VAE's path and the image VAE's
+/// reference.
+pub fn burn_loss_and_gradients(
     vae: &VaeNet,
     transition: &[GpHypers],
     reward: &GpHypers,

@@ -20,8 +20,8 @@ pub const FRAME_CHANNELS: usize = 6;
 pub const FRAME_SIDE: usize = 64;
 /// Width of the encoder's last convolution output, flattened (256 channels × 2 × 2).
 const FLAT: usize = 1024;
-const STD_SHIFT: f64 = 0.55;
-const STD_FLOOR: f64 = 0.01;
+pub const STD_SHIFT: f64 = 0.55;
+pub const STD_FLOOR: f64 = 0.01;
 /// The angle VAE's likelihood std: a few times the 0.01 observation noise, so that reconstruction weighs
 /// about as much against the GP terms as the images' summed pixel likelihood does.
 pub const ANGLE_LIKELIHOOD_STD: f64 = 0.05;

@@ -1,0 +1,430 @@
+//! Strided, unpadded 2-d convolutions and their transposes written out over flat f32 buffers, with their
+//! backward passes, for training steps where burn's autodiff convolutions cost more than the arithmetic (DLGPD's
+//! image VAE). Activations are channels-last (NHWC: image, row, column, channel), so that one kernel row of one
+//! output position reads `kernel × channels` consecutive floats; every product is then one faer GEMM between an
+//! im2col matrix and the weight, whose layout is permuted once per call. Weights and gradients stay in torch's
+//! layout (Conv2d [out, in, k, k], ConvTranspose2d [in, out, k, k]), so checkpoints do not change.
+//!
+//! A convolution and its transpose are adjoints over the same pair of grids: the "big" grid (a convolution's
+//! input, a transposed convolution's output) and the "small" one, with big side ≥ (small side − 1) · stride +
+//! kernel. Both torch layouts are [small channels, big channels, k, k], so one permuted weight
+//! W̃ [small channels, k · k · big channels] serves both directions:
+//!
+//! - convolution: y_small = im2col(x_big) · W̃ᵀ; its input gradient is col2im(dy · W̃);
+//! - transposed convolution: y_big = col2im(x_small · W̃); its input gradient is im2col(dy) · W̃ᵀ.
+//!
+//! Each image is gathered and scattered by one thread and the GEMMs split by rows only, and the images are
+//! taken in chunks whose size depends on the layer alone: the bytes do not depend on the thread count.
+
+use faer::Accum;
+use rayon::prelude::*;
+
+use super::backprop::{add_column_sums, matmul, tensor_index, view, view_mut};
+use super::params::ParamSet;
+use crate::error::{Error, Result};
+
+/// The im2col buffer of one chunk of images stays near this size: large enough for long GEMMs, small enough
+/// that a batch of a thousand 64 × 64 frames does not hold a gigabyte of columns.
+const COLUMN_BYTES: usize = 16 << 20;
+
+/// Which way a layer maps between its two grids.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Direction {
+    /// Conv2d: big grid in, small grid out.
+    Down,
+    /// ConvTranspose2d: small grid in, big grid out.
+    Up,
+}
+
+/// The two square grids a layer maps between.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Grids {
+    pub big_side: usize,
+    pub big_channels: usize,
+    pub small_side: usize,
+    pub small_channels: usize,
+    pub kernel: usize,
+    pub stride: usize,
+}
+
+impl Grids {
+    /// A convolution of `side`² × `channels_in` input without padding.
+    pub fn conv(side: usize, channels_in: usize, channels_out: usize, kernel: usize, stride: usize) -> Grids {
+        let small_side = if side >= kernel && stride > 0 { (side - kernel) / stride + 1 } else { 0 };
+        Grids { big_side: side, big_channels: channels_in, small_side, small_channels: channels_out, kernel, stride }
+    }
+
+    /// A transposed convolution of `side`² × `channels_in` input without padding: output side (side − 1)·s + k.
+    pub fn conv_transpose(side: usize, channels_in: usize, channels_out: usize, kernel: usize, stride: usize) -> Grids {
+        let big_side = side.saturating_sub(1) * stride + kernel;
+        Grids { big_side, big_channels: channels_out, small_side: side, small_channels: channels_in, kernel, stride }
+    }
+
+    pub fn big_len(&self) -> usize {
+        self.big_side * self.big_side * self.big_channels
+    }
+
+    pub fn small_len(&self) -> usize {
+        self.small_side * self.small_side * self.small_channels
+    }
+
+    fn positions(&self) -> usize {
+        self.small_side * self.small_side
+    }
+
+    /// Columns of the im2col matrix: one kernel window over the big grid's channels.
+    fn window(&self) -> usize {
+        self.kernel * self.kernel * self.big_channels
+    }
+
+    /// Multiply-adds of one image through the layer (forward).
+    pub fn macs_per_image(&self) -> usize {
+        self.positions() * self.window() * self.small_channels
+    }
+
+    fn chunk_images(&self) -> usize {
+        (COLUMN_BYTES / (self.positions() * self.window() * 4).max(1)).max(1)
+    }
+
+    /// im2col of `images` big-grid images: row (image, y, x) of `col` holds the window whose corner is at
+    /// (y · stride, x · stride), ordered (ky, kx, channel).
+    fn gather(&self, big: &[f32], col: &mut [f32]) {
+        let (k, s, c, side) = (self.kernel, self.stride, self.big_channels, self.big_side);
+        let span = k * c;
+        col.par_chunks_mut(self.positions() * self.window()).zip(big.par_chunks(self.big_len())).for_each(
+            |(col, big)| {
+                for (position, row) in col.chunks_mut(self.window()).enumerate() {
+                    let (y, x) = (position / self.small_side, position % self.small_side);
+                    for (ky, piece) in row.chunks_mut(span).enumerate() {
+                        let start = ((y * s + ky) * side + x * s) * c;
+                        piece.copy_from_slice(&big[start..start + span]);
+                    }
+                }
+            },
+        );
+    }
+
+    /// The adjoint of [`Grids::gather`]: adds every window of `col` back onto the big grid.
+    fn scatter_add(&self, col: &[f32], big: &mut [f32]) {
+        let (k, s, c, side) = (self.kernel, self.stride, self.big_channels, self.big_side);
+        let span = k * c;
+        big.par_chunks_mut(self.big_len()).zip(col.par_chunks(self.positions() * self.window())).for_each(
+            |(big, col)| {
+                for (position, row) in col.chunks(self.window()).enumerate() {
+                    let (y, x) = (position / self.small_side, position % self.small_side);
+                    for (ky, piece) in row.chunks(span).enumerate() {
+                        let start = ((y * s + ky) * side + x * s) * c;
+                        big[start..start + span].iter_mut().zip(piece).for_each(|(b, p)| *b += p);
+                    }
+                }
+            },
+        );
+    }
+}
+
+/// One convolution or transposed convolution of a parameter set, ready to run forward and backward.
+pub struct StridedConv {
+    pub grids: Grids,
+    pub direction: Direction,
+    /// W̃ [small channels, k · k · big channels].
+    weight: Vec<f32>,
+    bias: Vec<f32>,
+    weight_index: usize,
+    bias_index: usize,
+    /// Images per im2col buffer.
+    chunk: usize,
+}
+
+impl StridedConv {
+    /// The layer `prefix` (`prefix.weight` in torch's layout, `prefix.bias`) of `params`.
+    pub fn new(params: &ParamSet, prefix: &str, grids: Grids, direction: Direction) -> Result<Self> {
+        let (k, big, small) = (grids.kernel, grids.big_channels, grids.small_channels);
+        if grids.small_side == 0 || grids.stride == 0 || grids.big_side < (grids.small_side - 1) * grids.stride + k {
+            return Err(Error::config(format!("'{prefix}': {grids:?} is not a valid strided convolution")));
+        }
+        let weight_index = tensor_index(params, &format!("{prefix}.weight"), &[small, big, k, k])?;
+        let out_channels = match direction {
+            Direction::Down => small,
+            Direction::Up => big,
+        };
+        let bias_index = tensor_index(params, &format!("{prefix}.bias"), &[out_channels])?;
+        Ok(StridedConv {
+            grids,
+            direction,
+            weight: channels_last(&params.tensors[weight_index].values, small, big, k * k),
+            bias: params.tensors[bias_index].values.clone(),
+            weight_index,
+            bias_index,
+            chunk: grids.chunk_images(),
+        })
+    }
+
+    pub fn input_len(&self) -> usize {
+        match self.direction {
+            Direction::Down => self.grids.big_len(),
+            Direction::Up => self.grids.small_len(),
+        }
+    }
+
+    pub fn output_len(&self) -> usize {
+        match self.direction {
+            Direction::Down => self.grids.small_len(),
+            Direction::Up => self.grids.big_len(),
+        }
+    }
+
+    /// `x`: `images` inputs (NHWC) → their outputs (NHWC).
+    pub fn forward(&self, x: &[f32], images: usize) -> Vec<f32> {
+        debug_assert_eq!(x.len(), images * self.input_len());
+        let g = &self.grids;
+        let (window, positions, small) = (g.window(), g.positions(), g.small_channels);
+        let chunk = self.chunk;
+        let mut col = vec![0.0f32; chunk.min(images) * positions * window];
+        match self.direction {
+            Direction::Down => {
+                let mut y = self.bias.repeat(images * positions);
+                for (x, y) in x.chunks(chunk * g.big_len()).zip(y.chunks_mut(chunk * g.small_len())) {
+                    let rows = y.len() / small;
+                    let col = &mut col[..rows * window];
+                    g.gather(x, col);
+                    matmul(
+                        view_mut(y, rows, small),
+                        Accum::Add,
+                        view(col, rows, window),
+                        view(&self.weight, small, window).transpose(),
+                    );
+                }
+                y
+            }
+            Direction::Up => {
+                let mut y = self.bias.repeat(images * g.big_side * g.big_side);
+                for (x, y) in x.chunks(chunk * g.small_len()).zip(y.chunks_mut(chunk * g.big_len())) {
+                    let rows = x.len() / small;
+                    let col = &mut col[..rows * window];
+                    matmul(
+                        view_mut(col, rows, window),
+                        Accum::Replace,
+                        view(x, rows, small),
+                        view(&self.weight, small, window),
+                    );
+                    g.scatter_add(col, y);
+                }
+                y
+            }
+        }
+    }
+
+    /// Adds the weight and bias gradients for output gradients `dy` at inputs `x` to `grads` (torch's layout)
+    /// and returns the input gradients when asked for.
+    pub fn backward(&self, x: &[f32], dy: &[f32], images: usize, grads: &mut [Vec<f32>], want_dx: bool) -> Vec<f32> {
+        debug_assert_eq!(x.len(), images * self.input_len());
+        debug_assert_eq!(dy.len(), images * self.output_len());
+        let g = &self.grids;
+        let (window, positions, small) = (g.window(), g.positions(), g.small_channels);
+        let chunk = self.chunk;
+        let mut col = vec![0.0f32; chunk.min(images) * positions * window];
+        let mut weight_grad = vec![0.0f32; small * window];
+        let mut dx = if want_dx { vec![0.0f32; x.len()] } else { Vec::new() };
+        let (small_grid, big_grid) = match self.direction {
+            Direction::Down => (dy, x),
+            Direction::Up => (x, dy),
+        };
+        let small_chunks = small_grid.chunks(chunk * g.small_len());
+        for (index, (small_part, big_part)) in small_chunks.zip(big_grid.chunks(chunk * g.big_len())).enumerate() {
+            let rows = small_part.len() / small;
+            let col = &mut col[..rows * window];
+            // The small grid's values times the big grid's windows: the weight gradient in both directions.
+            g.gather(big_part, col);
+            matmul(
+                view_mut(&mut weight_grad, small, window),
+                Accum::Add,
+                view(small_part, rows, small).transpose(),
+                view(col, rows, window),
+            );
+            if !want_dx {
+                continue;
+            }
+            let dx = &mut dx[index * chunk * self.input_len()..][..small_part.len() / g.small_len() * self.input_len()];
+            match self.direction {
+                Direction::Down => {
+                    matmul(
+                        view_mut(col, rows, window),
+                        Accum::Replace,
+                        view(small_part, rows, small),
+                        view(&self.weight, small, window),
+                    );
+                    g.scatter_add(col, dx);
+                }
+                Direction::Up => matmul(
+                    view_mut(dx, rows, small),
+                    Accum::Replace,
+                    view(col, rows, window),
+                    view(&self.weight, small, window).transpose(),
+                ),
+            }
+        }
+        let torch_grad = &mut grads[self.weight_index];
+        add_torch_layout(torch_grad, &weight_grad, small, g.big_channels, g.kernel * g.kernel);
+        add_column_sums(&mut grads[self.bias_index], dy);
+        dx
+    }
+}
+
+/// [rows, channels, taps] → [rows, taps, channels].
+fn channels_last(w: &[f32], rows: usize, channels: usize, taps: usize) -> Vec<f32> {
+    let mut out = vec![0.0; w.len()];
+    for r in 0..rows {
+        for c in 0..channels {
+            for t in 0..taps {
+                out[(r * taps + t) * channels + c] = w[(r * channels + c) * taps + t];
+            }
+        }
+    }
+    out
+}
+
+/// dst [rows, channels, taps] += src [rows, taps, channels].
+fn add_torch_layout(dst: &mut [f32], src: &[f32], rows: usize, channels: usize, taps: usize) {
+    for r in 0..rows {
+        for c in 0..channels {
+            for t in 0..taps {
+                dst[(r * channels + c) * taps + t] += src[(r * taps + t) * channels + c];
+            }
+        }
+    }
+}
+
+/// `images` images [channels, side, side] → [side, side, channels].
+pub fn to_channels_last(x: &[f32], channels: usize, side: usize) -> Vec<f32> {
+    let mut out = vec![0.0; x.len()];
+    to_channels_last_into(x, channels, side, &mut out);
+    out
+}
+
+/// [`to_channels_last`] into a buffer of the same length.
+pub fn to_channels_last_into(x: &[f32], channels: usize, side: usize, out: &mut [f32]) {
+    let plane = side * side;
+    out.par_chunks_mut(channels * plane).zip(x.par_chunks(channels * plane)).for_each(|(out, x)| {
+        for c in 0..channels {
+            for p in 0..plane {
+                out[p * channels + c] = x[c * plane + p];
+            }
+        }
+    });
+}
+
+/// The inverse of [`to_channels_last`].
+pub fn to_channels_first(x: &[f32], channels: usize, side: usize) -> Vec<f32> {
+    let plane = side * side;
+    let mut out = vec![0.0; x.len()];
+    out.par_chunks_mut(channels * plane).zip(x.par_chunks(channels * plane)).for_each(|(out, x)| {
+        for c in 0..channels {
+            for p in 0..plane {
+                out[c * plane + p] = x[p * channels + c];
+            }
+        }
+    });
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use burn::module::Module;
+    use burn::tensor::Tensor;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    use super::*;
+    use crate::nn::backprop::zero_gradients;
+    use crate::nn::conv::Conv2dConfig;
+    use crate::nn::tensor::{tensor, training_device, values};
+
+    fn close(ours: &[f32], theirs: &[f32], what: &str) {
+        assert_eq!(ours.len(), theirs.len(), "{what}");
+        let scale = theirs.iter().fold(0.0f32, |m, x| m.max(x.abs())).max(1e-3);
+        let worst = ours.iter().zip(theirs).fold(0.0f32, |m, (x, y)| m.max((x - y).abs()));
+        assert!(worst <= 1e-5 * scale, "{what}: differs by {worst} at scale {scale}");
+    }
+
+    /// Output, input gradient and parameter gradients of one layer against burn's, for the loss Σ y ⊙ R.
+    fn check<M: Module>(layer: M, forward: impl Fn(&M, Tensor<4>) -> Tensor<4>, grids: Grids, direction: Direction) {
+        let device = training_device();
+        let mut rng = ChaCha8Rng::seed_from_u64(grids.big_side as u64);
+        let images = 3;
+        let (in_channels, in_side, out_channels, out_side) = match direction {
+            Direction::Down => (grids.big_channels, grids.big_side, grids.small_channels, grids.small_side),
+            Direction::Up => (grids.small_channels, grids.small_side, grids.big_channels, grids.big_side),
+        };
+        let x: Vec<f32> = (0..images * in_channels * in_side * in_side).map(|_| rng.random_range(-1.0..1.0)).collect();
+        let r: Vec<f32> =
+            (0..images * out_channels * out_side * out_side).map(|_| rng.random_range(-1.0..1.0)).collect();
+        let xt = tensor(x.clone(), [images, in_channels, in_side, in_side], &device).require_grad();
+        let y = forward(&layer, xt.clone());
+        let burn_grads = (y.clone() * tensor(r.clone(), y.dims(), &device)).sum().backward();
+        let params = ParamSet::<f32>::from_module(&layer, |n: &str| format!("layer.{n}"));
+        let ours = StridedConv::new(&params, "layer", grids, direction).unwrap();
+        let x_last = to_channels_last(&x, in_channels, in_side);
+        let y_ours = ours.forward(&x_last, images);
+        close(&to_channels_first(&y_ours, out_channels, out_side), &values(&y), "output");
+        let mut grads = zero_gradients(&params);
+        let dx = ours.backward(&x_last, &to_channels_last(&r, out_channels, out_side), images, &mut grads, true);
+        close(&to_channels_first(&dx, in_channels, in_side), &values(&xt.grad(&burn_grads).unwrap()), "dx");
+        for ((t, g), theirs) in params.tensors.iter().zip(&grads).zip(ParamSet::<f32>::gradients(&layer, &burn_grads)) {
+            close(g, &theirs, &t.name);
+        }
+    }
+
+    /// Both directions, with sides that leave a convolution's last row unread and kernels wider than the stride.
+    #[test]
+    fn both_directions_match_burn_forward_and_backward() {
+        let device = training_device();
+        let mut rng = ChaCha8Rng::seed_from_u64(1);
+        for (side, cin, cout, k, s) in [(9, 2, 3, 3, 2), (7, 4, 5, 4, 3), (6, 3, 2, 4, 2)] {
+            let conv = Conv2dConfig::new(cin, cout, k, s).init(&device, &mut rng);
+            check(conv, |l, x| l.forward(x), Grids::conv(side, cin, cout, k, s), Direction::Down);
+        }
+        for (side, cin, cout, k, s) in [(4, 3, 2, 3, 2), (1, 5, 3, 5, 2), (3, 2, 4, 6, 2)] {
+            let deconv = Conv2dConfig::new(cin, cout, k, s).init_transposed(&device, &mut rng);
+            check(deconv, |l, x| l.forward(x), Grids::conv_transpose(side, cin, cout, k, s), Direction::Up);
+        }
+    }
+
+    /// A batch split over several im2col buffers gives what one buffer gives, in both directions.
+    #[test]
+    fn chunked_batches_match_one_chunk() {
+        let device = training_device();
+        let mut rng = ChaCha8Rng::seed_from_u64(2);
+        let images = 5;
+        let named = |n: &str| format!("layer.{n}");
+        let down = ParamSet::<f32>::from_module(&Conv2dConfig::new(3, 4, 4, 2).init(&device, &mut rng), named);
+        let up = ParamSet::<f32>::from_module(&Conv2dConfig::new(4, 3, 4, 2).init_transposed(&device, &mut rng), named);
+        for (params, grids, direction) in [
+            (down, Grids::conv(10, 3, 4, 4, 2), Direction::Down),
+            (up, Grids::conv_transpose(4, 4, 3, 4, 2), Direction::Up),
+        ] {
+            let whole = StridedConv::new(&params, "layer", grids, direction).unwrap();
+            let mut chunked = StridedConv::new(&params, "layer", grids, direction).unwrap();
+            assert!(whole.chunk >= images);
+            chunked.chunk = 2;
+            let x: Vec<f32> = (0..images * whole.input_len()).map(|_| rng.random_range(-1.0..1.0)).collect();
+            let dy: Vec<f32> = (0..images * whole.output_len()).map(|_| rng.random_range(-1.0..1.0)).collect();
+            close(&chunked.forward(&x, images), &whole.forward(&x, images), "output");
+            let (mut whole_grads, mut chunked_grads) = (zero_gradients(&params), zero_gradients(&params));
+            let dx_whole = whole.backward(&x, &dy, images, &mut whole_grads, true);
+            close(&chunked.backward(&x, &dy, images, &mut chunked_grads, true), &dx_whole, "dx");
+            for (ours, theirs) in chunked_grads.iter().zip(&whole_grads) {
+                close(ours, theirs, "parameter gradient");
+            }
+        }
+    }
+
+    #[test]
+    fn layouts_round_trip() {
+        let x: Vec<f32> = (0..2 * 3 * 16).map(|i| i as f32).collect();
+        assert_eq!(to_channels_first(&to_channels_last(&x, 3, 4), 3, 4), x);
+        let w: Vec<f32> = (0..2 * 3 * 4).map(|i| i as f32).collect();
+        let mut back = vec![0.0; w.len()];
+        add_torch_layout(&mut back, &channels_last(&w, 2, 3, 4), 2, 3, 4);
+        assert_eq!(back, w);
+    }
+}
