@@ -12,7 +12,7 @@ use rayon::prelude::*;
 
 use super::config::PetsConfig;
 use crate::error::Result;
-use crate::nn::activation::Activation;
+use crate::nn::activation::{fast_exp, fast_sigmoid as sigmoid, fast_softplus as softplus, Activation};
 use crate::nn::backprop::{add_column_sums, matmul, tensor_index, view, view_mut, zero_gradients};
 use crate::nn::ParamSet;
 
@@ -124,14 +124,6 @@ struct BoundedLogVar {
     lower_slope: f32,
 }
 
-fn softplus(x: f32) -> f32 {
-    x.max(0.0) + (-x.abs()).exp().ln_1p()
-}
-
-fn sigmoid(x: f32) -> f32 {
-    1.0 / (1.0 + (-x).exp())
-}
-
 fn bounded(raw: f32, min: f32, max: f32) -> BoundedLogVar {
     let upper = max - softplus(max - raw);
     BoundedLogVar {
@@ -227,7 +219,7 @@ impl<'a> EnsembleNet<'a> {
             for j in 0..d {
                 let b = bounded(out[d + j], self.min_logvar[j], self.max_logvar[j]);
                 let error = out[j] - y[j];
-                let precision = (-b.logvar).exp();
+                let precision = fast_exp(-b.logvar);
                 row_sum += f64::from(0.5 * (error * error * precision + b.logvar));
                 d_out[j] = error * precision * scale;
                 let d_logvar = 0.5 * (1.0 - error * error * precision) * scale;
