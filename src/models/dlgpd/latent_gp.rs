@@ -10,6 +10,8 @@
 //! - every GP's negative log marginal likelihood and Gamma(1, 5) log prior divided by the batch size, and
 //!   the SNR penalty of all of them.
 
+use rayon::prelude::*;
+
 use crate::error::{Error, Result};
 use crate::models::gp::{GpHypers, ObjectiveGradients};
 
@@ -150,11 +152,28 @@ fn terms_with_unscale(
     let mut d_next_latents = vec![0.0; rows * dims];
     let mut d_hypers = Vec::with_capacity(dims + 1);
     let (mut transition_value, mut snr, mut jitter) = (0.0, 0.0, 0.0f64);
-    for (d, hypers) in transition.iter().enumerate() {
-        let targets: Vec<f64> = (0..rows).map(|b| next_latents[b * dims + d]).collect();
+    let reward_inputs = latent_action_rows(latents, actions, dims);
+    let floor = rewards.iter().copied().fold(f64::INFINITY, f64::min);
+    // The GPs' factorizations are independent: each on its own thread, summed below in a fixed order.
+    let (objectives, reward_objective) = rayon::join(
+        || {
+            transition
+                .par_iter()
+                .enumerate()
+                .map(|(d, hypers)| {
+                    let targets: Vec<f64> = (0..rows).map(|b| next_latents[b * dims + d]).collect();
+                    let sigma = unscale.std[d];
+                    let prior_mean: Vec<f64> =
+                        (0..rows).map(|b| inputs[b * width + d] * sigma + unscale.mean[d]).collect();
+                    hypers.objective_scaled(&inputs, &targets, &prior_mean, sigma * sigma)
+                })
+                .collect::<Vec<_>>()
+        },
+        || reward.objective(&reward_inputs, rewards, &vec![floor; rows]),
+    );
+    for ((d, hypers), objective) in transition.iter().enumerate().zip(objectives) {
+        let (value, g, gp) = objective?;
         let sigma = unscale.std[d];
-        let prior_mean: Vec<f64> = (0..rows).map(|b| inputs[b * width + d] * sigma + unscale.mean[d]).collect();
-        let (value, g, gp) = hypers.objective_scaled(&inputs, &targets, &prior_mean, sigma * sigma)?;
         transition_value += value;
         jitter = jitter.max(gp.jitter());
         for b in 0..rows {
@@ -174,9 +193,7 @@ fn terms_with_unscale(
     }
     let d_latents = scale.backward(latents, &d_inputs);
 
-    let reward_inputs = latent_action_rows(latents, actions, dims);
-    let floor = rewards.iter().copied().fold(f64::INFINITY, f64::min);
-    let (reward_value, mut g, gp) = reward.objective(&reward_inputs, rewards, &vec![floor; rows])?;
+    let (reward_value, mut g, gp) = reward_objective?;
     jitter = jitter.max(gp.jitter());
     let (penalty, d_signal, d_noise) = reward.snr_penalty();
     snr += penalty;
