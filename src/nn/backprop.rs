@@ -13,11 +13,18 @@ use crate::error::{Error, Result};
 /// Below this many multiply-adds a GEMM stays on one thread: splitting costs more than it saves.
 const PARALLEL_WORK: usize = 1 << 19;
 
-/// dst (m × n) = [dst +] a (m × k) · b (k × n). Large products are split by rows of `dst` over the rayon
-/// pool; every element is still summed by one thread in one order, so the bytes do not depend on the split.
+/// dst (m × n) = [dst +] a (m × k) · b (k × n). Large products are split over the rayon pool, by rows of
+/// `dst`, or by columns where `dst` is at least four times wider than tall: each piece packs the whole of the
+/// operand the pieces share, and there `a` is much the smaller one (a convolution's weight gradient against
+/// its im2col matrix). Every element is still summed by one thread in one order, so the bytes do not depend
+/// on the split.
 pub fn matmul(dst: MatMut<'_, f32>, accum: Accum, a: MatRef<'_, f32>, b: MatRef<'_, f32>) {
     let pieces = if dst.nrows() * dst.ncols() * a.ncols() >= PARALLEL_WORK { rayon::current_num_threads() } else { 1 };
-    split_rows(dst, accum, a, b, pieces);
+    if dst.ncols() >= 4 * dst.nrows() {
+        split_cols(dst, accum, a, b, pieces);
+    } else {
+        split_rows(dst, accum, a, b, pieces);
+    }
 }
 
 fn split_rows(dst: MatMut<'_, f32>, accum: Accum, a: MatRef<'_, f32>, b: MatRef<'_, f32>, pieces: usize) {
@@ -31,6 +38,19 @@ fn split_rows(dst: MatMut<'_, f32>, accum: Accum, a: MatRef<'_, f32>, b: MatRef<
     let (top, bottom) = dst.split_at_row_mut(mid);
     let (a_top, a_bottom) = a.split_at_row(mid);
     rayon::join(|| split_rows(top, accum, a_top, b, half), || split_rows(bottom, accum, a_bottom, b, pieces - half));
+}
+
+fn split_cols(dst: MatMut<'_, f32>, accum: Accum, a: MatRef<'_, f32>, b: MatRef<'_, f32>, pieces: usize) {
+    let n = dst.ncols();
+    if pieces <= 1 || n < 16 {
+        faer::linalg::matmul::matmul(dst, accum, a, b, 1.0f32, Par::Seq);
+        return;
+    }
+    let half = pieces / 2;
+    let mid = n * half / pieces;
+    let (left, right) = dst.split_at_col_mut(mid);
+    let (b_left, b_right) = b.split_at_col(mid);
+    rayon::join(|| split_cols(left, accum, a, b_left, half), || split_cols(right, accum, a, b_right, pieces - half));
 }
 
 /// Row-major `rows × cols` view of a buffer.
@@ -245,7 +265,10 @@ mod tests {
         for pieces in [2, 3, 7] {
             let mut split = vec![0.5; m * n];
             split_rows(view_mut(&mut split, m, n), Accum::Add, view(&a, m, k), view(&b, k, n), pieces);
-            assert_eq!(split, one, "{pieces} pieces");
+            assert_eq!(split, one, "{pieces} pieces of rows");
+            let mut split = vec![0.5; m * n];
+            split_cols(view_mut(&mut split, m, n), Accum::Add, view(&a, m, k), view(&b, k, n), pieces);
+            assert_eq!(split, one, "{pieces} pieces of columns");
         }
     }
 }

@@ -100,10 +100,10 @@ pub fn critic_loss_and_gradients(
     rows: usize,
 ) -> Result<(f64, f64, Vec<Vec<f32>>)> {
     let d_in = input.len() / rows.max(1);
-    let critics = twin(params, prefix, d_in, hidden)?;
-    let mut grads = zero_gradients(params);
-    let (mut loss, mut q_sum) = (0.0f64, 0.0f64);
-    for critic in &critics {
+    let [q1_net, q2_net] = twin(params, prefix, d_in, hidden)?;
+    // The critics share no tensor: each runs on its own thread into its own gradients, merged by name.
+    let one_critic = |critic: &ReluStack| {
+        let mut grads = zero_gradients(params);
         let (q, tape) = critic.forward(input, rows, false);
         let mut sum = 0.0f64;
         let dq: Vec<f32> = q
@@ -114,11 +114,18 @@ pub fn critic_loss_and_gradients(
                 2.0 * (q - y) / rows as f32
             })
             .collect();
-        loss += sum / rows as f64;
-        q_sum += q.iter().map(|&q| f64::from(q)).sum::<f64>();
         critic.backward(&tape, None, &dq, rows, Some(&mut grads), false);
+        (sum / rows as f64, q.iter().map(|&q| f64::from(q)).sum::<f64>(), grads)
+    };
+    let ((loss1, q_sum1, mut grads), (loss2, q_sum2, mut grads2)) =
+        rayon::join(|| one_critic(&q1_net), || one_critic(&q2_net));
+    let q2_prefix = format!("{prefix}.q2.");
+    for (tensor, (grad, grad2)) in params.tensors.iter().zip(grads.iter_mut().zip(&mut grads2)) {
+        if tensor.name.starts_with(&q2_prefix) {
+            *grad = std::mem::take(grad2);
+        }
     }
-    Ok((loss, q_sum / (2 * rows) as f64, grads))
+    Ok((loss1 + loss2, (q_sum1 + q_sum2) / (2 * rows) as f64, grads))
 }
 
 /// What the actor's loss reports beside its gradients.
@@ -177,7 +184,7 @@ pub fn actor_loss_and_gradients(
     }
     let [q1_net, q2_net] = &critics;
     let ((q1, tape1), (q2, tape2)) =
-        (q1_net.forward(&critic_input, rows, false), q2_net.forward(&critic_input, rows, false));
+        rayon::join(|| q1_net.forward(&critic_input, rows, false), || q2_net.forward(&critic_input, rows, false));
 
     let per_row = 1.0 / rows as f32;
     let (mut loss, mut log_prob_sum) = (0.0f64, 0.0f64);
@@ -194,8 +201,11 @@ pub fn actor_loss_and_gradients(
         loss += f64::from(alpha * log_prob[r] - q_min);
         log_prob_sum += f64::from(log_prob[r]);
     }
-    let mut d_input = q1_net.backward(&tape1, None, &dq1, rows, None, true);
-    add_into(&mut d_input, &q2_net.backward(&tape2, None, &dq2, rows, None, true));
+    let (mut d_input, d_input2) = rayon::join(
+        || q1_net.backward(&tape1, None, &dq1, rows, None, true),
+        || q2_net.backward(&tape2, None, &dq2, rows, None, true),
+    );
+    add_into(&mut d_input, &d_input2);
 
     let d_log_prob = alpha * per_row;
     let (mut d_mean, mut d_raw_log_std) = (vec![0.0f32; n], vec![0.0f32; n]);

@@ -397,3 +397,43 @@ fn hand_written_losses_and_gradients_match_burn_autodiff() {
     assert!((actor.loss - theirs).abs() < 1e-4 * (1.0 + theirs.abs()), "actor loss {} vs {theirs}", actor.loss);
     close("actor", &actor.gradients, &reference, &sac.policy_params);
 }
+
+/// The twin critics run side by side and GEMMs split by rows or columns only: one thread or two, same bytes.
+#[test]
+fn losses_and_gradients_do_not_depend_on_the_thread_count() {
+    use super::grad::{actor_loss_and_gradients, critic_loss_and_gradients};
+    use super::networks::CRITIC;
+
+    let mut c = config(9, vec![-0.2, -0.2, -1.0], vec![0.2, 0.2, 1.0]);
+    c.hidden = vec![256, 256];
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    let sac = Sac::new(c.clone(), &mut rng).unwrap();
+    let (rows, od, ad) = (128, c.obs_dim, c.action_dim);
+    let batch = random_batch(&mut rng, &c, rows);
+    let input = super::inference::concat_rows(&batch.obs, od, &batch.actions, ad, rows);
+    let targets = random_obs(&mut rng, rows, 2.0);
+    let eps = random_obs(&mut rng, rows * ad, 1.5);
+    let (scale, bias) = (c.action_scale(), c.action_bias());
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| {
+            let (loss, q, critic) =
+                critic_loss_and_gradients(&sac.critic_params, CRITIC, &c.hidden, &input, &targets, rows).unwrap();
+            let actor = actor_loss_and_gradients(
+                &sac.policy_params,
+                &sac.critic_params,
+                CRITIC,
+                &c.hidden,
+                &batch.obs,
+                &eps,
+                &scale,
+                &bias,
+                0.2,
+                rows,
+            )
+            .unwrap();
+            (loss.to_bits(), q.to_bits(), critic, actor.loss.to_bits(), actor.gradients)
+        })
+    };
+    assert_eq!(run(1), run(2));
+}
