@@ -210,7 +210,7 @@ repro-seads: build
 # matching evidence, Wilcoxon over 6 pairs: ≈ 75 min on one core). The Figs. 3.4/3.5 analogues (5/10/20
 # evidence rollouts; standard, inverted, light, heavy) are DLGPD_EVAL="--evidence-rollouts 5,10,20 --runs 2
 # --candidates 300 --elites 30 --iters 10" (hours). The medium preset's 3000 steps reconstruct the pole but
-# do not swing up; DLGPD_STEPS=30000 (about 12 h of one core) is the length of the run RESULTS.md reports,
+# do not swing up; DLGPD_STEPS=30000 (about 4 h of one core) is the length of the run RESULTS.md reports,
 # with one thread as there; an interrupted make resumes the stopped run. A finished run is trained further
 # with `mbrl train --resume DIR --steps N`.
 DLGPD_PRESET ?= medium

@@ -8,9 +8,9 @@ use crate::error::{Error, Result};
 pub enum Preset {
     /// MLP VAE on pole directions (cos θ, sin θ) instead of images, batch 256, 3000 steps: minutes on 2 cores.
     Small,
-    /// The paper's conv VAE on 64 × 64 frames at batch 128 for 3000 steps (about an hour on 2 cores).
+    /// The paper's conv VAE on 64 × 64 frames at batch 128 for 3000 steps (about 25 minutes on one core).
     Medium,
-    /// The paper: batch 1024, 2000 epochs of 14 000 transitions = 28 000 steps (days on 2 cores).
+    /// The paper: batch 1024, 2000 epochs of 14 000 transitions = 28 000 steps (about a day on one core).
     Paper,
 }
 
