@@ -177,41 +177,61 @@ impl StridedConv {
     pub fn forward(&self, x: &[f32], images: usize) -> Vec<f32> {
         debug_assert_eq!(x.len(), images * self.input_len());
         let g = &self.grids;
-        let (window, positions, small) = (g.window(), g.positions(), g.small_channels);
+        let (window, positions) = (g.window(), g.positions());
         let chunk = self.chunk;
         let mut col = vec![0.0f32; chunk.min(images) * positions * window];
         match self.direction {
             Direction::Down => {
                 let mut y = self.bias.repeat(images * positions);
                 for (x, y) in x.chunks(chunk * g.big_len()).zip(y.chunks_mut(chunk * g.small_len())) {
-                    let rows = y.len() / small;
-                    let col = &mut col[..rows * window];
-                    g.gather(x, col);
-                    matmul(
-                        view_mut(y, rows, small),
-                        Accum::Add,
-                        view(col, rows, window),
-                        view(&self.weight, small, window).transpose(),
-                    );
+                    self.windows_times_weight(x, &mut col, y, Accum::Add);
                 }
                 y
             }
             Direction::Up => {
                 let mut y = self.bias.repeat(images * g.big_side * g.big_side);
                 for (x, y) in x.chunks(chunk * g.small_len()).zip(y.chunks_mut(chunk * g.big_len())) {
-                    let rows = x.len() / small;
-                    let col = &mut col[..rows * window];
-                    matmul(
-                        view_mut(col, rows, window),
-                        Accum::Replace,
-                        view(x, rows, small),
-                        view(&self.weight, small, window),
-                    );
-                    g.scatter_add(col, y);
+                    self.spread_onto_windows(x, &mut col, y);
                 }
                 y
             }
         }
+    }
+
+    /// small (rows × small channels) [+]= im2col(big) · W̃ᵀ: a convolution, and a transposed convolution's
+    /// input gradient. `col` is scratch of at least rows × window.
+    fn windows_times_weight(&self, big: &[f32], col: &mut [f32], small: &mut [f32], accum: Accum) {
+        let rows = small.len() / self.grids.small_channels;
+        let col = &mut col[..rows * self.grids.window()];
+        self.grids.gather(big, col);
+        self.columns_times_weight(col, small, accum);
+    }
+
+    /// small [+]= col · W̃ᵀ for windows already gathered into `col` (rows × window).
+    fn columns_times_weight(&self, col: &[f32], small: &mut [f32], accum: Accum) {
+        let (window, channels) = (self.grids.window(), self.grids.small_channels);
+        let rows = small.len() / channels;
+        matmul(
+            view_mut(small, rows, channels),
+            accum,
+            view(col, rows, window),
+            view(&self.weight, channels, window).transpose(),
+        );
+    }
+
+    /// big += col2im(small · W̃), the adjoint of [`Self::windows_times_weight`]: a transposed convolution, and
+    /// a convolution's input gradient.
+    fn spread_onto_windows(&self, small: &[f32], col: &mut [f32], big: &mut [f32]) {
+        let (window, channels) = (self.grids.window(), self.grids.small_channels);
+        let rows = small.len() / channels;
+        let col = &mut col[..rows * window];
+        matmul(
+            view_mut(col, rows, window),
+            Accum::Replace,
+            view(small, rows, channels),
+            view(&self.weight, channels, window),
+        );
+        self.grids.scatter_add(col, big);
     }
 
     /// Adds the weight and bias gradients for output gradients `dy` at inputs `x` to `grads` (torch's layout)
@@ -246,21 +266,9 @@ impl StridedConv {
             }
             let dx = &mut dx[index * chunk * self.input_len()..][..small_part.len() / g.small_len() * self.input_len()];
             match self.direction {
-                Direction::Down => {
-                    matmul(
-                        view_mut(col, rows, window),
-                        Accum::Replace,
-                        view(small_part, rows, small),
-                        view(&self.weight, small, window),
-                    );
-                    g.scatter_add(col, dx);
-                }
-                Direction::Up => matmul(
-                    view_mut(dx, rows, small),
-                    Accum::Replace,
-                    view(col, rows, window),
-                    view(&self.weight, small, window).transpose(),
-                ),
+                Direction::Down => self.spread_onto_windows(small_part, col, dx),
+                // `col` holds this chunk's windows of dy already, gathered for the weight gradient.
+                Direction::Up => self.columns_times_weight(col, dx, Accum::Replace),
             }
         }
         let torch_grad = &mut grads[self.weight_index];
