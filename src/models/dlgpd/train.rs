@@ -10,7 +10,7 @@ use rand::Rng;
 use rand_distr::StandardNormal;
 
 use super::config::DlgpdConfig;
-use super::data::Windows;
+use super::data::{ObservationKind, Windows};
 use super::evidence::{condition_on_rows, encoded_means};
 use super::latent_gp::LatentScale;
 use super::model::{
@@ -21,7 +21,7 @@ use super::vae::{encode_rows, VaeNet};
 use crate::error::{Error, Result};
 use crate::models::gp::{GpHypers, HyperInit};
 use crate::nn::params::NamedTensor;
-use crate::nn::tensor::training_device;
+use crate::nn::tensor::{inference_device, training_device};
 use crate::nn::{Adam, AdamConfig, ParamSet};
 use crate::train::tensors::TensorData;
 use crate::train::{state, StoredTensor, TrainingMethod};
@@ -157,7 +157,13 @@ impl DlgpdTrainer {
                 train_rows.len()
             )));
         }
-        let device = training_device();
+        // The image VAE trains on its hand-written path; its burn module only encodes (validation, the frozen
+        // scale). On the autodiff device every such pass through the weights would stay in burn's graph, which
+        // only a backward pass clears, and none comes: a gigabyte at every validation.
+        let device = match windows.kind {
+            ObservationKind::Images { .. } => inference_device(),
+            ObservationKind::Angles => training_device(),
+        };
         let mut rng = rng_for(seed, &[INIT_STREAM]);
         let vae = VaeNet::init(windows.kind, config.latent_dim, config.hidden_units, &device, &mut rng)?;
         let params = vae.params();
