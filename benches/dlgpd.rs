@@ -1,8 +1,8 @@
 //! DLGPD's training step at the paper's batch of 1024 transitions: the GP terms alone (three transition GPs
 //! and the reward GP conditioned on the batch, exact f64 Cholesky, with every gradient), and the whole step's
 //! loss and gradients (two encodings of 6 × 64 × 64 frames, one decoding, the GP terms injected, backward),
-//! without the optimizer update; and one CEM iteration of the planner at two evidence sizes. PyTorch reference for the
-//! whole step on this kind of machine: 9.2 s at 2 threads (../shared/ARCHITECTURE.md).
+//! without the optimizer update; and one CEM iteration of the planner at two evidence sizes. PyTorch's figure for
+//! the whole step, measured beside ours on the same machine: `make bench-vs-pytorch ONLY=dlgpd_b1024`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use mbrl::models::dlgpd::data::ObservationKind;
