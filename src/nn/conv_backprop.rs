@@ -77,11 +77,6 @@ impl Grids {
         self.kernel * self.kernel * self.big_channels
     }
 
-    /// Multiply-adds of one image through the layer (forward).
-    pub fn macs_per_image(&self) -> usize {
-        self.positions() * self.window() * self.small_channels
-    }
-
     fn chunk_images(&self) -> usize {
         (COLUMN_BYTES / (self.positions() * self.window() * 4).max(1)).max(1)
     }

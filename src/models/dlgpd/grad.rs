@@ -29,7 +29,7 @@ const FLAT: usize = 1024;
 /// The convolutional VAE's layers over a parameter set named as `VaeNet::params` names them.
 pub struct ConvVaeGrad<'a> {
     encoder: Vec<StridedConv>,
-    /// Side and channels of the encoder's last grid, flattened channels-first into the heads' input.
+    /// Channels and side of the encoder's last grid, flattened channels-first into the heads' input.
     encoder_out: (usize, usize),
     mean: Dense<'a>,
     std: Dense<'a>,
@@ -61,7 +61,7 @@ impl<'a> ConvVaeGrad<'a> {
             encoder.push(StridedConv::new(params, &format!("encoder.conv{}", i + 1), grids, Direction::Down)?);
             (side, channels) = (grids.small_side, out);
         }
-        let flat = side * side * channels;
+        let (encoder_side, flat) = (side, side * side * channels);
         let mut decoder = Vec::new();
         let (mut side, mut channels) = (1, FLAT);
         for (i, &(out, kernel)) in DECODER.iter().enumerate() {
@@ -73,7 +73,7 @@ impl<'a> ConvVaeGrad<'a> {
             return Err(Error::config(format!("the decoder ends at {side} × {side}, not the frames' {FRAME_SIDE}")));
         }
         Ok(ConvVaeGrad {
-            encoder_out: (ENCODER_CHANNELS[3], flat / ENCODER_CHANNELS[3]),
+            encoder_out: (ENCODER_CHANNELS[3], encoder_side),
             mean: Dense::new(params, "encoder.mean", flat, latent, false)?,
             std: Dense::new(params, "encoder.std", flat, latent, false)?,
             fc: Dense::new(params, "decoder.fc", latent, FLAT, false)?,
@@ -90,8 +90,8 @@ impl<'a> ConvVaeGrad<'a> {
             relu_in_place(&mut y);
             grids.push(y);
         }
-        let (channels, plane) = self.encoder_out;
-        let flat = to_channels_first(grids.last().expect("four grids"), channels, (plane as f64).sqrt() as usize);
+        let (channels, side) = self.encoder_out;
+        let flat = to_channels_first(grids.last().expect("four grids"), channels, side);
         let mean = self.mean.forward(&flat, images);
         let raw_std = self.std.forward(&flat, images);
         let std = raw_std.iter().map(|&r| fast_softplus(r + STD_SHIFT as f32) + STD_FLOOR as f32).collect();
@@ -112,8 +112,8 @@ impl<'a> ConvVaeGrad<'a> {
         let mut d_flat = self.mean.backward(&tape.flat, d_mean, images, grads, true);
         let d_from_std = self.std.backward(&tape.flat, &d_std, images, grads, true);
         d_flat.iter_mut().zip(&d_from_std).for_each(|(a, b)| *a += b);
-        let (channels, plane) = self.encoder_out;
-        let mut d = to_channels_last(&d_flat, channels, (plane as f64).sqrt() as usize);
+        let (channels, side) = self.encoder_out;
+        let mut d = to_channels_last(&d_flat, channels, side);
         for (i, layer) in self.encoder.iter().enumerate().rev() {
             relu_backward(&mut d, &tape.grids[i + 1]);
             d = layer.backward(&tape.grids[i], &d, images, grads, i > 0);
@@ -155,13 +155,6 @@ impl<'a> ConvVaeGrad<'a> {
         }
         relu_backward(&mut d, &tape.grids[0]);
         self.fc.backward(latents, &d, rows, grads, true)
-    }
-
-    /// Multiply-adds of one transition's forward pass: two encodings and one decoding.
-    pub fn macs_per_transition(&self) -> usize {
-        let convs = |layers: &[StridedConv]| layers.iter().map(|l| l.grids.macs_per_image()).sum::<usize>();
-        let heads = 2 * self.mean.d_in * self.mean.d_out;
-        2 * (convs(&self.encoder) + heads) + convs(&self.decoder) + self.fc.d_in * self.fc.d_out
     }
 }
 
