@@ -4,23 +4,30 @@
 //! bookkeeping, copies and reloading the weights into the module each step cost more than the arithmetic.
 //! `net.rs` stays the reference: a test holds the loss and every gradient here to burn's.
 //!
-//! Members never share a sum, so each member's work runs as its own rayon task, and the GEMMs inside split by
-//! rows only: every number is summed by one thread in one order, so the bytes do not depend on the threads.
+//! A step runs in two parallel phases. First each member's batch, cut into one row range per thread, goes
+//! forward, through the loss and back to every layer's output gradient as one task per range: a small preset's
+//! layers are a few microseconds of GEMM each, so tasks per layer would spend the step waking threads. Then
+//! every (layer, member) weight gradient is one GEMM over all of the member's rows. Rows of a product do not
+//! depend on which other rows it computes, and the sums over rows (the loss, the bounds' gradients) are taken
+//! after the first phase in row order, so the bytes do not depend on the threads.
 
-use faer::Accum;
+use faer::linalg::matmul::matmul as faer_matmul;
+use faer::{Accum, Par};
 use rayon::prelude::*;
 
 use super::config::PetsConfig;
 use crate::error::Result;
 use crate::nn::activation::{fast_exp, fast_sigmoid as sigmoid, fast_softplus as softplus, Activation};
-use crate::nn::backprop::{add_column_sums, matmul, tensor_index, view, view_mut, zero_gradients};
+use crate::nn::backprop::{add_column_sums, tensor_index, view, view_mut, zero_gradients};
 use crate::nn::ParamSet;
-
-/// Elements per parallel task of an element-wise pass.
-const ELEMENTWISE_BLOCK: usize = 1 << 14;
 
 /// mbrl-lib's weight on Σ max_logvar − Σ min_logvar.
 const BOUNDS_PENALTY: f32 = 0.01;
+
+/// dst = [dst +] a · b on the calling thread: the first phase's tasks already fill the pool.
+fn matmul_here(dst: faer::MatMut<'_, f32>, accum: Accum, a: faer::MatRef<'_, f32>, b: faer::MatRef<'_, f32>) {
+    faer_matmul(dst, accum, a, b, 1.0f32, Par::Seq);
+}
 
 /// One ensemble layer's weights, [members, in, out] and [members, 1, out], as views of a parameter set.
 struct Layer<'a> {
@@ -46,44 +53,88 @@ impl<'a> Layer<'a> {
         })
     }
 
-    /// [members, rows, in] → `y` [members, rows, out], one GEMM per member.
-    fn forward(&self, x: &[f32], rows: usize, y: &mut Vec<f32>) {
-        let (i, o) = (self.d_in, self.d_out);
-        y.resize(x.len() / i * o, 0.0);
-        y.par_chunks_mut(rows * o)
-            .zip(x.par_chunks(rows * i))
-            .zip(self.weight.par_chunks(i * o).zip(self.bias.par_chunks(o)))
-            .for_each(|((y, x), (w, b))| {
-                y.chunks_mut(o).for_each(|row| row.copy_from_slice(b));
-                matmul(view_mut(y, rows, o), Accum::Add, view(x, rows, i), view(w, i, o));
-            });
+    fn member_weight(&self, member: usize) -> &[f32] {
+        let size = self.d_in * self.d_out;
+        &self.weight[member * size..(member + 1) * size]
     }
 
-    /// Writes this layer's weight and bias gradients for output gradients `dy` at inputs `x` into
-    /// `weight_grad` and `bias_grad` (shaped like the layer's tensors).
+    /// Member `member`'s `rows` inputs `x` → `y` (rows × out).
+    fn forward(&self, member: usize, x: &[f32], rows: usize, y: &mut [f32]) {
+        let (i, o) = (self.d_in, self.d_out);
+        let bias = &self.bias[member * o..(member + 1) * o];
+        y.chunks_mut(o).for_each(|row| row.copy_from_slice(bias));
+        matmul_here(view_mut(y, rows, o), Accum::Add, view(x, rows, i), view(self.member_weight(member), i, o));
+    }
+
+    /// The input gradients `dx` (rows × in) of member `member` for output gradients `dy`.
+    fn backward_input(&self, member: usize, dy: &[f32], rows: usize, dx: &mut [f32]) {
+        let (i, o) = (self.d_in, self.d_out);
+        let w = view(self.member_weight(member), i, o);
+        matmul_here(view_mut(dx, rows, i), Accum::Replace, view(dy, rows, o), w.transpose());
+    }
+
+    /// One member's weight and bias gradients for its output gradients `dy` (rows × out) at its inputs `x`.
     fn backward_weights(&self, x: &[f32], dy: &[f32], rows: usize, weight_grad: &mut [f32], bias_grad: &mut [f32]) {
         let (i, o) = (self.d_in, self.d_out);
-        weight_grad
-            .par_chunks_mut(i * o)
-            .zip(bias_grad.par_chunks_mut(o))
-            .zip(x.par_chunks(rows * i).zip(dy.par_chunks(rows * o)))
-            .for_each(|((gw, gb), (x, dy))| {
-                matmul(view_mut(gw, i, o), Accum::Replace, view(x, rows, i).transpose(), view(dy, rows, o));
-                gb.fill(0.0);
-                add_column_sums(gb, dy);
-            });
+        matmul_here(view_mut(weight_grad, i, o), Accum::Replace, view(x, rows, i).transpose(), view(dy, rows, o));
+        bias_grad.fill(0.0);
+        add_column_sums(bias_grad, dy);
     }
+}
 
-    /// The input gradients `dx` [members, rows, in] for output gradients `dy`.
-    fn backward_input(&self, dy: &[f32], rows: usize, dx: &mut Vec<f32>) {
-        let (i, o) = (self.d_in, self.d_out);
-        dx.resize(dy.len() / o * i, 0.0);
-        dx.par_chunks_mut(rows * i).zip(dy.par_chunks(rows * o)).zip(self.weight.par_chunks(i * o)).for_each(
-            |((dx, dy), w)| {
-                matmul(view_mut(dx, rows, i), Accum::Replace, view(dy, rows, o), view(w, i, o).transpose());
-            },
-        );
+/// Rows `start..end` of member `member`'s batch.
+#[derive(Clone, Copy)]
+struct Part {
+    member: usize,
+    start: usize,
+    end: usize,
+}
+
+impl Part {
+    fn rows(&self) -> usize {
+        self.end - self.start
     }
+}
+
+/// Every member's rows in one range per thread, in memory order: with the presets' five members on two
+/// threads, ten equal tasks share the pool evenly where five would leave a thread idle for a fifth of the
+/// phase; on one thread, halves would only repack each weight twice.
+fn parts(members: usize, rows: usize) -> Vec<Part> {
+    let per_member = rayon::current_num_threads().clamp(1, rows.max(1));
+    (0..members)
+        .flat_map(|member| {
+            (0..per_member).map(move |p| Part {
+                member,
+                start: rows * p / per_member,
+                end: rows * (p + 1) / per_member,
+            })
+        })
+        .collect()
+}
+
+/// A [members, rows, width] buffer cut into the parts' pieces, which cover it in order.
+fn cut<'a, T>(mut buffer: &'a mut [T], parts: &[Part], width: usize) -> std::vec::IntoIter<&'a mut [T]> {
+    let pieces: Vec<&'a mut [T]> = parts
+        .iter()
+        .map(|p| {
+            let (piece, rest) = std::mem::take(&mut buffer).split_at_mut(p.rows() * width);
+            buffer = rest;
+            piece
+        })
+        .collect();
+    pieces.into_iter()
+}
+
+/// A part's pieces of the workspace's buffers.
+struct PartBuffers<'a> {
+    activations: Vec<&'a mut [f32]>,
+    slopes: Vec<&'a mut [f32]>,
+    output: &'a mut [f32],
+    /// Gradient at each layer's output (before the activation, for hidden layers); empty without gradients.
+    d_outputs: Vec<&'a mut [f32]>,
+    /// Each row's loss, and its d max_logvar then d min_logvar terms; empty without gradients.
+    row_losses: &'a mut [f64],
+    row_bounds: &'a mut [f32],
 }
 
 /// The ensemble's layers as views of a parameter set in mbrl-lib's names (see `net::torch_name`).
@@ -102,14 +153,17 @@ pub struct EnsembleNet<'a> {
 /// when freed and return as zeroed pages, which cost a medium-sized step about a tenth of its time.
 #[derive(Debug, Default)]
 pub struct Workspace {
-    /// Every layer's input: the network's, then each hidden layer's activations.
-    inputs: Vec<Vec<f32>>,
+    /// Each hidden layer's activations [members, rows, units].
+    activations: Vec<Vec<f32>>,
     /// Each hidden activation's derivative at its input.
     slopes: Vec<Vec<f32>>,
     /// The output layer's [members, rows, 2·target_dim]: mean, then the raw log-variance.
     output: Vec<f32>,
-    d_output: Vec<f32>,
-    d_input: Vec<f32>,
+    /// The loss's gradient at each layer's output, hidden layers before their activation.
+    d_outputs: Vec<Vec<f32>>,
+    /// Per row: the loss [members · rows], and the bounds' gradient terms [members · rows, 2 · target_dim].
+    row_losses: Vec<f64>,
+    row_bounds: Vec<f32>,
     /// After [`EnsembleNet::loss_and_gradients`] with gradients: one per parameter tensor, in their order.
     pub gradients: Vec<Vec<f32>>,
 }
@@ -159,37 +213,145 @@ impl<'a> EnsembleNet<'a> {
         })
     }
 
-    /// Fills the workspace's activations, slopes and output for `inputs` [members, rows, in].
-    fn forward(&self, ws: &mut Workspace, inputs: &[f32], rows: usize) {
-        ws.inputs.resize_with(self.hidden.len() + 1, Vec::new);
-        ws.slopes.resize_with(self.hidden.len(), Vec::new);
-        ws.inputs[0].clear();
-        ws.inputs[0].extend_from_slice(inputs);
+    fn layers(&self) -> impl DoubleEndedIterator<Item = &Layer<'a>> {
+        self.hidden.iter().chain(std::iter::once(&self.output))
+    }
+
+    /// Sizes the workspace for `rows` per member and cuts it into the parts' pieces.
+    fn part_buffers<'w>(
+        &self,
+        ws: &'w mut Workspace,
+        parts: &[Part],
+        rows: usize,
+        gradients: bool,
+    ) -> Vec<PartBuffers<'w>> {
+        let e = self.members;
+        let hidden = self.hidden.len();
+        ws.activations.resize_with(hidden, Vec::new);
+        ws.slopes.resize_with(hidden, Vec::new);
+        ws.d_outputs.resize_with(if gradients { hidden + 1 } else { 0 }, Vec::new);
+        let widths: Vec<usize> = self.layers().map(|l| l.d_out).collect();
+        let mut activations: Vec<_> = ws
+            .activations
+            .iter_mut()
+            .zip(&widths)
+            .map(|(b, &w)| {
+                b.resize(e * rows * w, 0.0);
+                cut(b, parts, w)
+            })
+            .collect();
+        let mut slopes: Vec<_> = ws
+            .slopes
+            .iter_mut()
+            .zip(&widths)
+            .map(|(b, &w)| {
+                b.resize(e * rows * w, 0.0);
+                cut(b, parts, w)
+            })
+            .collect();
+        let mut d_outputs: Vec<_> = ws
+            .d_outputs
+            .iter_mut()
+            .zip(&widths)
+            .map(|(b, &w)| {
+                b.resize(e * rows * w, 0.0);
+                cut(b, parts, w)
+            })
+            .collect();
+        let d2 = 2 * self.target_dim;
+        ws.output.resize(e * rows * d2, 0.0);
+        let mut output = cut(&mut ws.output, parts, d2);
+        ws.row_losses.resize(if gradients { e * rows } else { 0 }, 0.0);
+        ws.row_bounds.resize(if gradients { e * rows * d2 } else { 0 }, 0.0);
+        let (row_width, bound_width) = if gradients { (1, d2) } else { (0, 0) };
+        let mut row_losses = cut(&mut ws.row_losses, parts, row_width);
+        let mut row_bounds = cut(&mut ws.row_bounds, parts, bound_width);
+        let next = |pieces: &mut Vec<std::vec::IntoIter<&'w mut [f32]>>| -> Vec<&'w mut [f32]> {
+            pieces.iter_mut().map(|p| p.next().expect("one piece per part")).collect()
+        };
+        parts
+            .iter()
+            .map(|_| PartBuffers {
+                activations: next(&mut activations),
+                slopes: next(&mut slopes),
+                output: output.next().expect("one piece per part"),
+                d_outputs: next(&mut d_outputs),
+                row_losses: row_losses.next().expect("one piece per part"),
+                row_bounds: row_bounds.next().expect("one piece per part"),
+            })
+            .collect()
+    }
+
+    /// A part's activations, slopes and output for its rows of `inputs` [members, rows, in].
+    fn forward_part(&self, buffers: &mut PartBuffers<'_>, part: Part, x: &[f32]) {
+        let rows = part.rows();
         for (k, layer) in self.hidden.iter().enumerate() {
-            let (done, next) = ws.inputs.split_at_mut(k + 1);
-            let h = &mut next[0];
-            layer.forward(&done[k], rows, h);
-            let slope = &mut ws.slopes[k];
-            slope.resize(h.len(), 0.0);
-            h.par_chunks_mut(ELEMENTWISE_BLOCK)
-                .zip(slope.par_chunks_mut(ELEMENTWISE_BLOCK))
-                .for_each(|(h, slope)| self.activation.apply_with_derivative(h, slope));
+            let (done, next) = buffers.activations.split_at_mut(k);
+            let input: &[f32] = if k == 0 { x } else { done[k - 1] };
+            layer.forward(part.member, input, rows, next[0]);
+            self.activation.apply_with_derivative(next[0], buffers.slopes[k]);
         }
-        self.output.forward(ws.inputs.last().expect("the input is the first entry"), rows, &mut ws.output);
+        let last: &[f32] = buffers.activations.last().map_or(x, |a| a);
+        self.output.forward(part.member, last, rows, buffers.output);
+    }
+
+    /// The part's rows' losses and bounds' gradient terms, and its output gradient written into the last of
+    /// `d_outputs`. `scale` is 1 / (rows · target_dim), the member mean's weight.
+    fn loss_part(&self, buffers: &mut PartBuffers<'_>, targets: &[f32], scale: f32) {
+        let d = self.target_dim;
+        let d_output = buffers.d_outputs.last_mut().expect("the output layer's gradient");
+        let rows = buffers.output.chunks(2 * d).zip(targets.chunks(d)).zip(d_output.chunks_mut(2 * d));
+        let row_terms = buffers.row_losses.iter_mut().zip(buffers.row_bounds.chunks_mut(2 * d));
+        for (((out, y), d_out), (row_loss, bounds)) in rows.zip(row_terms) {
+            let mut sum = 0.0f64;
+            for j in 0..d {
+                let b = bounded(out[d + j], self.min_logvar[j], self.max_logvar[j]);
+                let error = out[j] - y[j];
+                let precision = fast_exp(-b.logvar);
+                sum += f64::from(0.5 * (error * error * precision + b.logvar));
+                d_out[j] = error * precision * scale;
+                let d_logvar = 0.5 * (1.0 - error * error * precision) * scale;
+                d_out[d + j] = d_logvar * b.lower_slope * b.upper_slope;
+                bounds[j] = d_logvar * b.lower_slope * (1.0 - b.upper_slope);
+                bounds[d + j] = d_logvar * (1.0 - b.lower_slope);
+            }
+            *row_loss = sum;
+        }
+    }
+
+    /// Carries the output gradient back to every hidden layer's output, before its activation.
+    fn backward_part(&self, buffers: &mut PartBuffers<'_>, part: Part) {
+        let layers: Vec<&Layer<'_>> = self.layers().collect();
+        for k in (1..layers.len()).rev() {
+            let (below, above) = buffers.d_outputs.split_at_mut(k);
+            let dx = &mut *below[k - 1];
+            layers[k].backward_input(part.member, above[0], part.rows(), dx);
+            dx.iter_mut().zip(buffers.slopes[k - 1].iter()).for_each(|(d, s)| *d *= s);
+        }
     }
 
     /// Mean squared error of the predicted mean against `targets` over every member, row and output, for
     /// inputs [members, rows, in] (normalized) and targets [members, rows, target_dim].
     pub fn mean_squared_error(&self, ws: &mut Workspace, inputs: &[f32], targets: &[f32], rows: usize) -> f64 {
-        self.forward(ws, inputs, rows);
-        let d = self.target_dim;
-        let sum: f64 = ws
-            .output
-            .chunks(2 * d)
-            .zip(targets.chunks(d))
-            .map(|(out, y)| out[..d].iter().zip(y).map(|(m, y)| f64::from(m - y).powi(2)).sum::<f64>())
-            .sum();
-        sum / targets.len().max(1) as f64
+        let (din, d) = (self.layers().next().map_or(0, |l| l.d_in), self.target_dim);
+        let parts = parts(self.members, rows);
+        let buffers = self.part_buffers(ws, &parts, rows, false);
+        let sums: Vec<f64> = buffers
+            .into_par_iter()
+            .zip(parts.par_iter())
+            .map(|(mut buffers, &part)| {
+                let first = part.member * rows + part.start;
+                self.forward_part(&mut buffers, part, &inputs[first * din..(first + part.rows()) * din]);
+                let y = &targets[first * d..(first + part.rows()) * d];
+                buffers
+                    .output
+                    .chunks(2 * d)
+                    .zip(y.chunks(d))
+                    .map(|(out, y)| out[..d].iter().zip(y).map(|(m, y)| f64::from(m - y).powi(2)).sum::<f64>())
+                    .sum()
+            })
+            .collect();
+        sums.iter().sum::<f64>() / targets.len().max(1) as f64
     }
 
     /// The loss mbrl-lib trains on, for inputs [members, rows, in] (normalized) and targets
@@ -205,65 +367,55 @@ impl<'a> EnsembleNet<'a> {
         rows: usize,
     ) -> f64 {
         let (e, d) = (self.members, self.target_dim);
-        self.forward(ws, inputs, rows);
+        let din = self.layers().next().map_or(0, |l| l.d_in);
         let scale = 1.0 / (rows * d) as f32;
-        let mut d_output = std::mem::take(&mut ws.d_output);
-        d_output.resize(ws.output.len(), 0.0);
-        let mut d_min = vec![0.0f32; d];
-        let mut d_max = vec![0.0f32; d];
-        let mut member_sums = vec![0.0f64; e];
-        for (row, ((out, y), d_out)) in
-            ws.output.chunks(2 * d).zip(targets.chunks(d)).zip(d_output.chunks_mut(2 * d)).enumerate()
-        {
-            let mut row_sum = 0.0f64;
-            for j in 0..d {
-                let b = bounded(out[d + j], self.min_logvar[j], self.max_logvar[j]);
-                let error = out[j] - y[j];
-                let precision = fast_exp(-b.logvar);
-                row_sum += f64::from(0.5 * (error * error * precision + b.logvar));
-                d_out[j] = error * precision * scale;
-                let d_logvar = 0.5 * (1.0 - error * error * precision) * scale;
-                d_out[d + j] = d_logvar * b.lower_slope * b.upper_slope;
-                d_max[j] += d_logvar * b.lower_slope * (1.0 - b.upper_slope);
-                d_min[j] += d_logvar * (1.0 - b.lower_slope);
-            }
-            member_sums[row / rows] += row_sum;
+        let parts = parts(e, rows);
+        let buffers = self.part_buffers(ws, &parts, rows, true);
+        buffers.into_par_iter().zip(parts.par_iter()).for_each(|(mut buffers, &part)| {
+            let first = part.member * rows + part.start;
+            self.forward_part(&mut buffers, part, &inputs[first * din..(first + part.rows()) * din]);
+            self.loss_part(&mut buffers, &targets[first * d..(first + part.rows()) * d], scale);
+            self.backward_part(&mut buffers, part);
+        });
+
+        let member_sums: Vec<f64> = ws.row_losses.chunks(rows).map(|member| member.iter().sum()).collect();
+        let (mut d_max, mut d_min) = (vec![0.0f32; d], vec![0.0f32; d]);
+        for row in ws.row_bounds.chunks(2 * d) {
+            d_max.iter_mut().zip(&row[..d]).for_each(|(g, x)| *g += x);
+            d_min.iter_mut().zip(&row[d..]).for_each(|(g, x)| *g += x);
         }
+        d_max.iter_mut().for_each(|g| *g += BOUNDS_PENALTY);
+        d_min.iter_mut().for_each(|g| *g -= BOUNDS_PENALTY);
         let penalty = BOUNDS_PENALTY * (self.max_logvar.iter().sum::<f32>() - self.min_logvar.iter().sum::<f32>());
         let loss = member_sums.iter().map(|s| s / (rows * d) as f64).sum::<f64>() + f64::from(penalty);
         if ws.gradients.len() != params.tensors.len() {
             ws.gradients = zero_gradients(params);
         }
-        d_max.iter_mut().for_each(|g| *g += BOUNDS_PENALTY);
-        d_min.iter_mut().for_each(|g| *g -= BOUNDS_PENALTY);
         ws.gradients[self.bounds_index[0]] = d_min;
         ws.gradients[self.bounds_index[1]] = d_max;
 
-        // dy and dx trade buffers layer by layer; both stay in the workspace.
-        let mut dy = d_output;
-        let mut dx = std::mem::take(&mut ws.d_input);
-        let layers = self.hidden.iter().chain(std::iter::once(&self.output)).collect::<Vec<_>>();
-        for (k, layer) in layers.iter().enumerate().rev() {
-            let (mut weight_grad, mut bias_grad) = (
-                std::mem::take(&mut ws.gradients[layer.weight_index]),
-                std::mem::take(&mut ws.gradients[layer.bias_index]),
-            );
-            layer.backward_weights(&ws.inputs[k], &dy, rows, &mut weight_grad, &mut bias_grad);
+        // Every (layer, member) weight gradient is one independent task: one GEMM over the member's rows.
+        let mut taken: Vec<(&Layer<'_>, Vec<f32>, Vec<f32>)> = self
+            .layers()
+            .map(|layer| {
+                let weight_grad = std::mem::take(&mut ws.gradients[layer.weight_index]);
+                (layer, weight_grad, std::mem::take(&mut ws.gradients[layer.bias_index]))
+            })
+            .collect();
+        let mut tasks = Vec::with_capacity(taken.len() * e);
+        for (k, (layer, weight_grad, bias_grad)) in taken.iter_mut().enumerate() {
+            let (i, o) = (layer.d_in, layer.d_out);
+            let x: &[f32] = if k == 0 { inputs } else { &ws.activations[k - 1] };
+            let members = weight_grad.chunks_mut(i * o).zip(bias_grad.chunks_mut(o));
+            for ((gw, gb), (x, dy)) in members.zip(x.chunks(rows * i).zip(ws.d_outputs[k].chunks(rows * o))) {
+                tasks.push((*layer, x, dy, gw, gb));
+            }
+        }
+        tasks.into_par_iter().for_each(|(layer, x, dy, gw, gb)| layer.backward_weights(x, dy, rows, gw, gb));
+        for (layer, weight_grad, bias_grad) in taken {
             ws.gradients[layer.weight_index] = weight_grad;
             ws.gradients[layer.bias_index] = bias_grad;
-            if k == 0 {
-                break;
-            }
-            layer.backward_input(&dy, rows, &mut dx);
-            dx.par_chunks_mut(ELEMENTWISE_BLOCK).zip(ws.slopes[k - 1].par_chunks(ELEMENTWISE_BLOCK)).for_each(
-                |(d, slope)| {
-                    d.iter_mut().zip(slope).for_each(|(d, s)| *d *= s);
-                },
-            );
-            std::mem::swap(&mut dy, &mut dx);
         }
-        ws.d_output = dy;
-        ws.d_input = dx;
         loss
     }
 }
