@@ -4,6 +4,11 @@
 with each step's FLOP count, both sides' GFLOP/s, the f32 GEMM ceiling measured in the same run, and the
 load the machine was under (load average, and how many cores other processes kept busy while each side ran).
 
+The ball EKF's PyTorch side trains on the batches mbrl's trainer draws: when that row is selected, this script
+first runs `cargo run --release --example ball_loss_case`, which writes them with mbrl's loss, gradients and
+training losses to target/ball_loss_case.json, then `benches/pytorch/ball_reference.py --check` on that file,
+and stops if the reference no longer computes mbrl's loss; neither counts towards either side's load figures.
+
 A step meets the target when mbrl is at least 2x PyTorch, or when mbrl reaches at least 85 % of the GEMM
 ceiling without being slower than PyTorch (where PyTorch itself already runs near the ceiling).
 
@@ -20,6 +25,9 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
+BALL_ROW = "ball_b64x50"
+# Where ball_reference.py and training_steps.py read the ball case from by default.
+BALL_CASE = os.path.join(ROOT, "target", "ball_loss_case.json")
 
 LABELS = {
     "pets_small": "PETS small (5 × 3×64), batch 256",
@@ -63,6 +71,16 @@ def run_side(name, command):
     return rows, {"load_before": load_before, "load_after": load_average(), "other_cores": others, "wall": wall1 - wall0}
 
 
+def prepare_ball_case(python):
+    commands = [
+        ["cargo", "run", "--release", "--quiet", "--example", "ball_loss_case", "--", BALL_CASE],
+        [python, os.path.join(HERE, "pytorch", "ball_reference.py"), "--check", BALL_CASE],
+    ]
+    for command in commands:
+        if subprocess.run(command, cwd=ROOT).returncode != 0:
+            sys.exit(f"error: the ball EKF's PyTorch case failed: {' '.join(command)}")
+
+
 def find_python(explicit):
     candidates = [explicit] if explicit else [os.environ.get("PYTORCH_PYTHON"), sys.executable, "python3"]
     for python in filter(None, candidates):
@@ -91,6 +109,8 @@ def main():
     args = parser.parse_args()
     python = find_python(args.python)
     extra = (["--quick"] if args.quick else []) + (["--only", args.only] if args.only else [])
+    if args.only is None or BALL_ROW in args.only.split(","):
+        prepare_ball_case(python)
 
     ours, our_load = run_side("mbrl", ["cargo", "bench", "--quiet", "--bench", "training_steps", "--"] + extra)
     theirs, their_load = run_side("PyTorch", [python, os.path.join(HERE, "pytorch", "training_steps.py")] + extra)

@@ -5,13 +5,15 @@ at two, each the median of its timed steps after warm-up. Prints one JSON object
 The networks and losses are the reference scripts' (pets_reference.py, context_reference.py,
 dlgpd_reference.py), which mirror the authors' code; SAC is written here as the SEADS agent runs it
 (pytorch-soft-actor-critic's update: twin critics on r + γ(1 − done)(min Q_target − α log π), then the
-actor against the updated critics, then the Polyak step).
+actor against the updated critics, then the Polyak step). The ball EKF is ball_reference.py's, which
+mirrors mbrl's own batched filter (there is no authors' code to mirror): it trains on the batches mbrl's
+trainer draws, read from the case file `cargo run --release --example ball_loss_case` writes
+(benches/vs_pytorch.py runs it first), and, as benches/training_steps.rs times that row, each of its figures
+is the mean of steps 2-11 of a fresh training run; the batches are tensors before the clock starts.
 
 FLOPs per step are counted once per workload by torch.utils.flop_counter.FlopCounterMode: the matmul and
 convolution FLOPs of the forward and backward pass (element-wise work, the optimizer and float64 GP
 factorizations are not counted). benches/vs_pytorch.py divides both sides' times into that same count.
-
-The ball EKF has no PyTorch reference here: its row says so.
 
 Usage: python3 benches/pytorch/training_steps.py [--quick] [--only NAME[,NAME...]]
 """
@@ -24,6 +26,7 @@ import statistics
 import sys
 import time
 import warnings
+from typing import Callable, NamedTuple
 
 warnings.filterwarnings("ignore", message="Failed to initialize NumPy")
 
@@ -32,6 +35,7 @@ import torch.nn.functional as F  # noqa: E402
 from torch.utils.flop_counter import FlopCounterMode  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import ball_reference  # noqa: E402
 import context_reference  # noqa: E402
 import dlgpd_reference  # noqa: E402
 import pets_reference  # noqa: E402
@@ -158,7 +162,50 @@ def dlgpd(batch):
     return step
 
 
-# name: (builder, warm-up steps, timed steps) — the same counts as benches/training_steps.rs.
+class SelfTimed(NamedTuple):
+    """A workload that times itself, as its Rust side does: `sample()` returns seconds per optimizer step;
+    `step()` takes one step, for the FLOP count."""
+
+    sample: Callable[[], float]
+    step: Callable[[], None]
+
+
+def ball():
+    case = ball_reference.load_case(ball_reference.DEFAULT_CASE)
+    physics = ball_reference.physics_of(case)
+    batches = [ball_reference.batch_of(entry) for entry in case["batches"]]
+
+    def fresh_run():
+        params = ball_reference.raw_parameters(case)
+        return params, ball_reference.adam(params, case)
+
+    def first_step():
+        ball_reference.train_step(*fresh_run(), batches[0], physics)
+
+    def sample():
+        # As benches/training_steps.rs times `train` for 11 steps less `train` for 1: a fresh run whose first
+        # step (the first batch, Adam's first update) is not counted and whose other ten are averaged.
+        params, optimizer = fresh_run()
+        ball_reference.train_step(params, optimizer, batches[0], physics)
+        start = time.perf_counter()
+        for batch in batches[1:]:
+            ball_reference.train_step(params, optimizer, batch, physics)
+        return (time.perf_counter() - start) / (len(batches) - 1)
+
+    return SelfTimed(sample, first_step)
+
+
+def timed(step):
+    def sample():
+        start = time.perf_counter()
+        step()
+        return time.perf_counter() - start
+
+    return sample
+
+
+# name: (builder, warm-up steps, timed steps or, for a self-timed workload, samples) — the same counts as
+# benches/training_steps.rs.
 WORKLOADS = {
     "pets_small": (lambda: pets("small"), 20, 200),
     "pets_medium": (lambda: pets("medium"), 10, 60),
@@ -167,7 +214,7 @@ WORKLOADS = {
     "sac_b128": (sac, 10, 100),
     "dlgpd_b256": (lambda: dlgpd(256), 1, 3),
     "dlgpd_b1024": (lambda: dlgpd(1024), 1, 3),
-    "ball_b64x50": (None, 0, 0),
+    "ball_b64x50": (ball, 0, 3),
 }
 
 
@@ -194,22 +241,16 @@ def main():
         torch.set_num_threads(threads)
         for name in names:
             build, warmup, repeats = WORKLOADS[name]
-            if build is None:
-                print(json.dumps({"workload": name, "threads": threads, "seconds": None}), flush=True)
-                continue
             if args.quick:
                 warmup, repeats = min(warmup, 2), max(repeats // 5, 2)
             torch.manual_seed(0)
-            step = build()
+            workload = build()
+            sample, step = workload if isinstance(workload, SelfTimed) else (timed(workload), workload)
             if name not in flops:
                 flops[name] = count_flops(step)
             for _ in range(warmup):
                 step()
-            samples = []
-            for _ in range(repeats):
-                start = time.perf_counter()
-                step()
-                samples.append(time.perf_counter() - start)
+            samples = [sample() for _ in range(repeats)]
             row = {"workload": name, "threads": threads, "seconds": statistics.median(samples)}
             row.update({"samples": repeats, "flops": flops[name]})
             print(json.dumps(row), flush=True)
