@@ -6,12 +6,18 @@
 use std::borrow::Cow;
 
 use faer::{Accum, MatMut, MatRef, Par};
+use rayon::prelude::*;
 
 use super::params::ParamSet;
 use crate::error::{Error, Result};
 
 /// Below this many multiply-adds a GEMM stays on one thread: splitting costs more than it saves.
 const PARALLEL_WORK: usize = 1 << 19;
+
+/// Values per task of an element-wise pass. A buffer under two blocks stays on one thread: waking another
+/// costs more than a pass over it (SAC's and PETS' layers), while the context model's 75 000-row decoder
+/// passes are tens of milliseconds each and would otherwise leave the second core idle.
+const ELEMENTWISE_BLOCK: usize = 1 << 15;
 
 /// dst (m × n) = [dst +] a (m × k) · b (k × n). Large products are split over the rayon pool, by rows of
 /// `dst`, or by columns where `dst` is at least four times wider than tall: each piece packs the whole of the
@@ -111,7 +117,7 @@ impl<'a> Dense<'a> {
     /// `rows` inputs → `rows × d_out` outputs.
     pub fn forward(&self, x: &[f32], rows: usize) -> Vec<f32> {
         debug_assert_eq!(x.len(), rows * self.d_in);
-        let mut y = self.bias.repeat(rows);
+        let mut y = repeat_row(self.bias, rows);
         matmul(
             view_mut(&mut y, rows, self.d_out),
             Accum::Add,
@@ -153,19 +159,112 @@ impl Dense<'_> {
     pub fn backward_input(&self, dy: &[f32], rows: usize) -> Vec<f32> {
         debug_assert_eq!(dy.len(), rows * self.d_out);
         let (o, i) = (self.d_out, self.d_in);
-        let mut dx = vec![0.0; rows * i];
+        let mut dx = zeros(rows * i);
         matmul(view_mut(&mut dx, rows, i), Accum::Replace, view(dy, rows, o), view(&self.weight, o, i));
         dx
     }
 }
 
-/// sums[j] += Σ_rows m[row, j] for a row-major matrix with `sums.len()` columns.
+/// sums[j] += Σ_rows m[row, j] for a row-major matrix with `sums.len()` columns. A large matrix is summed in
+/// blocks of rows of a size set by its width alone, whose partial sums are then added in block order: the
+/// bytes do not depend on the threads.
 pub fn add_column_sums(sums: &mut [f32], m: &[f32]) {
-    for row in m.chunks(sums.len()) {
-        for (s, x) in sums.iter_mut().zip(row) {
-            *s += x;
+    let width = sums.len();
+    let add_rows = |sums: &mut [f32], block: &[f32]| {
+        for row in block.chunks(width) {
+            sums.iter_mut().zip(row).for_each(|(s, x)| *s += x);
         }
+    };
+    if width == 0 || m.len() < 2 * ELEMENTWISE_BLOCK {
+        add_rows(sums, m);
+        return;
     }
+    let block = ELEMENTWISE_BLOCK.div_ceil(width) * width;
+    let partials: Vec<Vec<f32>> = m
+        .par_chunks(block)
+        .map(|rows| {
+            let mut partial = vec![0.0; width];
+            add_rows(&mut partial, rows);
+            partial
+        })
+        .collect();
+    for partial in &partials {
+        sums.iter_mut().zip(partial).for_each(|(s, x)| *s += x);
+    }
+}
+
+/// Applies `f` to every value, in parallel blocks when the buffer is large.
+pub fn for_each_value(xs: &mut [f32], f: impl Fn(&mut f32) + Sync) {
+    if xs.len() < 2 * ELEMENTWISE_BLOCK {
+        xs.iter_mut().for_each(f);
+    } else {
+        xs.par_chunks_mut(ELEMENTWISE_BLOCK).for_each(|block| block.iter_mut().for_each(&f));
+    }
+}
+
+/// Applies `f` to every pair of `dst` and `src` values, in parallel blocks when the buffers are large.
+pub fn zip_values(dst: &mut [f32], src: &[f32], f: impl Fn(&mut f32, f32) + Sync) {
+    debug_assert_eq!(dst.len(), src.len());
+    if dst.len() < 2 * ELEMENTWISE_BLOCK {
+        dst.iter_mut().zip(src).for_each(|(d, s)| f(d, *s));
+    } else {
+        dst.par_chunks_mut(ELEMENTWISE_BLOCK)
+            .zip(src.par_chunks(ELEMENTWISE_BLOCK))
+            .for_each(|(d, s)| d.iter_mut().zip(s).for_each(|(d, s)| f(d, *s)));
+    }
+}
+
+/// A new buffer of `n` values, each written by `fill` from its block's offset, in parallel blocks when large:
+/// a fresh multi-megabyte buffer written by one thread (memset, memcpy) leaves the other core idle.
+fn filled(n: usize, block: usize, fill: impl Fn(usize, &mut [std::mem::MaybeUninit<f32>]) + Sync) -> Vec<f32> {
+    let mut out = Vec::with_capacity(n);
+    let slots = &mut out.spare_capacity_mut()[..n];
+    if n < 2 * ELEMENTWISE_BLOCK {
+        fill(0, slots);
+    } else {
+        slots.par_chunks_mut(block).enumerate().for_each(|(k, chunk)| fill(k * block, chunk));
+    }
+    // SAFETY: `fill` wrote every one of the first n slots (each caller writes its whole chunk).
+    unsafe { out.set_len(n) };
+    out
+}
+
+/// `n` zeros.
+pub fn zeros(n: usize) -> Vec<f32> {
+    filled(n, ELEMENTWISE_BLOCK, |_, chunk| chunk.iter_mut().for_each(|slot| _ = slot.write(0.0)))
+}
+
+/// A copy of `src`.
+pub fn copy_of(src: &[f32]) -> Vec<f32> {
+    filled(src.len(), ELEMENTWISE_BLOCK, |start, chunk| {
+        chunk.iter_mut().zip(&src[start..]).for_each(|(slot, x)| _ = slot.write(*x));
+    })
+}
+
+/// The buffers one after another.
+pub fn concat(parts: &[&[f32]]) -> Vec<f32> {
+    let mut out = Vec::with_capacity(parts.iter().map(|p| p.len()).sum());
+    for part in parts {
+        let start = out.len();
+        let slots = &mut out.spare_capacity_mut()[..part.len()];
+        slots.par_chunks_mut(ELEMENTWISE_BLOCK).zip(part.par_chunks(ELEMENTWISE_BLOCK)).for_each(|(s, p)| {
+            s.iter_mut().zip(p).for_each(|(slot, x)| _ = slot.write(*x));
+        });
+        // SAFETY: the part's slots were all written just above.
+        unsafe { out.set_len(start + part.len()) };
+    }
+    out
+}
+
+/// `row` repeated `rows` times (a bias broadcast over a batch).
+pub fn repeat_row(row: &[f32], rows: usize) -> Vec<f32> {
+    if row.is_empty() {
+        return Vec::new();
+    }
+    let block = ELEMENTWISE_BLOCK.div_ceil(row.len()) * row.len();
+    filled(row.len() * rows, block, |_, chunk| {
+        chunk.iter_mut().zip(row.iter().cycle()).for_each(|(slot, x)| _ = slot.write(*x));
+    })
 }
 
 /// Linear → ReLU → Linear; the caller applies and differentiates what follows the second layer.
@@ -198,7 +297,7 @@ impl<'a> TwoLayer<'a> {
     /// The second layer's output (before any activation of the caller's) and the tape.
     pub fn forward(&self, x: &[f32], rows: usize) -> (Vec<f32>, TwoLayerTape) {
         let mut hidden = self.first.forward(x, rows);
-        hidden.iter_mut().for_each(|h| *h = h.max(0.0));
+        relu_in_place(&mut hidden);
         let out = self.second.forward(&hidden, rows);
         (out, TwoLayerTape { hidden })
     }
@@ -213,32 +312,28 @@ impl<'a> TwoLayer<'a> {
         want_dx: bool,
     ) -> Vec<f32> {
         let mut d_hidden = self.second.backward(&tape.hidden, d_out, rows, grads, true);
-        for (d, h) in d_hidden.iter_mut().zip(&tape.hidden) {
-            if *h <= 0.0 {
-                *d = 0.0;
-            }
-        }
+        relu_backward(&mut d_hidden, &tape.hidden);
         self.first.backward(x, &d_hidden, rows, grads, want_dx)
     }
 }
 
 /// dst[i] += src[i].
 pub fn add_into(dst: &mut [f32], src: &[f32]) {
-    dst.iter_mut().zip(src).for_each(|(a, b)| *a += b);
+    zip_values(dst, src, |a, b| *a += b);
 }
 
 /// In place: ReLU, keeping the output as its own derivative mask.
 pub fn relu_in_place(xs: &mut [f32]) {
-    xs.iter_mut().for_each(|x| *x = x.max(0.0));
+    for_each_value(xs, |x| *x = x.max(0.0));
 }
 
 /// d ← d · 1[y > 0] for a ReLU output y.
 pub fn relu_backward(d: &mut [f32], y: &[f32]) {
-    for (d, y) in d.iter_mut().zip(y) {
-        if *y <= 0.0 {
+    zip_values(d, y, |d, y| {
+        if y <= 0.0 {
             *d = 0.0;
         }
-    }
+    });
 }
 
 #[cfg(test)]
@@ -269,6 +364,37 @@ mod tests {
             let mut split = vec![0.5; m * n];
             split_cols(view_mut(&mut split, m, n), Accum::Add, view(&a, m, k), view(&b, k, n), pieces);
             assert_eq!(split, one, "{pieces} pieces of columns");
+        }
+    }
+
+    /// The passes that split large buffers over the pool: exact copies, and column sums whose bytes do not
+    /// depend on the threads and whose value is the sum's.
+    #[test]
+    fn large_passes_give_the_same_bytes_on_any_pool() {
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let (rows, width) = (3001, 37);
+        let m: Vec<f32> = (0..rows * width).map(|_| rng.random_range(-1.0..1.0)).collect();
+        let bias: Vec<f32> = (0..width).map(|_| rng.random_range(-1.0..1.0)).collect();
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| {
+                let mut sums = vec![0.5; width];
+                add_column_sums(&mut sums, &m);
+                let copies = (copy_of(&m), concat(&[&m[..5], &m, &bias]), repeat_row(&bias, rows), zeros(m.len()));
+                (sums, copies)
+            })
+        };
+        let (sums, (copy, joined, repeated, zeroed)) = run(1);
+        assert_eq!(copy, m);
+        assert_eq!(joined, [&m[..5], &m, &bias].concat());
+        assert_eq!(repeated, bias.repeat(rows));
+        assert!(zeroed.iter().all(|z| *z == 0.0) && zeroed.len() == m.len());
+        for (j, s) in sums.iter().enumerate() {
+            let exact = 0.5 + m.iter().skip(j).step_by(width).map(|x| *x as f64).sum::<f64>();
+            assert!((*s as f64 - exact).abs() < 1e-3, "column {j}: {s} vs {exact}");
+        }
+        for threads in [2, 3] {
+            assert_eq!(run(threads), run(1), "{threads} threads");
         }
     }
 }

@@ -12,8 +12,8 @@ use super::net::{STD_FLOOR, STD_SCALE, STD_SHIFT, VARIANCE_FLOOR};
 use crate::error::{Error, Result};
 use crate::nn::activation::{fast_sigmoid as sigmoid, fast_softplus as softplus, fast_tanh as tanh};
 use crate::nn::backprop::{
-    add_column_sums, add_into, matmul, relu_backward, relu_in_place, tensor_index, view, view_mut, zero_gradients,
-    TwoLayer, TwoLayerTape,
+    add_column_sums, add_into, concat, copy_of, for_each_value, matmul, relu_backward, relu_in_place, repeat_row,
+    tensor_index, view, view_mut, zero_gradients, zeros, zip_values, TwoLayer, TwoLayerTape,
 };
 use crate::nn::ParamSet;
 
@@ -29,10 +29,10 @@ pub struct LossValues {
     pub context_std: f64,
 }
 
-/// Rows per parallel task of an element-wise pass over `rows × width` values: one task below ~64k values,
-/// where splitting costs more than it saves.
+/// Rows per parallel task of an element-wise pass over `rows × width` values: one task below ~32k values,
+/// where splitting costs more than it saves (a batch-512 GRU step through time is 100k).
 fn block_rows(rows: usize, width: usize) -> usize {
-    let tasks = (rows * width / (1 << 16)).clamp(1, rayon::current_num_threads().max(1));
+    let tasks = (rows * width / (1 << 15)).clamp(1, rayon::current_num_threads().max(1));
     rows.div_ceil(tasks).max(1)
 }
 
@@ -115,7 +115,7 @@ impl<'a> Gru<'a> {
             view(d_gates, rows, g).transpose(),
             view(x, rows, e),
         );
-        let mut dx = vec![0.0; rows * e];
+        let mut dx = zeros(rows * e);
         matmul(
             view_mut(&mut dx, rows, e),
             Accum::Replace,
@@ -128,10 +128,9 @@ impl<'a> Gru<'a> {
     /// h ← GRU(h) from complete input gates `gi` (rows × 3E, b_ih included).
     fn step(&self, gi: &[f32], h: &mut [f32], rows: usize) -> GruTape {
         let (e, g) = (self.e, 3 * self.e);
-        let mut gh = self.bias_hh.repeat(rows);
+        let mut gh = repeat_row(self.bias_hh, rows);
         matmul(view_mut(&mut gh, rows, g), Accum::Add, view(h, rows, e), view(self.weight_hh, g, e).transpose());
-        let mut tape =
-            GruTape { r: vec![0.0; rows * e], z: vec![0.0; rows * e], n: vec![0.0; rows * e], hn: vec![0.0; rows * e] };
+        let mut tape = GruTape { r: zeros(rows * e), z: zeros(rows * e), n: zeros(rows * e), hn: zeros(rows * e) };
         let (he, hg) = (block_rows(rows, e) * e, block_rows(rows, e) * g);
         let GruTape { r, z, n, hn } = &mut tape;
         h.par_chunks_mut(he)
@@ -166,7 +165,7 @@ impl<'a> Gru<'a> {
         d_gh: &mut [f32],
     ) -> Vec<f32> {
         let (e, g) = (self.e, 3 * self.e);
-        let mut dh = vec![0.0; rows * e];
+        let mut dh = zeros(rows * e);
         let (he, hg) = (block_rows(rows, e) * e, block_rows(rows, e) * g);
         dh.par_chunks_mut(he)
             .zip(d_gi.par_chunks_mut(hg).zip(d_gh.par_chunks_mut(hg)))
@@ -283,21 +282,20 @@ fn max_pool(
 ) -> (Vec<f32>, Vec<Option<usize>>) {
     let mut pooled = vec![0.0f32; sets * f];
     let mut argmax = vec![None; sets * f];
-    for set in 0..sets {
-        for k in 0..size {
-            let row = set * size + k;
+    pooled.par_chunks_mut(f).zip(argmax.par_chunks_mut(f)).enumerate().for_each(|(set, (pooled, argmax))| {
+        for row in set * size..(set + 1) * size {
             if present.is_some_and(|p| !p[row]) {
                 continue;
             }
             for j in 0..f {
                 let x = features[row * f + j];
-                if x > pooled[set * f + j] {
-                    pooled[set * f + j] = x;
-                    argmax[set * f + j] = Some(row);
+                if x > pooled[j] {
+                    pooled[j] = x;
+                    argmax[j] = Some(row);
                 }
             }
         }
-    }
+    });
     (pooled, argmax)
 }
 
@@ -345,7 +343,6 @@ pub fn loss_and_gradients(
     let l = batch.local_dim;
     let p = s - l;
     let a = batch.actions.len() / (b * t);
-    let tdim = 2 * s + a;
     let m = batch.context_max;
     let (e, lat, f) = (config.embedding, config.latent_dim, config.transition_features);
     let net = Net::new(params, config, s, l, a)?;
@@ -353,9 +350,7 @@ pub fn loss_and_gradients(
     let steps = t - 1;
 
     // Transition features of the chunk's and the context's transitions in one pass.
-    let mut transitions = Vec::with_capacity((b * t + b * m) * tdim);
-    transitions.extend_from_slice(&batch.chunk_transitions);
-    transitions.extend_from_slice(&batch.context);
+    let transitions = concat(&[&batch.chunk_transitions, &batch.context]);
     let enc_rows = b * t + b * m;
     let (mut features, enc_tape) = net.transition_encoder.forward(&transitions, enc_rows);
     relu_in_place(&mut features);
@@ -381,10 +376,10 @@ pub fn loss_and_gradients(
     let predicted: Vec<f32> = batch.states.chunks(s).flat_map(|row| &row[..p]).copied().collect();
     let starts: Vec<f32> = (0..b).flat_map(|i| &predicted[i * n * p..(i * n + t) * p]).copied().collect();
     let (mut h_all, state_tape) = net.state_encoder.forward(&starts, b * t);
-    h_all.iter_mut().for_each(|x| *x = tanh(*x));
+    for_each_value(&mut h_all, |x| *x = tanh(*x));
     let (mut act_emb, act_tape) = net.action_encoder.forward(&batch.actions, b * t);
     relu_in_place(&mut act_emb);
-    let mut action_gates = net.gru.bias_ih.repeat(b * t);
+    let mut action_gates = repeat_row(net.gru.bias_ih, b * t);
     net.gru.add_input_gates(&act_emb, b * t, 1, &mut action_gates);
     let terrain = net.terrain_embedding.as_ref().map(|embedding| {
         let tau: Vec<f32> = (0..b)
@@ -408,9 +403,9 @@ pub fn loss_and_gradients(
         .collect();
     let (mut ctx_single, ctx_single_tape) = net.context_embedding.forward(&beta_single, b * t);
     relu_in_place(&mut ctx_single);
-    let mut gi_single = action_gates.clone();
+    let mut gi_single = copy_of(&action_gates);
     net.gru.add_input_gates(&ctx_single, b * t, 0, &mut gi_single);
-    let mut h_single = h_all.clone();
+    let mut h_single = copy_of(&h_all);
     let single_tape = net.gru.step(&gi_single, &mut h_single, b * t);
 
     // Multi-step: one β per chunk, open loop from s_0; the predictions of s_2.. enter the sum.
@@ -425,13 +420,17 @@ pub fn loss_and_gradients(
     let mut seq_tapes = Vec::with_capacity(t);
     let mut open_loop = vec![0.0; b * steps * e];
     let mut gi = vec![0.0; b * g];
+    let chunk_rows = block_rows(b, g);
     for k in 0..t {
-        for i in 0..b {
-            let (src, ctx) = (&action_gates[(i * t + k) * g..(i * t + k + 1) * g], &ctx_gates[i * g..(i + 1) * g]);
-            for ((o, x), c) in gi[i * g..(i + 1) * g].iter_mut().zip(src).zip(ctx) {
-                *o = x + c;
+        gi.par_chunks_mut(chunk_rows * g).enumerate().for_each(|(block, gi)| {
+            for (row, gi) in gi.chunks_mut(g).enumerate() {
+                let i = block * chunk_rows + row;
+                let (src, ctx) = (&action_gates[(i * t + k) * g..(i * t + k + 1) * g], &ctx_gates[i * g..(i + 1) * g]);
+                for ((o, x), c) in gi.iter_mut().zip(src).zip(ctx) {
+                    *o = x + c;
+                }
             }
-        }
+        });
         seq_h_prev.extend_from_slice(&h);
         seq_tapes.push(net.gru.step(&gi, &mut h, b));
         if k >= 1 {
@@ -444,10 +443,7 @@ pub fn loss_and_gradients(
 
     // One decoder pass over the reconstruction, single-step and multi-step GRU states.
     let rows = 2 * b * t + b * steps;
-    let mut decoded = Vec::with_capacity(rows * e);
-    decoded.extend_from_slice(&h_all);
-    decoded.extend_from_slice(&h_single);
-    decoded.extend_from_slice(&open_loop);
+    let decoded = concat(&[&h_all, &h_single, &open_loop]);
     let mut targets = Vec::with_capacity(rows * p);
     targets.extend_from_slice(&starts);
     for i in 0..b {
@@ -521,13 +517,13 @@ pub fn loss_and_gradients(
         }
         (Variance::Decoder(_), None) => unreachable!("a variance decoder's forward pass leaves its tape"),
     }
-    let mut d_h_all = d_decoded[..b * t * e].to_vec();
+    let mut d_h_all = copy_of(&d_decoded[..b * t * e]);
     let d_h_single = &d_decoded[b * t * e..2 * b * t * e];
     let d_open = &d_decoded[2 * b * t * e..];
 
     // Back through the open loop.
-    let mut d_gi_seq = vec![0.0; b * t * g];
-    let mut seq_d_gh = vec![0.0; t * b * g];
+    let mut d_gi_seq = zeros(b * t * g);
+    let mut seq_d_gh = zeros(t * b * g);
     let mut dh = vec![0.0; b * e];
     let mut d_gi_step = vec![0.0; b * g];
     for k in (0..t).rev() {
@@ -541,9 +537,13 @@ pub fn loss_and_gradients(
         let h_prev = &seq_h_prev[k * b * e..(k + 1) * b * e];
         let d_gh = &mut seq_d_gh[k * b * g..(k + 1) * b * g];
         dh = net.gru.step_backward(&seq_tapes[k], h_prev, &dh, b, &mut d_gi_step, d_gh);
-        for i in 0..b {
-            d_gi_seq[(i * t + k) * g..(i * t + k + 1) * g].copy_from_slice(&d_gi_step[i * g..(i + 1) * g]);
-        }
+        // Chunk i's gates at step k go to row i·T + k: whole chunks' rows per task.
+        d_gi_seq.par_chunks_mut(chunk_rows * t * g).enumerate().for_each(|(block, rows)| {
+            for (row, chunk) in rows.chunks_mut(t * g).enumerate() {
+                let i = block * chunk_rows + row;
+                chunk[k * g..(k + 1) * g].copy_from_slice(&d_gi_step[i * g..(i + 1) * g]);
+            }
+        });
     }
     for i in 0..b {
         add_into(&mut d_h_all[i * t * e..(i * t + 1) * e], &dh[i * e..(i + 1) * e]);
@@ -551,15 +551,16 @@ pub fn loss_and_gradients(
     net.gru.hidden_weight_backward(&seq_h_prev, &seq_d_gh, t * b, &mut grads);
 
     // Back through the single steps.
-    let mut d_gi_single = vec![0.0; b * t * g];
-    let mut single_d_gh = vec![0.0; b * t * g];
+    let mut d_gi_single = zeros(b * t * g);
+    let mut single_d_gh = zeros(b * t * g);
     let d_h_prev_single =
         net.gru.step_backward(&single_tape, &h_all, d_h_single, b * t, &mut d_gi_single, &mut single_d_gh);
     net.gru.hidden_weight_backward(&h_all, &single_d_gh, b * t, &mut grads);
     add_into(&mut d_h_all, &d_h_prev_single);
 
     // The input gates: the action (and terrain) part and b_ih are shared by both predictions.
-    let d_action_gates: Vec<f32> = d_gi_single.iter().zip(&d_gi_seq).map(|(a, b)| a + b).collect();
+    let mut d_action_gates = copy_of(&d_gi_single);
+    add_into(&mut d_action_gates, &d_gi_seq);
     add_column_sums(&mut grads[net.gru.index[2]], &d_action_gates);
     let mut d_act_emb = net.gru.input_backward(&act_emb, &d_action_gates, b * t, 1, &mut grads);
     relu_backward(&mut d_act_emb, &act_emb);
@@ -574,19 +575,18 @@ pub fn loss_and_gradients(
     let d_beta_single =
         net.context_embedding.backward(&beta_single, &ctx_single_tape, &d_ctx_single, b * t, &mut grads, true);
     let mut d_ctx_gates = vec![0.0; b * g];
-    for i in 0..b {
-        for k in 0..t {
-            let src = &d_gi_seq[(i * t + k) * g..(i * t + k + 1) * g];
-            add_into(&mut d_ctx_gates[i * g..(i + 1) * g], src);
+    d_ctx_gates.par_chunks_mut(g).zip(d_gi_seq.par_chunks(t * g)).for_each(|(sum, steps)| {
+        for step in steps.chunks(g) {
+            sum.iter_mut().zip(step).for_each(|(s, x)| *s += x);
         }
-    }
+    });
     let mut d_ctx_seq = net.gru.input_backward(&ctx_seq, &d_ctx_gates, b, 0, &mut grads);
     relu_backward(&mut d_ctx_seq, &ctx_seq);
     let d_beta = net.context_embedding.backward(&beta, &ctx_seq_tape, &d_ctx_seq, b, &mut grads, true);
 
     // The state encoder.
     let mut d_state = d_h_all;
-    d_state.iter_mut().zip(&h_all).for_each(|(d, y)| *d *= 1.0 - y * y);
+    zip_values(&mut d_state, &h_all, |d, y| *d *= 1.0 - y * y);
     net.state_encoder.backward(&starts, &state_tape, &d_state, b * t, &mut grads, false);
 
     // The beliefs: reparameterized samples and the KL terms.
