@@ -19,7 +19,7 @@
 use faer::Accum;
 use rayon::prelude::*;
 
-use super::backprop::{add_column_sums, matmul, tensor_index, view, view_mut};
+use super::backprop::{add_column_sums, matmul, repeat_row, tensor_index, view, view_mut, zeros};
 use super::params::ParamSet;
 use crate::error::{Error, Result};
 
@@ -174,17 +174,17 @@ impl StridedConv {
         let g = &self.grids;
         let (window, positions) = (g.window(), g.positions());
         let chunk = self.chunk;
-        let mut col = vec![0.0f32; chunk.min(images) * positions * window];
+        let mut col = zeros(chunk.min(images) * positions * window);
         match self.direction {
             Direction::Down => {
-                let mut y = self.bias.repeat(images * positions);
+                let mut y = repeat_row(&self.bias, images * positions);
                 for (x, y) in x.chunks(chunk * g.big_len()).zip(y.chunks_mut(chunk * g.small_len())) {
                     self.windows_times_weight(x, &mut col, y, Accum::Add);
                 }
                 y
             }
             Direction::Up => {
-                let mut y = self.bias.repeat(images * g.big_side * g.big_side);
+                let mut y = repeat_row(&self.bias, images * g.big_side * g.big_side);
                 for (x, y) in x.chunks(chunk * g.small_len()).zip(y.chunks_mut(chunk * g.big_len())) {
                     self.spread_onto_windows(x, &mut col, y);
                 }
@@ -237,9 +237,9 @@ impl StridedConv {
         let g = &self.grids;
         let (window, positions, small) = (g.window(), g.positions(), g.small_channels);
         let chunk = self.chunk;
-        let mut col = vec![0.0f32; chunk.min(images) * positions * window];
+        let mut col = zeros(chunk.min(images) * positions * window);
         let mut weight_grad = vec![0.0f32; small * window];
-        let mut dx = if want_dx { vec![0.0f32; x.len()] } else { Vec::new() };
+        let mut dx = if want_dx { zeros(x.len()) } else { Vec::new() };
         let (small_grid, big_grid) = match self.direction {
             Direction::Down => (dy, x),
             Direction::Up => (x, dy),

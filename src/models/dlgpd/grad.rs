@@ -12,7 +12,7 @@ use super::vae::{FRAME_CHANNELS, FRAME_SIDE, STD_FLOOR, STD_SHIFT};
 use crate::error::{Error, Result};
 use crate::models::gp::GpHypers;
 use crate::nn::activation::{fast_sigmoid, fast_softplus};
-use crate::nn::backprop::{relu_backward, relu_in_place, zero_gradients, Dense};
+use crate::nn::backprop::{add_into, relu_backward, relu_in_place, zero_gradients, zeros, Dense};
 use crate::nn::conv_backprop::{
     to_channels_first, to_channels_last, to_channels_last_into, Direction, Grids, StridedConv,
 };
@@ -111,7 +111,7 @@ impl<'a> ConvVaeGrad<'a> {
         }
         let mut d_flat = self.mean.backward(&tape.flat, d_mean, images, grads, true);
         let d_from_std = self.std.backward(&tape.flat, &d_std, images, grads, true);
-        d_flat.iter_mut().zip(&d_from_std).for_each(|(a, b)| *a += b);
+        add_into(&mut d_flat, &d_from_std);
         let (channels, side) = self.encoder_out;
         let mut d = to_channels_last(&d_flat, channels, side);
         for (i, layer) in self.encoder.iter().enumerate().rev() {
@@ -198,7 +198,7 @@ pub fn images_loss_and_gradients(
     if batch.obs.len() != rows * width || batch.next_obs.len() != rows * width {
         return Err(Error::data(format!("DLGPD batch: {rows} rows of frames need {width} values each")));
     }
-    let mut frames = vec![0.0; 2 * rows * width];
+    let mut frames = zeros(2 * rows * width);
     let (current, next) = frames.split_at_mut(rows * width);
     to_channels_last_into(&batch.obs, FRAME_CHANNELS, FRAME_SIDE, current);
     to_channels_last_into(&batch.next_obs, FRAME_CHANNELS, FRAME_SIDE, next);
