@@ -16,6 +16,7 @@ pub mod fast;
 pub mod features;
 pub mod gaussian;
 pub mod gru;
+pub mod gru_backprop;
 pub mod init;
 pub mod linear;
 pub mod normalizer;

@@ -3,7 +3,6 @@
 //! copies and fresh pages cost more than the arithmetic. `net.rs` stays the reference: a test holds the loss and
 //! every gradient here to burn's.
 
-use faer::Accum;
 use rayon::prelude::*;
 
 use super::config::ContextConfig;
@@ -12,9 +11,10 @@ use super::net::{STD_FLOOR, STD_SCALE, STD_SHIFT, VARIANCE_FLOOR};
 use crate::error::{Error, Result};
 use crate::nn::activation::{fast_sigmoid as sigmoid, fast_softplus as softplus, fast_tanh as tanh};
 use crate::nn::backprop::{
-    add_column_sums, add_into, concat, copy_of, for_each_value, matmul, relu_backward, relu_in_place, repeat_row,
-    tensor_index, view, view_mut, zero_gradients, zeros, zip_values, TwoLayer, TwoLayerTape,
+    add_column_sums, add_into, block_rows, concat, copy_of, for_each_value, relu_backward, relu_in_place, repeat_row,
+    tensor_index, zero_gradients, zeros, zip_values, TwoLayer, TwoLayerTape,
 };
+use crate::nn::gru_backprop::Gru;
 use crate::nn::ParamSet;
 
 /// The loss and its parts (batch means), as [`super::net::LossParts`] reports them.
@@ -27,13 +27,6 @@ pub struct LossValues {
     pub kl: f64,
     pub posterior_std: f64,
     pub context_std: f64,
-}
-
-/// Rows per parallel task of an element-wise pass over `rows × width` values: one task below ~32k values,
-/// where splitting costs more than it saves (a batch-512 GRU step through time is 100k).
-fn block_rows(rows: usize, width: usize) -> usize {
-    let tasks = (rows * width / (1 << 15)).clamp(1, rayon::current_num_threads().max(1));
-    rows.div_ceil(tasks).max(1)
 }
 
 /// The context network's layers as views of a parameter set.
@@ -56,159 +49,6 @@ enum Variance<'a> {
     Constant(&'a [f32], usize),
 }
 
-struct Gru<'a> {
-    e: usize,
-    inputs: usize,
-    weight_ih: &'a [f32],
-    weight_hh: &'a [f32],
-    bias_ih: &'a [f32],
-    bias_hh: &'a [f32],
-    index: [usize; 4],
-}
-
-/// What one GRU step keeps for its backward pass (rows × E each).
-struct GruTape {
-    r: Vec<f32>,
-    z: Vec<f32>,
-    n: Vec<f32>,
-    /// W_hn h + b_hn, which the reset gate scales.
-    hn: Vec<f32>,
-}
-
-impl<'a> Gru<'a> {
-    fn new(params: &'a ParamSet, e: usize, inputs: usize) -> Result<Self> {
-        let ix = [
-            tensor_index(params, "gru.weight_ih", &[3 * e, inputs * e])?,
-            tensor_index(params, "gru.weight_hh", &[3 * e, e])?,
-            tensor_index(params, "gru.bias_ih", &[3 * e])?,
-            tensor_index(params, "gru.bias_hh", &[3 * e])?,
-        ];
-        let v = |k: usize| params.tensors[ix[k]].values.as_slice();
-        Ok(Gru { e, inputs, weight_ih: v(0), weight_hh: v(1), bias_ih: v(2), bias_hh: v(3), index: ix })
-    }
-
-    /// gates (rows × 3E) += x · W_ih[:, block]ᵀ for input block `block` (0 context, 1 action, 2 terrain).
-    fn add_input_gates(&self, x: &[f32], rows: usize, block: usize, gates: &mut [f32]) {
-        let (e, g) = (self.e, 3 * self.e);
-        matmul(
-            view_mut(gates, rows, g),
-            Accum::Add,
-            view(x, rows, e),
-            view(self.weight_ih, g, self.inputs * e).subcols(block * e, e).transpose(),
-        );
-    }
-
-    /// The input-gate gradients `d_gates` (rows × 3E) of block `block`'s input `x`: adds to W_ih's gradient and
-    /// returns dx.
-    fn input_backward(
-        &self,
-        x: &[f32],
-        d_gates: &[f32],
-        rows: usize,
-        block: usize,
-        grads: &mut [Vec<f32>],
-    ) -> Vec<f32> {
-        let (e, g, width) = (self.e, 3 * self.e, self.inputs * self.e);
-        matmul(
-            view_mut(&mut grads[self.index[0]], g, width).subcols_mut(block * e, e),
-            Accum::Add,
-            view(d_gates, rows, g).transpose(),
-            view(x, rows, e),
-        );
-        let mut dx = zeros(rows * e);
-        matmul(
-            view_mut(&mut dx, rows, e),
-            Accum::Replace,
-            view(d_gates, rows, g),
-            view(self.weight_ih, g, width).subcols(block * e, e),
-        );
-        dx
-    }
-
-    /// h ← GRU(h) from complete input gates `gi` (rows × 3E, b_ih included).
-    fn step(&self, gi: &[f32], h: &mut [f32], rows: usize) -> GruTape {
-        let (e, g) = (self.e, 3 * self.e);
-        let mut gh = repeat_row(self.bias_hh, rows);
-        matmul(view_mut(&mut gh, rows, g), Accum::Add, view(h, rows, e), view(self.weight_hh, g, e).transpose());
-        let mut tape = GruTape { r: zeros(rows * e), z: zeros(rows * e), n: zeros(rows * e), hn: zeros(rows * e) };
-        let (he, hg) = (block_rows(rows, e) * e, block_rows(rows, e) * g);
-        let GruTape { r, z, n, hn } = &mut tape;
-        h.par_chunks_mut(he)
-            .zip(r.par_chunks_mut(he).zip(z.par_chunks_mut(he)))
-            .zip(n.par_chunks_mut(he).zip(hn.par_chunks_mut(he)))
-            .zip(gi.par_chunks(hg).zip(gh.par_chunks(hg)))
-            .for_each(|(((h, (r, z)), (n, hn)), (gi, gh))| {
-                for row in 0..h.len() / e {
-                    let (gi, gh) = (&gi[row * g..(row + 1) * g], &gh[row * g..(row + 1) * g]);
-                    for k in 0..e {
-                        let at = row * e + k;
-                        r[at] = sigmoid(gi[k] + gh[k]);
-                        z[at] = sigmoid(gi[e + k] + gh[e + k]);
-                        n[at] = tanh(gi[2 * e + k] + r[at] * gh[2 * e + k]);
-                        hn[at] = gh[2 * e + k];
-                        h[at] = (1.0 - z[at]) * n[at] + z[at] * h[at];
-                    }
-                }
-            });
-        tape
-    }
-
-    /// Backward of one step: from dh' (rows × E) and the previous state, the input-gate gradients (written to
-    /// `d_gi`), the hidden-gate gradients (written to `d_gh`, for one W_hh GEMM over all steps later) and dh.
-    fn step_backward(
-        &self,
-        tape: &GruTape,
-        h_prev: &[f32],
-        dh_next: &[f32],
-        rows: usize,
-        d_gi: &mut [f32],
-        d_gh: &mut [f32],
-    ) -> Vec<f32> {
-        let (e, g) = (self.e, 3 * self.e);
-        let mut dh = zeros(rows * e);
-        let (he, hg) = (block_rows(rows, e) * e, block_rows(rows, e) * g);
-        dh.par_chunks_mut(he)
-            .zip(d_gi.par_chunks_mut(hg).zip(d_gh.par_chunks_mut(hg)))
-            .zip(tape.r.par_chunks(he).zip(tape.z.par_chunks(he)))
-            .zip(tape.n.par_chunks(he).zip(tape.hn.par_chunks(he)))
-            .zip(h_prev.par_chunks(he).zip(dh_next.par_chunks(he)))
-            .for_each(|((((dh, (d_gi, d_gh)), (r, z)), (n, hn)), (h_prev, dh_next))| {
-                for row in 0..dh.len() / e {
-                    let (d_gi, d_gh) = (&mut d_gi[row * g..(row + 1) * g], &mut d_gh[row * g..(row + 1) * g]);
-                    for k in 0..e {
-                        let at = row * e + k;
-                        let (r, z, n, hn) = (r[at], z[at], n[at], hn[at]);
-                        let d = dh_next[at];
-                        let dn = d * (1.0 - z) * (1.0 - n * n);
-                        let dz = d * (h_prev[at] - n) * z * (1.0 - z);
-                        let dr = dn * hn * r * (1.0 - r);
-                        d_gi[k] = dr;
-                        d_gi[e + k] = dz;
-                        d_gi[2 * e + k] = dn;
-                        d_gh[k] = dr;
-                        d_gh[e + k] = dz;
-                        d_gh[2 * e + k] = dn * r;
-                        dh[at] = d * z;
-                    }
-                }
-            });
-        matmul(view_mut(&mut dh, rows, e), Accum::Add, view(d_gh, rows, g), view(self.weight_hh, g, e));
-        dh
-    }
-
-    /// W_hh's and b_hh's gradients from all steps' hidden-gate gradients and previous states at once.
-    fn hidden_weight_backward(&self, h_prev: &[f32], d_gh: &[f32], rows: usize, grads: &mut [Vec<f32>]) {
-        let (e, g) = (self.e, 3 * self.e);
-        matmul(
-            view_mut(&mut grads[self.index[1]], g, e),
-            Accum::Add,
-            view(d_gh, rows, g).transpose(),
-            view(h_prev, rows, e),
-        );
-        add_column_sums(&mut grads[self.index[3]], d_gh);
-    }
-}
-
 impl<'a> Net<'a> {
     fn new(params: &'a ParamSet, config: &ContextConfig, s: usize, local: usize, a: usize) -> Result<Self> {
         let (e, h) = (config.embedding, config.hidden_units);
@@ -226,7 +66,7 @@ impl<'a> Net<'a> {
             action_encoder: two("action_encoder", a, e)?,
             context_embedding: two("context_embedding", b, e)?,
             terrain_embedding: if local > 0 { Some(two("terrain_embedding", local, e)?) } else { None },
-            gru: Gru::new(params, e, if local > 0 { 3 } else { 2 })?,
+            gru: Gru::new(params, "gru", e, if local > 0 { 3 } else { 2 })?,
             mean_decoder: two("mean_decoder", e, p)?,
             variance,
             transition_encoder: two("transition_encoder", 2 * s + a, f)?,
@@ -379,7 +219,7 @@ pub fn loss_and_gradients(
     for_each_value(&mut h_all, |x| *x = tanh(*x));
     let (mut act_emb, act_tape) = net.action_encoder.forward(&batch.actions, b * t);
     relu_in_place(&mut act_emb);
-    let mut action_gates = repeat_row(net.gru.bias_ih, b * t);
+    let mut action_gates = repeat_row(net.gru.bias_ih(), b * t);
     net.gru.add_input_gates(&act_emb, b * t, 1, &mut action_gates);
     let terrain = net.terrain_embedding.as_ref().map(|embedding| {
         let tau: Vec<f32> = (0..b)
@@ -561,7 +401,7 @@ pub fn loss_and_gradients(
     // The input gates: the action (and terrain) part and b_ih are shared by both predictions.
     let mut d_action_gates = copy_of(&d_gi_single);
     add_into(&mut d_action_gates, &d_gi_seq);
-    add_column_sums(&mut grads[net.gru.index[2]], &d_action_gates);
+    add_column_sums(&mut grads[net.gru.bias_ih_index()], &d_action_gates);
     let mut d_act_emb = net.gru.input_backward(&act_emb, &d_action_gates, b * t, 1, &mut grads);
     relu_backward(&mut d_act_emb, &act_emb);
     net.action_encoder.backward(&batch.actions, &act_tape, &d_act_emb, b * t, &mut grads, false);

@@ -1,0 +1,181 @@
+//! A GRU cell (torch.nn.GRUCell's equations, gates stacked r, z, n) written out by hand over plain f32 buffers
+//! for training through time: a step forward with its tape, a step back, and the weight gradients taken once
+//! over all steps (one W_hh GEMM over every step's hidden-gate gradients rather than one per step). Its input is
+//! `inputs` blocks of the hidden width side by side (the context model's context, action and terrain
+//! embeddings), so each block's gates and gradients are one GEMM against its columns of W_ih.
+//!
+//! The models that train through it keep burn's `GruCell` (`nn::gru`) as their reference: the context model's
+//! test holds every gradient to burn's autodiff.
+
+use faer::Accum;
+use rayon::prelude::*;
+
+use super::activation::{fast_sigmoid as sigmoid, fast_tanh as tanh};
+use super::backprop::{add_column_sums, block_rows, matmul, repeat_row, tensor_index, view, view_mut, zeros};
+use super::params::ParamSet;
+use crate::error::Result;
+
+/// The cell's weights as views of a parameter set (torch's layout: W_ih [3E, blocks·E], W_hh [3E, E]).
+pub struct Gru<'a> {
+    e: usize,
+    inputs: usize,
+    weight_ih: &'a [f32],
+    weight_hh: &'a [f32],
+    bias_ih: &'a [f32],
+    bias_hh: &'a [f32],
+    index: [usize; 4],
+}
+
+/// What one GRU step keeps for its backward pass (rows × E each).
+pub struct GruTape {
+    r: Vec<f32>,
+    z: Vec<f32>,
+    n: Vec<f32>,
+    /// W_hn h + b_hn, which the reset gate scales.
+    hn: Vec<f32>,
+}
+
+impl<'a> Gru<'a> {
+    /// The cell `prefix` of `params` with hidden width `e` and `inputs` input blocks of width `e`.
+    pub fn new(params: &'a ParamSet, prefix: &str, e: usize, inputs: usize) -> Result<Self> {
+        let ix = [
+            tensor_index(params, &format!("{prefix}.weight_ih"), &[3 * e, inputs * e])?,
+            tensor_index(params, &format!("{prefix}.weight_hh"), &[3 * e, e])?,
+            tensor_index(params, &format!("{prefix}.bias_ih"), &[3 * e])?,
+            tensor_index(params, &format!("{prefix}.bias_hh"), &[3 * e])?,
+        ];
+        let v = |k: usize| params.tensors[ix[k]].values.as_slice();
+        Ok(Gru { e, inputs, weight_ih: v(0), weight_hh: v(1), bias_ih: v(2), bias_hh: v(3), index: ix })
+    }
+
+    /// b_ih, which callers broadcast over the rows before adding the input blocks' gates.
+    pub fn bias_ih(&self) -> &'a [f32] {
+        self.bias_ih
+    }
+
+    /// Where b_ih's gradient goes: the column sums of the input-gate gradients.
+    pub fn bias_ih_index(&self) -> usize {
+        self.index[2]
+    }
+
+    /// gates (rows × 3E) += x · W_ih[:, block]ᵀ for input block `block` (0 context, 1 action, 2 terrain).
+    pub fn add_input_gates(&self, x: &[f32], rows: usize, block: usize, gates: &mut [f32]) {
+        let (e, g) = (self.e, 3 * self.e);
+        matmul(
+            view_mut(gates, rows, g),
+            Accum::Add,
+            view(x, rows, e),
+            view(self.weight_ih, g, self.inputs * e).subcols(block * e, e).transpose(),
+        );
+    }
+
+    /// The input-gate gradients `d_gates` (rows × 3E) of block `block`'s input `x`: adds to W_ih's gradient and
+    /// returns dx.
+    pub fn input_backward(
+        &self,
+        x: &[f32],
+        d_gates: &[f32],
+        rows: usize,
+        block: usize,
+        grads: &mut [Vec<f32>],
+    ) -> Vec<f32> {
+        let (e, g, width) = (self.e, 3 * self.e, self.inputs * self.e);
+        matmul(
+            view_mut(&mut grads[self.index[0]], g, width).subcols_mut(block * e, e),
+            Accum::Add,
+            view(d_gates, rows, g).transpose(),
+            view(x, rows, e),
+        );
+        let mut dx = zeros(rows * e);
+        matmul(
+            view_mut(&mut dx, rows, e),
+            Accum::Replace,
+            view(d_gates, rows, g),
+            view(self.weight_ih, g, width).subcols(block * e, e),
+        );
+        dx
+    }
+
+    /// h ← GRU(h) from complete input gates `gi` (rows × 3E, b_ih included).
+    pub fn step(&self, gi: &[f32], h: &mut [f32], rows: usize) -> GruTape {
+        let (e, g) = (self.e, 3 * self.e);
+        let mut gh = repeat_row(self.bias_hh, rows);
+        matmul(view_mut(&mut gh, rows, g), Accum::Add, view(h, rows, e), view(self.weight_hh, g, e).transpose());
+        let mut tape = GruTape { r: zeros(rows * e), z: zeros(rows * e), n: zeros(rows * e), hn: zeros(rows * e) };
+        let (he, hg) = (block_rows(rows, e) * e, block_rows(rows, e) * g);
+        let GruTape { r, z, n, hn } = &mut tape;
+        h.par_chunks_mut(he)
+            .zip(r.par_chunks_mut(he).zip(z.par_chunks_mut(he)))
+            .zip(n.par_chunks_mut(he).zip(hn.par_chunks_mut(he)))
+            .zip(gi.par_chunks(hg).zip(gh.par_chunks(hg)))
+            .for_each(|(((h, (r, z)), (n, hn)), (gi, gh))| {
+                for row in 0..h.len() / e {
+                    let (gi, gh) = (&gi[row * g..(row + 1) * g], &gh[row * g..(row + 1) * g]);
+                    for k in 0..e {
+                        let at = row * e + k;
+                        r[at] = sigmoid(gi[k] + gh[k]);
+                        z[at] = sigmoid(gi[e + k] + gh[e + k]);
+                        n[at] = tanh(gi[2 * e + k] + r[at] * gh[2 * e + k]);
+                        hn[at] = gh[2 * e + k];
+                        h[at] = (1.0 - z[at]) * n[at] + z[at] * h[at];
+                    }
+                }
+            });
+        tape
+    }
+
+    /// Backward of one step: from dh' (rows × E) and the previous state, the input-gate gradients (written to
+    /// `d_gi`), the hidden-gate gradients (written to `d_gh`, for one W_hh GEMM over all steps later) and dh.
+    pub fn step_backward(
+        &self,
+        tape: &GruTape,
+        h_prev: &[f32],
+        dh_next: &[f32],
+        rows: usize,
+        d_gi: &mut [f32],
+        d_gh: &mut [f32],
+    ) -> Vec<f32> {
+        let (e, g) = (self.e, 3 * self.e);
+        let mut dh = zeros(rows * e);
+        let (he, hg) = (block_rows(rows, e) * e, block_rows(rows, e) * g);
+        dh.par_chunks_mut(he)
+            .zip(d_gi.par_chunks_mut(hg).zip(d_gh.par_chunks_mut(hg)))
+            .zip(tape.r.par_chunks(he).zip(tape.z.par_chunks(he)))
+            .zip(tape.n.par_chunks(he).zip(tape.hn.par_chunks(he)))
+            .zip(h_prev.par_chunks(he).zip(dh_next.par_chunks(he)))
+            .for_each(|((((dh, (d_gi, d_gh)), (r, z)), (n, hn)), (h_prev, dh_next))| {
+                for row in 0..dh.len() / e {
+                    let (d_gi, d_gh) = (&mut d_gi[row * g..(row + 1) * g], &mut d_gh[row * g..(row + 1) * g]);
+                    for k in 0..e {
+                        let at = row * e + k;
+                        let (r, z, n, hn) = (r[at], z[at], n[at], hn[at]);
+                        let d = dh_next[at];
+                        let dn = d * (1.0 - z) * (1.0 - n * n);
+                        let dz = d * (h_prev[at] - n) * z * (1.0 - z);
+                        let dr = dn * hn * r * (1.0 - r);
+                        d_gi[k] = dr;
+                        d_gi[e + k] = dz;
+                        d_gi[2 * e + k] = dn;
+                        d_gh[k] = dr;
+                        d_gh[e + k] = dz;
+                        d_gh[2 * e + k] = dn * r;
+                        dh[at] = d * z;
+                    }
+                }
+            });
+        matmul(view_mut(&mut dh, rows, e), Accum::Add, view(d_gh, rows, g), view(self.weight_hh, g, e));
+        dh
+    }
+
+    /// W_hh's and b_hh's gradients from all steps' hidden-gate gradients and previous states at once.
+    pub fn hidden_weight_backward(&self, h_prev: &[f32], d_gh: &[f32], rows: usize, grads: &mut [Vec<f32>]) {
+        let (e, g) = (self.e, 3 * self.e);
+        matmul(
+            view_mut(&mut grads[self.index[1]], g, e),
+            Accum::Add,
+            view(d_gh, rows, g).transpose(),
+            view(h_prev, rows, e),
+        );
+        add_column_sums(&mut grads[self.index[3]], d_gh);
+    }
+}
