@@ -125,6 +125,23 @@ fn cut<'a, T>(mut buffer: &'a mut [T], parts: &[Part], width: usize) -> std::vec
     pieces.into_iter()
 }
 
+/// Per-layer buffers, each sized for `total_rows` of its layer's width and cut into the parts' pieces.
+fn cut_layers<'a>(
+    buffers: &'a mut [Vec<f32>],
+    widths: &[usize],
+    parts: &[Part],
+    total_rows: usize,
+) -> Vec<std::vec::IntoIter<&'a mut [f32]>> {
+    buffers
+        .iter_mut()
+        .zip(widths)
+        .map(|(buffer, &width)| {
+            buffer.resize(total_rows * width, 0.0);
+            cut(buffer, parts, width)
+        })
+        .collect()
+}
+
 /// A part's pieces of the workspace's buffers.
 struct PartBuffers<'a> {
     activations: Vec<&'a mut [f32]>,
@@ -231,33 +248,9 @@ impl<'a> EnsembleNet<'a> {
         ws.slopes.resize_with(hidden, Vec::new);
         ws.d_outputs.resize_with(if gradients { hidden + 1 } else { 0 }, Vec::new);
         let widths: Vec<usize> = self.layers().map(|l| l.d_out).collect();
-        let mut activations: Vec<_> = ws
-            .activations
-            .iter_mut()
-            .zip(&widths)
-            .map(|(b, &w)| {
-                b.resize(e * rows * w, 0.0);
-                cut(b, parts, w)
-            })
-            .collect();
-        let mut slopes: Vec<_> = ws
-            .slopes
-            .iter_mut()
-            .zip(&widths)
-            .map(|(b, &w)| {
-                b.resize(e * rows * w, 0.0);
-                cut(b, parts, w)
-            })
-            .collect();
-        let mut d_outputs: Vec<_> = ws
-            .d_outputs
-            .iter_mut()
-            .zip(&widths)
-            .map(|(b, &w)| {
-                b.resize(e * rows * w, 0.0);
-                cut(b, parts, w)
-            })
-            .collect();
+        let mut activations = cut_layers(&mut ws.activations, &widths, parts, e * rows);
+        let mut slopes = cut_layers(&mut ws.slopes, &widths, parts, e * rows);
+        let mut d_outputs = cut_layers(&mut ws.d_outputs, &widths, parts, e * rows);
         let d2 = 2 * self.target_dim;
         ws.output.resize(e * rows * d2, 0.0);
         let mut output = cut(&mut ws.output, parts, d2);
