@@ -1,8 +1,8 @@
-//! Writes the ball EKF's training case for the PyTorch reference (benches/pytorch/ball_reference.py): the bench's
-//! simulated recordings (benches/inputs/mod.rs `ball_recordings`) cut into chunks as the trainer cuts them, the
-//! batches of the first `STEPS` optimizer steps of `train` under `TrainSettings::default()`, the raw parameters and
-//! physics, the loss and its gradients with respect to the raw parameters on the first batch, and the losses
-//! `train` itself reports over those steps.
+//! Writes the ball EKF's training case for the PyTorch reference (benches/pytorch/ball_reference.py): the
+//! bench's simulated recordings (benches/inputs/mod.rs `ball_recordings`, included below) cut into chunks as
+//! the trainer cuts them, the batches of the first `STEPS` optimizer steps of `train` under
+//! `TrainSettings::default()`, the raw parameters and physics, the loss and its gradients with respect to the
+//! raw parameters on the first batch, and the losses `train` itself reports over those steps.
 //!
 //!   cargo run --release --example ball_loss_case -- [FILE]   (default target/ball_loss_case.json)
 //!
@@ -12,9 +12,6 @@ use std::path::PathBuf;
 
 use burn::module::Param;
 use burn::tensor::{Gradients, Tensor};
-use mbrl::data::ball_io::Recording;
-use mbrl::data::collect_ball::{collect_ball, BallCollectSettings};
-use mbrl::envs::ball::Orientation;
 use mbrl::models::ball::learn::{
     chunk_loss, cut_chunks, train, training_device, BallParamsModule, Batch, Chunk, TrainSettings,
 };
@@ -23,23 +20,15 @@ use mbrl::util::seeding::rng_for;
 use rand::seq::SliceRandom;
 use serde_json::{json, Value};
 
+// The benches' own inputs, so the case is exactly the data `ball_b64x50` trains on.
+#[path = "../benches/inputs/mod.rs"]
+mod inputs;
+
 /// The bench's `ball()` times `train` for 11 steps less `train` for 1.
 const STEPS: u64 = 11;
 
 /// The trainer's shuffle stream (`SHUFFLE_STREAM` in src/models/ball/learn/trainer.rs).
 const SHUFFLE_STREAM: u64 = 0;
-
-/// A copy of benches/inputs/mod.rs `ball_recordings()`, which an example cannot import.
-fn ball_recordings() -> Vec<Recording> {
-    let settings = BallCollectSettings {
-        trajectories: 40,
-        orientation: Orientation::Default,
-        augment_rotations: 0,
-        seed: 1,
-        command_line: String::new(),
-    };
-    collect_ball(&settings, &NullMonitor).expect("the simulated ball collects").recordings
-}
 
 /// The chunks of step `step` (from 1) as `BallEkfTrainer::batch` draws them: consecutive slices of a seeded
 /// permutation per epoch. The loss of the first batch is held to `train`'s own below, which catches a drift.
@@ -100,7 +89,7 @@ fn main() {
     let settings = TrainSettings { steps: STEPS, ..TrainSettings::default() };
     assert!(!settings.launcher_prior, "the reference has no launcher spin network");
     let physics = &settings.initial.physics;
-    let recordings = ball_recordings();
+    let recordings = inputs::ball_recordings();
     let chunks = cut_chunks(&recordings, settings.chunk_len, physics).expect("chunks");
     let batches: Vec<Vec<&Chunk>> = (1..=STEPS)
         .map(|step| batch_indices(chunks.len(), &settings, step).into_iter().map(|i| &chunks[i]).collect())

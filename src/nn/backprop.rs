@@ -193,10 +193,10 @@ pub fn add_column_sums(sums: &mut [f32], m: &[f32]) {
     }
 }
 
-/// Rows per parallel task of an element-wise pass over `rows × width` values: one task below ~32k values,
-/// where splitting costs more than it saves (a batch-512 GRU step through time is 100k).
+/// Rows per parallel task of an element-wise pass over `rows × width` values: one task below a block of
+/// values, where splitting costs more than it saves (a batch-512 GRU step through time is three blocks).
 pub fn block_rows(rows: usize, width: usize) -> usize {
-    let tasks = (rows * width / (1 << 15)).clamp(1, rayon::current_num_threads().max(1));
+    let tasks = (rows * width / ELEMENTWISE_BLOCK).clamp(1, rayon::current_num_threads().max(1));
     rows.div_ceil(tasks).max(1)
 }
 

@@ -157,6 +157,7 @@ struct PartBuffers<'a> {
 /// The ensemble's layers as views of a parameter set in mbrl-lib's names (see `net::torch_name`).
 pub struct EnsembleNet<'a> {
     members: usize,
+    input_dim: usize,
     target_dim: usize,
     activation: Activation,
     hidden: Vec<Layer<'a>>,
@@ -220,6 +221,7 @@ impl<'a> EnsembleNet<'a> {
         ];
         Ok(EnsembleNet {
             members,
+            input_dim,
             target_dim,
             activation: config.activation,
             hidden,
@@ -326,7 +328,7 @@ impl<'a> EnsembleNet<'a> {
     /// Mean squared error of the predicted mean against `targets` over every member, row and output, for
     /// inputs [members, rows, in] (normalized) and targets [members, rows, target_dim].
     pub fn mean_squared_error(&self, ws: &mut Workspace, inputs: &[f32], targets: &[f32], rows: usize) -> f64 {
-        let (din, d) = (self.layers().next().map_or(0, |l| l.d_in), self.target_dim);
+        let (din, d) = (self.input_dim, self.target_dim);
         let parts = parts(self.members, rows);
         let buffers = self.part_buffers(ws, &parts, rows, false);
         let sums: Vec<f64> = buffers
@@ -360,7 +362,7 @@ impl<'a> EnsembleNet<'a> {
         rows: usize,
     ) -> f64 {
         let (e, d) = (self.members, self.target_dim);
-        let din = self.layers().next().map_or(0, |l| l.d_in);
+        let din = self.input_dim;
         let scale = 1.0 / (rows * d) as f32;
         let parts = parts(e, rows);
         let buffers = self.part_buffers(ws, &parts, rows, true);
