@@ -2,7 +2,7 @@
 //! (benches/pytorch/training_steps.py), plus the machine's f32 GEMM ceiling through faer in the same run.
 //! benches/vs_pytorch.py runs both and prints the ratio table; run alone, this prints one JSON object per line:
 //!
-//!   cargo bench --bench training_steps -- [--quick] [--only NAME[,NAME…]]
+//!   cargo bench --bench training_steps -- [--quick] [--only NAME[,NAME…]] [--threads N]
 //!
 //! Each workload's figure is the median of its timed steps after warm-up steps; the ceiling is the best of
 //! several 1024³ products. The step counts and sizes are those the issue names (PETS small and medium, the
@@ -192,7 +192,17 @@ fn main() {
             std::process::exit(2);
         }
     }
-    for threads in [1, 2] {
+    let thread_counts: Vec<usize> = match args.iter().position(|a| a == "--threads") {
+        Some(i) => match args.get(i + 1).and_then(|n| n.parse().ok()).filter(|&n| n > 0) {
+            Some(n) => vec![n],
+            None => {
+                eprintln!("error: --threads expects a positive thread count");
+                std::process::exit(2);
+            }
+        },
+        None => vec![1, 2],
+    };
+    for threads in thread_counts {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("a rayon pool");
         let ceiling = pool.install(|| gemm_ceiling(quick));
         println!(r#"{{"workload":"gemm_ceiling","threads":{threads},"gflops":{ceiling:.2}}}"#);
