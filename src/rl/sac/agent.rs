@@ -6,11 +6,12 @@ use burn::tensor::{Device, Tensor};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
+use rayon::prelude::*;
 
 use super::batch::{SacLosses, TransitionBatch};
 use super::config::SacConfig;
 use super::grad::{actor_loss_and_gradients, critic_loss_and_gradients};
-use super::inference::{concat_rows, PolicyFast, TwinQFast};
+use super::inference::{concat_rows, squash, PolicyFast, TwinQFast};
 use super::networks::{critic_name, policy_name, GaussianPolicy, QNetwork, CRITIC, CRITIC_TARGET, TANH_EPSILON};
 use crate::error::{Error, Result};
 use crate::nn::tensor::training_device;
@@ -184,19 +185,10 @@ impl Sac {
     pub fn update<R: Rng + ?Sized>(&mut self, batch: &TransitionBatch, rng: &mut R) -> Result<SacLosses> {
         let (od, ad, n) = (self.config.obs_dim, self.config.action_dim, batch.rows);
         batch.check(od, ad)?;
-        let (gamma, alpha) = (self.config.gamma as f32, self.config.alpha as f32);
+        let alpha = self.config.alpha as f32;
 
-        // Critic target y = r + γ(1 − done)(min Q_target(s', a') − α log π(a'|s')), without gradients.
-        // The critics see actions in env units, as stored in the replay memory.
-        let (next_squashed, next_log_prob) = self.policy_fast.sample(&batch.next_obs, n, &self.scale, rng);
-        let next_actions = self.to_env(&next_squashed);
-        let next_q = self.target_fast.min_q(&concat_rows(&batch.next_obs, od, &next_actions, ad, n), n);
-        let y: Vec<f32> = (0..n)
-            .map(|i| {
-                let soft_v = next_q[i] - alpha * next_log_prob[i];
-                batch.rewards[i] + (1.0 - batch.done[i]) * gamma * soft_v
-            })
-            .collect();
+        let next_eps: Vec<f32> = (0..n * ad).map(|_| rng.sample(StandardNormal)).collect();
+        let y = self.critic_targets(batch, &next_eps);
 
         let input = concat_rows(&batch.obs, od, &batch.actions, ad, n);
         let (critic_value, mean_q, mut grads) =
@@ -237,6 +229,35 @@ impl Sac {
         self.load_targets()?;
         self.updates += 1;
         Ok(SacLosses { actor: actor_value, critic: critic_value, mean_q, entropy })
+    }
+
+    /// The critic targets y = r + γ(1 − done)(min Q_target(s', a') − α log π(a'|s')), without gradients, for
+    /// next-action noise `eps` (rows × action_dim). The critics see actions in env units, as stored in the replay
+    /// memory. Rows are independent and a GEMM's row gives the same bytes in any row block, so each thread
+    /// takes one block: the bytes do not depend on the thread count.
+    fn critic_targets(&self, batch: &TransitionBatch, eps: &[f32]) -> Vec<f32> {
+        let (od, ad, n) = (self.config.obs_dim, self.config.action_dim, batch.rows);
+        let (gamma, alpha) = (self.config.gamma as f32, self.config.alpha as f32);
+        let block = n.div_ceil(rayon::current_num_threads().max(1)).max(1);
+        let starts: Vec<usize> = (0..n).step_by(block).collect();
+        let blocks: Vec<Vec<f32>> = starts
+            .into_par_iter()
+            .map(|start| {
+                let rows = block.min(n - start);
+                let next_obs = &batch.next_obs[start * od..(start + rows) * od];
+                let (mean, log_std) = self.policy_fast.forward(next_obs, rows, true);
+                let (squashed, log_prob) = squash(&mean, &log_std, &eps[start * ad..(start + rows) * ad], &self.scale);
+                let next_actions = self.to_env(&squashed);
+                let next_q = self.target_fast.min_q(&concat_rows(next_obs, od, &next_actions, ad, rows), rows);
+                (0..rows)
+                    .map(|i| {
+                        let soft_v = next_q[i] - alpha * log_prob[i];
+                        batch.rewards[start + i] + (1.0 - batch.done[start + i]) * gamma * soft_v
+                    })
+                    .collect()
+            })
+            .collect();
+        blocks.concat()
     }
 
     // Loading cannot fail on shapes: parameter values are only ever replaced by checked ones of equal length.

@@ -437,3 +437,32 @@ fn losses_and_gradients_do_not_depend_on_the_thread_count() {
     };
     assert_eq!(run(1), run(2));
 }
+
+/// The critic targets are computed in one row block per thread: whole updates give the same bytes at one, two
+/// and three threads.
+#[test]
+fn updates_do_not_depend_on_the_thread_count() {
+    let mut c = config(9, vec![-0.2, -0.2, -1.0], vec![0.2, 0.2, 1.0]);
+    c.hidden = vec![64, 64];
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| {
+            let mut rng = ChaCha8Rng::seed_from_u64(8);
+            let mut sac = Sac::new(c.clone(), &mut rng).unwrap();
+            let batch = random_batch(&mut rng, &c, 37);
+            let losses: Vec<u64> = (0..3)
+                .flat_map(|_| {
+                    let l = sac.update(&batch, &mut rng).unwrap();
+                    [l.actor.to_bits(), l.critic.to_bits(), l.mean_q.to_bits()]
+                })
+                .collect();
+            let bits = |p: &crate::nn::ParamSet| p.tensors.iter().flat_map(|t| t.values.iter().map(|v| v.to_bits())).collect();
+            let params: Vec<Vec<u32>> =
+                vec![bits(sac.policy_params()), bits(sac.critic_params()), bits(sac.target_params())];
+            (losses, params)
+        })
+    };
+    let one = run(1);
+    assert_eq!(one, run(2));
+    assert_eq!(one, run(3));
+}
