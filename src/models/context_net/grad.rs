@@ -234,52 +234,65 @@ pub fn loss_and_gradients(
         net.gru.add_input_gates(emb, b * t, 2, &mut action_gates);
     }
 
-    // Single-step predictions from every chunk state, each with a fresh β sample.
-    let beta_single: Vec<f32> = (0..b * t * lat)
-        .map(|k| {
-            let (i, d) = (k / (t * lat), k % lat);
-            posterior.mean[i * lat + d] + posterior.std[i * lat + d] * batch.noise_single[k]
-        })
-        .collect();
-    let (mut ctx_single, ctx_single_tape) = net.context_embedding.forward(&beta_single, b * t);
-    relu_in_place(&mut ctx_single);
-    let mut gi_single = copy_of(&action_gates);
-    net.gru.add_input_gates(&ctx_single, b * t, 0, &mut gi_single);
-    let mut h_single = copy_of(&h_all);
-    let single_tape = net.gru.step(&gi_single, &mut h_single, b * t);
-
-    // Multi-step: one β per chunk, open loop from s_0; the predictions of s_2.. enter the sum.
-    let beta: Vec<f32> = (0..b * lat).map(|k| posterior.mean[k] + posterior.std[k] * batch.noise_sequence[k]).collect();
-    let (mut ctx_seq, ctx_seq_tape) = net.context_embedding.forward(&beta, b);
-    relu_in_place(&mut ctx_seq);
-    let mut ctx_gates = vec![0.0; b * g];
-    net.gru.add_input_gates(&ctx_seq, b, 0, &mut ctx_gates);
-    let mut h: Vec<f32> = (0..b).flat_map(|i| h_all[i * t * e..(i * t + 1) * e].iter().copied()).collect();
-    // Step-major: row k·B + i is chunk i at step k.
-    let mut seq_h_prev = Vec::with_capacity(t * b * e);
-    let mut seq_tapes = Vec::with_capacity(t);
-    let mut open_loop = vec![0.0; b * steps * e];
-    let mut gi = vec![0.0; b * g];
+    // The single-step predictions and the multi-step open loop share only their inputs, so they run side by
+    // side: the loop's small per-step products leave most of a second thread idle.
     let chunk_rows = block_rows(b, g);
-    for k in 0..t {
-        gi.par_chunks_mut(chunk_rows * g).enumerate().for_each(|(block, gi)| {
-            for (row, gi) in gi.chunks_mut(g).enumerate() {
-                let i = block * chunk_rows + row;
-                let (src, ctx) = (&action_gates[(i * t + k) * g..(i * t + k + 1) * g], &ctx_gates[i * g..(i + 1) * g]);
-                for ((o, x), c) in gi.iter_mut().zip(src).zip(ctx) {
-                    *o = x + c;
+    let single_steps = || {
+        // Single-step predictions from every chunk state, each with a fresh β sample.
+        let beta_single: Vec<f32> = (0..b * t * lat)
+            .map(|k| {
+                let (i, d) = (k / (t * lat), k % lat);
+                posterior.mean[i * lat + d] + posterior.std[i * lat + d] * batch.noise_single[k]
+            })
+            .collect();
+        let (mut ctx_single, ctx_single_tape) = net.context_embedding.forward(&beta_single, b * t);
+        relu_in_place(&mut ctx_single);
+        let mut gi_single = copy_of(&action_gates);
+        net.gru.add_input_gates(&ctx_single, b * t, 0, &mut gi_single);
+        let mut h_single = copy_of(&h_all);
+        let single_tape = net.gru.step(&gi_single, &mut h_single, b * t);
+        (beta_single, ctx_single, ctx_single_tape, h_single, single_tape)
+    };
+    let open_loop = || {
+        // Multi-step: one β per chunk, open loop from s_0; the predictions of s_2.. enter the sum.
+        let beta: Vec<f32> =
+            (0..b * lat).map(|k| posterior.mean[k] + posterior.std[k] * batch.noise_sequence[k]).collect();
+        let (mut ctx_seq, ctx_seq_tape) = net.context_embedding.forward(&beta, b);
+        relu_in_place(&mut ctx_seq);
+        let mut ctx_gates = vec![0.0; b * g];
+        net.gru.add_input_gates(&ctx_seq, b, 0, &mut ctx_gates);
+        let mut h: Vec<f32> = (0..b).flat_map(|i| h_all[i * t * e..(i * t + 1) * e].iter().copied()).collect();
+        // Step-major: row k·B + i is chunk i at step k.
+        let mut seq_h_prev = Vec::with_capacity(t * b * e);
+        let mut seq_tapes = Vec::with_capacity(t);
+        let mut open_loop = vec![0.0; b * steps * e];
+        let mut gi = vec![0.0; b * g];
+        for k in 0..t {
+            gi.par_chunks_mut(chunk_rows * g).enumerate().for_each(|(block, gi)| {
+                for (row, gi) in gi.chunks_mut(g).enumerate() {
+                    let i = block * chunk_rows + row;
+                    let src = &action_gates[(i * t + k) * g..(i * t + k + 1) * g];
+                    let ctx = &ctx_gates[i * g..(i + 1) * g];
+                    for ((o, x), c) in gi.iter_mut().zip(src).zip(ctx) {
+                        *o = x + c;
+                    }
+                }
+            });
+            seq_h_prev.extend_from_slice(&h);
+            seq_tapes.push(net.gru.step(&gi, &mut h, b));
+            if k >= 1 {
+                for i in 0..b {
+                    let j = k - 1;
+                    open_loop[(i * steps + j) * e..(i * steps + j + 1) * e].copy_from_slice(&h[i * e..(i + 1) * e]);
                 }
             }
-        });
-        seq_h_prev.extend_from_slice(&h);
-        seq_tapes.push(net.gru.step(&gi, &mut h, b));
-        if k >= 1 {
-            for i in 0..b {
-                let j = k - 1;
-                open_loop[(i * steps + j) * e..(i * steps + j + 1) * e].copy_from_slice(&h[i * e..(i + 1) * e]);
-            }
         }
-    }
+        (beta, ctx_seq, ctx_seq_tape, seq_h_prev, seq_tapes, open_loop)
+    };
+    let (
+        (beta_single, ctx_single, ctx_single_tape, h_single, single_tape),
+        (beta, ctx_seq, ctx_seq_tape, seq_h_prev, seq_tapes, open_loop),
+    ) = rayon::join(single_steps, open_loop);
 
     // One decoder pass over the reconstruction, single-step and multi-step GRU states.
     let rows = 2 * b * t + b * steps;
@@ -361,40 +374,47 @@ pub fn loss_and_gradients(
     let d_h_single = &d_decoded[b * t * e..2 * b * t * e];
     let d_open = &d_decoded[2 * b * t * e..];
 
-    // Back through the open loop.
-    let mut d_gi_seq = zeros(b * t * g);
-    let mut seq_d_gh = zeros(t * b * g);
-    let mut dh = vec![0.0; b * e];
-    let mut d_gi_step = vec![0.0; b * g];
-    for k in (0..t).rev() {
-        if k >= 1 {
-            let j = k - 1;
-            for i in 0..b {
-                let src = &d_open[(i * steps + j) * e..(i * steps + j + 1) * e];
-                add_into(&mut dh[i * e..(i + 1) * e], src);
+    // Back through the open loop and, beside it, through the single steps; their weight gradients are then
+    // added in a fixed order.
+    let open_loop_back = || {
+        let mut d_gi_seq = zeros(b * t * g);
+        let mut seq_d_gh = zeros(t * b * g);
+        let mut dh = vec![0.0; b * e];
+        let mut d_gi_step = vec![0.0; b * g];
+        for k in (0..t).rev() {
+            if k >= 1 {
+                let j = k - 1;
+                for i in 0..b {
+                    let src = &d_open[(i * steps + j) * e..(i * steps + j + 1) * e];
+                    add_into(&mut dh[i * e..(i + 1) * e], src);
+                }
             }
+            let h_prev = &seq_h_prev[k * b * e..(k + 1) * b * e];
+            let d_gh = &mut seq_d_gh[k * b * g..(k + 1) * b * g];
+            dh = net.gru.step_backward(&seq_tapes[k], h_prev, &dh, b, &mut d_gi_step, d_gh);
+            // Chunk i's gates at step k go to row i·T + k: whole chunks' rows per task.
+            d_gi_seq.par_chunks_mut(chunk_rows * t * g).enumerate().for_each(|(block, rows)| {
+                for (row, chunk) in rows.chunks_mut(t * g).enumerate() {
+                    let i = block * chunk_rows + row;
+                    chunk[k * g..(k + 1) * g].copy_from_slice(&d_gi_step[i * g..(i + 1) * g]);
+                }
+            });
         }
-        let h_prev = &seq_h_prev[k * b * e..(k + 1) * b * e];
-        let d_gh = &mut seq_d_gh[k * b * g..(k + 1) * b * g];
-        dh = net.gru.step_backward(&seq_tapes[k], h_prev, &dh, b, &mut d_gi_step, d_gh);
-        // Chunk i's gates at step k go to row i·T + k: whole chunks' rows per task.
-        d_gi_seq.par_chunks_mut(chunk_rows * t * g).enumerate().for_each(|(block, rows)| {
-            for (row, chunk) in rows.chunks_mut(t * g).enumerate() {
-                let i = block * chunk_rows + row;
-                chunk[k * g..(k + 1) * g].copy_from_slice(&d_gi_step[i * g..(i + 1) * g]);
-            }
-        });
-    }
+        (d_gi_seq, seq_d_gh, dh)
+    };
+    let single_steps_back = || {
+        let mut d_gi_single = zeros(b * t * g);
+        let mut single_d_gh = zeros(b * t * g);
+        let d_h_prev_single =
+            net.gru.step_backward(&single_tape, &h_all, d_h_single, b * t, &mut d_gi_single, &mut single_d_gh);
+        (d_gi_single, single_d_gh, d_h_prev_single)
+    };
+    let ((d_gi_seq, seq_d_gh, dh), (d_gi_single, single_d_gh, d_h_prev_single)) =
+        rayon::join(open_loop_back, single_steps_back);
     for i in 0..b {
         add_into(&mut d_h_all[i * t * e..(i * t + 1) * e], &dh[i * e..(i + 1) * e]);
     }
     net.gru.hidden_weight_backward(&seq_h_prev, &seq_d_gh, t * b, &mut grads);
-
-    // Back through the single steps.
-    let mut d_gi_single = zeros(b * t * g);
-    let mut single_d_gh = zeros(b * t * g);
-    let d_h_prev_single =
-        net.gru.step_backward(&single_tape, &h_all, d_h_single, b * t, &mut d_gi_single, &mut single_d_gh);
     net.gru.hidden_weight_backward(&h_all, &single_d_gh, b * t, &mut grads);
     add_into(&mut d_h_all, &d_h_prev_single);
 
