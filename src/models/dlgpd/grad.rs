@@ -208,13 +208,28 @@ pub fn images_loss_and_gradients(
     let (sample, next_sample) = samples.split_at(rows * latent);
     let next_std = &std[rows * latent..];
 
-    let (mut d_logits, decoder_tape) = net.decode(next_sample, rows);
     let targets = &tape.grids[0][rows * width..];
     let inv_rows = 1.0 / rows.max(1) as f64;
-    let reconstruction = bce_into_gradient(&mut d_logits, targets, inv_rows as f32) * inv_rows;
-    let entropy = -0.5 * inv_rows * next_std.iter().map(|&s| (s as f64).ln()).sum::<f64>();
+    // The decoder's passes and the GPs (f64 Cholesky factorizations, a tenth of a batch-1024 step) need only the
+    // samples, so they run side by side.
+    let decoder_passes = || {
+        let (mut d_logits, decoder_tape) = net.decode(next_sample, rows);
+        let reconstruction = bce_into_gradient(&mut d_logits, targets, inv_rows as f32) * inv_rows;
+        let backward = match gradients {
+            Gradients::NotWanted => None,
+            Gradients::Wanted => {
+                let mut grads = zero_gradients(params);
+                let d_next = net.decode_backward(next_sample, &decoder_tape, d_logits, rows, &mut grads);
+                Some((grads, d_next))
+            }
+        };
+        (reconstruction, backward)
+    };
     let as_f64 = |v: &[f32]| v.iter().map(|&x| x as f64).collect::<Vec<f64>>();
-    let gp = gp_terms(transition, reward, &as_f64(sample), &batch.actions, &as_f64(next_sample), &batch.rewards)?;
+    let gp_pass = || gp_terms(transition, reward, &as_f64(sample), &batch.actions, &as_f64(next_sample), &batch.rewards);
+    let ((reconstruction, backward), gp) = rayon::join(decoder_passes, gp_pass);
+    let gp = gp?;
+    let entropy = -0.5 * inv_rows * next_std.iter().map(|&s| (s as f64).ln()).sum::<f64>();
     let total = reconstruction + entropy + gp.value;
     if !total.is_finite() {
         return Err(Error::diverged(format!(
@@ -222,11 +237,9 @@ pub fn images_loss_and_gradients(
             gp.value
         )));
     }
-    let vae_gradients = match gradients {
-        Gradients::NotWanted => Vec::new(),
-        Gradients::Wanted => {
-            let mut grads = zero_gradients(params);
-            let d_next = net.decode_backward(next_sample, &decoder_tape, d_logits, rows, &mut grads);
+    let vae_gradients = match backward {
+        None => Vec::new(),
+        Some((mut grads, d_next)) => {
             // d sample = the GP's gradient; then d mean = d sample and d std = d sample ⊙ ε, per half.
             let mut d_mean: Vec<f32> = gp.d_latents.iter().map(|&g| g as f32).collect();
             d_mean.extend(gp.d_next_latents.iter().zip(&d_next).map(|(&g, d)| g as f32 + d));
