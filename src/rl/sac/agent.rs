@@ -19,6 +19,9 @@ use crate::nn::{Adam, AdamConfig, ParamSet};
 
 const HALF_LN_2PI: f32 = 0.918_938_5;
 
+/// The critic targets' rows per parallel block, at least: SEADS' batch of 128 is two blocks.
+const TARGET_BLOCK_ROWS: usize = 64;
+
 pub struct Sac {
     pub(super) config: SacConfig,
     pub(super) device: Device,
@@ -233,12 +236,13 @@ impl Sac {
 
     /// The critic targets y = r + γ(1 − done)(min Q_target(s', a') − α log π(a'|s')), without gradients, for
     /// next-action noise `eps` (rows × action_dim). The critics see actions in env units, as stored in the replay
-    /// memory. Rows are independent and a GEMM's row gives the same bytes in any row block, so each thread
-    /// takes one block: the bytes do not depend on the thread count.
-    fn critic_targets(&self, batch: &TransitionBatch, eps: &[f32]) -> Vec<f32> {
+    /// memory. Rows are independent, so blocks of rows run in parallel; the blocks are cut by the batch size
+    /// alone, never the thread count, because faer rounds a one-row product differently from a larger one.
+    pub(super) fn critic_targets(&self, batch: &TransitionBatch, eps: &[f32]) -> Vec<f32> {
         let (od, ad, n) = (self.config.obs_dim, self.config.action_dim, batch.rows);
         let (gamma, alpha) = (self.config.gamma as f32, self.config.alpha as f32);
-        let block = n.div_ceil(rayon::current_num_threads().max(1)).max(1);
+        let blocks = (n / TARGET_BLOCK_ROWS).max(1);
+        let block = n.div_ceil(blocks).max(1);
         let starts: Vec<usize> = (0..n).step_by(block).collect();
         let blocks: Vec<Vec<f32>> = starts
             .into_par_iter()

@@ -438,31 +438,71 @@ fn losses_and_gradients_do_not_depend_on_the_thread_count() {
     assert_eq!(run(1), run(2));
 }
 
-/// The critic targets are computed in one row block per thread: whole updates give the same bytes at one, two
-/// and three threads.
+/// The critic targets are computed in row blocks cut by the batch size: whole updates give the same bytes at
+/// one to four threads, for batches of one block (3 rows) and of several (300 rows: four blocks of 75).
 #[test]
 fn updates_do_not_depend_on_the_thread_count() {
     let mut c = config(9, vec![-0.2, -0.2, -1.0], vec![0.2, 0.2, 1.0]);
-    c.hidden = vec![64, 64];
-    let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-        pool.install(|| {
-            let mut rng = ChaCha8Rng::seed_from_u64(8);
-            let mut sac = Sac::new(c.clone(), &mut rng).unwrap();
-            let batch = random_batch(&mut rng, &c, 37);
-            let losses: Vec<u64> = (0..3)
-                .flat_map(|_| {
-                    let l = sac.update(&batch, &mut rng).unwrap();
-                    [l.actor.to_bits(), l.critic.to_bits(), l.mean_q.to_bits()]
-                })
-                .collect();
-            let bits = |p: &crate::nn::ParamSet| p.tensors.iter().flat_map(|t| t.values.iter().map(|v| v.to_bits())).collect();
-            let params: Vec<Vec<u32>> =
-                vec![bits(sac.policy_params()), bits(sac.critic_params()), bits(sac.target_params())];
-            (losses, params)
+    c.hidden = vec![32, 32];
+    for rows in [3, 300] {
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| {
+                let mut rng = ChaCha8Rng::seed_from_u64(8);
+                let mut sac = Sac::new(c.clone(), &mut rng).unwrap();
+                let batch = random_batch(&mut rng, &c, rows);
+                let losses: Vec<u64> = (0..2)
+                    .flat_map(|_| {
+                        let l = sac.update(&batch, &mut rng).unwrap();
+                        [l.actor.to_bits(), l.critic.to_bits(), l.mean_q.to_bits()]
+                    })
+                    .collect();
+                let bits =
+                    |p: &crate::nn::ParamSet| p.tensors.iter().flat_map(|t| t.values.iter().map(|v| v.to_bits())).collect();
+                let params: Vec<Vec<u32>> =
+                    vec![bits(sac.policy_params()), bits(sac.critic_params()), bits(sac.target_params())];
+                (losses, params)
+            })
+        };
+        let one = run(1);
+        for threads in [2, 3, 4] {
+            assert_eq!(one, run(threads), "{rows} rows, {threads} threads");
+        }
+    }
+}
+
+/// The blocked critic targets equal the whole batch's through the acting path, whose sampling draws the same
+/// noise from the same stream.
+#[test]
+fn blocked_critic_targets_equal_the_unblocked_computation() {
+    use super::inference::{concat_rows, PolicyFast, TwinQFast};
+    use super::networks::CRITIC_TARGET;
+    let mut c = config(9, vec![-0.2, -0.2, -1.0], vec![0.2, 0.2, 1.0]);
+    c.hidden = vec![32, 32];
+    let mut rng = ChaCha8Rng::seed_from_u64(9);
+    let sac = Sac::new(c.clone(), &mut rng).unwrap();
+    let rows = 300;
+    let batch = random_batch(&mut rng, &c, rows);
+    let (od, ad) = (c.obs_dim, c.action_dim);
+    let (scale, bias) = (c.action_scale(), c.action_bias());
+    let policy = PolicyFast::from_params(sac.policy_params(), c.hidden.len()).unwrap();
+    let targets = TwinQFast::from_params(sac.target_params(), CRITIC_TARGET, c.hidden.len()).unwrap();
+    let mut stream = rng.clone();
+    let (squashed, log_prob) = policy.sample(&batch.next_obs, rows, &scale, &mut stream);
+    let actions: Vec<f32> = squashed
+        .iter()
+        .enumerate()
+        .map(|(i, y)| {
+            let k = i % ad;
+            (y * scale[k] + bias[k]).clamp(c.action_low[k] as f32, c.action_high[k] as f32)
         })
-    };
-    let one = run(1);
-    assert_eq!(one, run(2));
-    assert_eq!(one, run(3));
+        .collect();
+    let next_q = targets.min_q(&concat_rows(&batch.next_obs, od, &actions, ad, rows), rows);
+    let (gamma, alpha) = (c.gamma as f32, c.alpha as f32);
+    let whole: Vec<u32> = (0..rows)
+        .map(|i| (batch.rewards[i] + (1.0 - batch.done[i]) * gamma * (next_q[i] - alpha * log_prob[i])).to_bits())
+        .collect();
+    let eps: Vec<f32> = (0..rows * ad).map(|_| rng.sample(rand_distr::StandardNormal)).collect();
+    let blocked: Vec<u32> = sac.critic_targets(&batch, &eps).iter().map(|y| y.to_bits()).collect();
+    assert_eq!(blocked, whole);
 }
