@@ -226,7 +226,8 @@ pub fn images_loss_and_gradients(
         (reconstruction, backward)
     };
     let as_f64 = |v: &[f32]| v.iter().map(|&x| x as f64).collect::<Vec<f64>>();
-    let gp_pass = || gp_terms(transition, reward, &as_f64(sample), &batch.actions, &as_f64(next_sample), &batch.rewards);
+    let gp_pass =
+        || gp_terms(transition, reward, &as_f64(sample), &batch.actions, &as_f64(next_sample), &batch.rewards);
     let ((reconstruction, backward), gp) = rayon::join(decoder_passes, gp_pass);
     let gp = gp?;
     let entropy = -0.5 * inv_rows * next_std.iter().map(|&s| (s as f64).ln()).sum::<f64>();

@@ -457,8 +457,9 @@ fn updates_do_not_depend_on_the_thread_count() {
                         [l.actor.to_bits(), l.critic.to_bits(), l.mean_q.to_bits()]
                     })
                     .collect();
-                let bits =
-                    |p: &crate::nn::ParamSet| p.tensors.iter().flat_map(|t| t.values.iter().map(|v| v.to_bits())).collect();
+                let bits = |p: &crate::nn::ParamSet| {
+                    p.tensors.iter().flat_map(|t| t.values.iter().map(|v| v.to_bits())).collect()
+                };
                 let params: Vec<Vec<u32>> =
                     vec![bits(sac.policy_params()), bits(sac.critic_params()), bits(sac.target_params())];
                 (losses, params)
