@@ -72,25 +72,15 @@ fn is_tall_weight_gradient(dst: &MatMut<'_, f32>, a: &MatRef<'_, f32>, b: &MatRe
 }
 
 /// dst = [dst +] a · b computed as (bᵀ · aᵀ)ᵀ: the product into a row-major n × m buffer (split over the pool
-/// as any other), then added to `dst` transposed, in tiles.
+/// as any other), then added to `dst` transposed.
 fn transposed_product(mut dst: MatMut<'_, f32>, accum: Accum, a: MatRef<'_, f32>, b: MatRef<'_, f32>) {
-    const TILE: usize = 16;
     let (m, n) = (dst.nrows(), dst.ncols());
     let mut product = vec![0.0f32; n * m];
     matmul(view_mut(&mut product, n, m), Accum::Replace, b.transpose(), a.transpose());
-    for i0 in (0..m).step_by(TILE) {
-        for j0 in (0..n).step_by(TILE) {
-            for i in i0..(i0 + TILE).min(m) {
-                for j in j0..(j0 + TILE).min(n) {
-                    let value = product[j * m + i];
-                    let out = dst.as_mut().get_mut(i, j);
-                    *out = match accum {
-                        Accum::Add => *out + value,
-                        Accum::Replace => value,
-                    };
-                }
-            }
-        }
+    let product = view(&product, n, m).transpose();
+    match accum {
+        Accum::Add => dst += product,
+        Accum::Replace => dst.copy_from(product),
     }
 }
 

@@ -23,20 +23,10 @@ fn find<'a>(params: &'a ParamSet, name: &str) -> Result<&'a NamedTensor> {
     params.get(name).ok_or_else(|| Error::config(format!("network lacks the tensor '{name}'")))
 }
 
-/// In tiles, so that both the reads and the strided writes stay in cache: SAC re-transposes its networks
-/// after every update.
 fn transpose(values: &[f32], rows: usize, cols: usize) -> Vec<f32> {
-    const TILE: usize = 16;
     let mut out = vec![0.0; values.len()];
-    for r0 in (0..rows).step_by(TILE) {
-        for c0 in (0..cols).step_by(TILE) {
-            for r in r0..(r0 + TILE).min(rows) {
-                for c in c0..(c0 + TILE).min(cols) {
-                    out[c * rows + r] = values[r * cols + c];
-                }
-            }
-        }
-    }
+    MatMut::from_row_major_slice_mut(&mut out, cols, rows)
+        .copy_from(MatRef::from_row_major_slice(values, rows, cols).transpose());
     out
 }
 

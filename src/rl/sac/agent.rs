@@ -241,8 +241,7 @@ impl Sac {
     pub(super) fn critic_targets(&self, batch: &TransitionBatch, eps: &[f32]) -> Vec<f32> {
         let (od, ad, n) = (self.config.obs_dim, self.config.action_dim, batch.rows);
         let (gamma, alpha) = (self.config.gamma as f32, self.config.alpha as f32);
-        let blocks = (n / TARGET_BLOCK_ROWS).max(1);
-        let block = n.div_ceil(blocks).max(1);
+        let block = n.div_ceil((n / TARGET_BLOCK_ROWS).max(1)).max(1);
         let starts: Vec<usize> = (0..n).step_by(block).collect();
         let blocks: Vec<Vec<f32>> = starts
             .into_par_iter()
