@@ -26,6 +26,7 @@ use mbrl::nn::tensor::training_device;
 use mbrl::rl::sac::Sac;
 use mbrl::run::NullMonitor;
 use mbrl::train::TrainingMethod;
+use mbrl::util::warm_pool::run_warm;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -210,7 +211,8 @@ fn main() {
             if only.as_ref().is_some_and(|names| !names.iter().any(|n| n == workload.name)) {
                 continue;
             }
-            let (seconds, samples) = pool.install(|| time_workload(workload, quick));
+            // As `train` runs its steps: on a pool thread, the other workers kept awake (`util::warm_pool`).
+            let (seconds, samples) = pool.install(|| run_warm(|| time_workload(workload, quick)));
             println!(
                 r#"{{"workload":"{}","threads":{threads},"seconds":{seconds:.6e},"samples":{samples}}}"#,
                 workload.name

@@ -31,7 +31,7 @@ pub trait Method: Sized + 'static {
     type Variant: Clone + Send + Sync;
     /// What config.json records beyond the shared fields: model sizes, data counts.
     type Details: Clone + Serialize + DeserializeOwned;
-    type Trainer: TrainingMethod;
+    type Trainer: TrainingMethod + Send;
 
     /// The config with another total; called only for [`Method::EXTENDABLE`] methods.
     fn with_total_steps(config: &Self::Config, _steps: u64) -> Self::Config {

@@ -14,3 +14,4 @@ pub mod rk45;
 pub mod seeding;
 pub mod suggest;
 pub mod table;
+pub mod warm_pool;

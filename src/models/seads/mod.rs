@@ -95,7 +95,7 @@ pub struct SeadsDetails {
 pub type SeadsRun = RunRecord<Seads>;
 
 /// A SEADS trainer of any game, with the figures its summary reports.
-pub trait SeadsTraining: TrainingMethod {
+pub trait SeadsTraining: TrainingMethod + Send {
     fn last(&self) -> &EpochStats;
     fn env_steps(&self) -> u64;
 }
