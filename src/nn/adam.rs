@@ -100,18 +100,12 @@ impl<T: Float + Send + Sync> Adam<T> {
             }
             norm = Some(total.to_f64().unwrap_or(f64::NAN));
         }
-        self.step += 1;
-        let c = &self.config;
-        let (beta1, beta2, eps, wd) =
-            (Self::cast(c.beta1), Self::cast(c.beta2), Self::cast(c.epsilon), Self::cast(c.weight_decay));
-        let bias1 = T::one() - beta1.powi(self.step.min(i32::MAX as u64) as i32);
-        let bias2_sqrt = (T::one() - beta2.powi(self.step.min(i32::MAX as u64) as i32)).sqrt();
-        let step_size = Self::cast(c.learning_rate) / bias1;
         for (k, (p, g)) in params.iter().zip(grads.iter()).enumerate() {
             if p.len() != g.len() || p.len() != self.exp_avg[k].len() {
                 return Err(Error::config(format!("optimizer tensor {k}: sizes of parameter and gradient differ")));
             }
         }
+        let step = self.next_step();
         // Tensors update independently, element by element in one order: the bytes do not depend on threads.
         params
             .par_iter_mut()
@@ -122,23 +116,67 @@ impl<T: Float + Send + Sync> Adam<T> {
                 p.par_chunks_mut(UPDATE_BLOCK)
                     .zip(g.par_chunks(UPDATE_BLOCK))
                     .zip(m.par_chunks_mut(UPDATE_BLOCK).zip(v.par_chunks_mut(UPDATE_BLOCK)))
-                    .for_each(|((p, g), (m, v))| {
-                        // Zipped slices rather than indices: without bounds checks the loop vectorizes.
-                        let step = |p: &mut T, grad: T, m: &mut T, v: &mut T| {
-                            *m = beta1 * *m + (T::one() - beta1) * grad;
-                            *v = beta2 * *v + (T::one() - beta2) * grad * grad;
-                            let denom = v.sqrt() / bias2_sqrt + eps;
-                            *p = *p - step_size * *m / denom;
-                        };
-                        let each = p.iter_mut().zip(g.iter()).zip(m.iter_mut().zip(v.iter_mut()));
-                        if wd > T::zero() {
-                            each.for_each(|((p, &g), (m, v))| step(p, g + wd * *p, m, v));
-                        } else {
-                            each.for_each(|((p, &g), (m, v))| step(p, g, m, v));
-                        }
-                    });
+                    .for_each(|((p, g), (m, v))| step.apply(p, g, m, v));
             });
         Ok(norm)
+    }
+
+    /// Counts an update without clipping and returns its coefficients, for a training step that applies them
+    /// to each block of parameters as soon as that block's gradient is ready (PETS). Refused when clipping is
+    /// configured: the global norm needs every gradient first.
+    pub fn begin_unclipped_update(&mut self) -> Result<AdamStep<T>> {
+        if self.config.clip_grad_norm.is_some() {
+            return Err(Error::config("optimizer: a block-wise update cannot clip the global gradient norm"));
+        }
+        Ok(self.next_step())
+    }
+
+    fn next_step(&mut self) -> AdamStep<T> {
+        self.step += 1;
+        let c = &self.config;
+        let (beta1, beta2) = (Self::cast(c.beta1), Self::cast(c.beta2));
+        let steps = self.step.min(i32::MAX as u64) as i32;
+        let bias1 = T::one() - beta1.powi(steps);
+        AdamStep {
+            beta1,
+            beta2,
+            epsilon: Self::cast(c.epsilon),
+            weight_decay: Self::cast(c.weight_decay),
+            bias2_sqrt: (T::one() - beta2.powi(steps)).sqrt(),
+            step_size: Self::cast(c.learning_rate) / bias1,
+        }
+    }
+}
+
+/// One update's coefficients. Every element takes the same arithmetic wherever it is applied, so a step that
+/// updates block by block gives the bytes of [`Adam::update`].
+#[derive(Clone, Copy, Debug)]
+pub struct AdamStep<T> {
+    beta1: T,
+    beta2: T,
+    epsilon: T,
+    weight_decay: T,
+    bias2_sqrt: T,
+    step_size: T,
+}
+
+impl<T: Float> AdamStep<T> {
+    /// Updates parameters `p` with gradients `g` and their moments `m`, `v` (all the same length).
+    pub fn apply(&self, p: &mut [T], g: &[T], m: &mut [T], v: &mut [T]) {
+        let AdamStep { beta1, beta2, epsilon, weight_decay, bias2_sqrt, step_size } = *self;
+        // Zipped slices rather than indices: without bounds checks the loop vectorizes.
+        let step = |p: &mut T, grad: T, m: &mut T, v: &mut T| {
+            *m = beta1 * *m + (T::one() - beta1) * grad;
+            *v = beta2 * *v + (T::one() - beta2) * grad * grad;
+            let denom = v.sqrt() / bias2_sqrt + epsilon;
+            *p = *p - step_size * *m / denom;
+        };
+        let each = p.iter_mut().zip(g.iter()).zip(m.iter_mut().zip(v.iter_mut()));
+        if weight_decay > T::zero() {
+            each.for_each(|((p, &g), (m, v))| step(p, g + weight_decay * *p, m, v));
+        } else {
+            each.for_each(|((p, &g), (m, v))| step(p, g, m, v));
+        }
     }
 }
 

@@ -18,8 +18,9 @@ use rayon::prelude::*;
 use super::config::PetsConfig;
 use crate::error::Result;
 use crate::nn::activation::{fast_exp, fast_sigmoid as sigmoid, fast_softplus as softplus, Activation};
+use crate::nn::adam::AdamStep;
 use crate::nn::backprop::{add_column_sums, tensor_index, view, view_mut, zero_gradients};
-use crate::nn::ParamSet;
+use crate::nn::{Adam, ParamSet};
 
 /// mbrl-lib's weight on Σ max_logvar − Σ min_logvar.
 const BOUNDS_PENALTY: f32 = 0.01;
@@ -71,14 +72,6 @@ impl<'a> Layer<'a> {
         let (i, o) = (self.d_in, self.d_out);
         let w = view(self.member_weight(member), i, o);
         matmul_here(view_mut(dx, rows, i), Accum::Replace, view(dy, rows, o), w.transpose());
-    }
-
-    /// One member's weight and bias gradients for its output gradients `dy` (rows × out) at its inputs `x`.
-    fn backward_weights(&self, x: &[f32], dy: &[f32], rows: usize, weight_grad: &mut [f32], bias_grad: &mut [f32]) {
-        let (i, o) = (self.d_in, self.d_out);
-        matmul_here(view_mut(weight_grad, i, o), Accum::Replace, view(x, rows, i).transpose(), view(dy, rows, o));
-        bias_grad.fill(0.0);
-        add_column_sums(bias_grad, dy);
     }
 }
 
@@ -361,6 +354,21 @@ impl<'a> EnsembleNet<'a> {
         targets: &[f32],
         rows: usize,
     ) -> f64 {
+        let loss = self.output_gradients(params, ws, inputs, targets, rows);
+        weight_gradients(&self.shapes(), ws, inputs, rows, None);
+        loss
+    }
+
+    /// The loss of [`EnsembleNet::loss_and_gradients`] and its gradient at every layer's output; the bounds'
+    /// gradients are left in `ws.gradients`, whose other tensors keep their sizes for [`weight_gradients`].
+    fn output_gradients(
+        &self,
+        params: &ParamSet,
+        ws: &mut Workspace,
+        inputs: &[f32],
+        targets: &[f32],
+        rows: usize,
+    ) -> f64 {
         let (e, d) = (self.members, self.target_dim);
         let din = self.input_dim;
         let scale = 1.0 / (rows * d) as f32;
@@ -388,31 +396,163 @@ impl<'a> EnsembleNet<'a> {
         }
         ws.gradients[self.bounds_index[0]] = d_min;
         ws.gradients[self.bounds_index[1]] = d_max;
-
-        // Every (layer, member) weight gradient is one independent task: one GEMM over the member's rows.
-        let mut taken: Vec<(&Layer<'_>, Vec<f32>, Vec<f32>)> = self
-            .layers()
-            .map(|layer| {
-                let weight_grad = std::mem::take(&mut ws.gradients[layer.weight_index]);
-                (layer, weight_grad, std::mem::take(&mut ws.gradients[layer.bias_index]))
-            })
-            .collect();
-        let mut tasks = Vec::with_capacity(taken.len() * e);
-        for (k, (layer, weight_grad, bias_grad)) in taken.iter_mut().enumerate() {
-            let (i, o) = (layer.d_in, layer.d_out);
-            let x: &[f32] = if k == 0 { inputs } else { &ws.activations[k - 1] };
-            let members = weight_grad.chunks_mut(i * o).zip(bias_grad.chunks_mut(o));
-            for ((gw, gb), (x, dy)) in members.zip(x.chunks(rows * i).zip(ws.d_outputs[k].chunks(rows * o))) {
-                tasks.push((*layer, x, dy, gw, gb));
-            }
-        }
-        tasks.into_par_iter().for_each(|(layer, x, dy, gw, gb)| layer.backward_weights(x, dy, rows, gw, gb));
-        for (layer, weight_grad, bias_grad) in taken {
-            ws.gradients[layer.weight_index] = weight_grad;
-            ws.gradients[layer.bias_index] = bias_grad;
-        }
         loss
     }
+
+    fn shapes(&self) -> Vec<LayerShape> {
+        self.layers()
+            .map(|l| LayerShape {
+                d_in: l.d_in,
+                d_out: l.d_out,
+                weight_index: l.weight_index,
+                bias_index: l.bias_index,
+            })
+            .collect()
+    }
+}
+
+/// One PETS training step on `params`: the loss and gradients of [`EnsembleNet::loss_and_gradients`], with
+/// Adam applied to each (layer, member) block by the task that computed its gradient, while that gradient is
+/// still in cache, and to the few remaining tensors after. The same bytes as the gradients followed by
+/// [`Adam::update`]; without clipping only (see [`Adam::begin_unclipped_update`]). A non-finite loss is
+/// returned without an update, as the unfused step does.
+#[allow(clippy::too_many_arguments)]
+pub fn train_step(
+    params: &mut ParamSet,
+    adam: &mut Adam<f32>,
+    config: &PetsConfig,
+    dims: (usize, usize),
+    ws: &mut Workspace,
+    inputs: &[f32],
+    targets: &[f32],
+    rows: usize,
+) -> Result<f64> {
+    let (loss, shapes) = {
+        let net = EnsembleNet::new(params, config, dims.0, dims.1)?;
+        (net.output_gradients(params, ws, inputs, targets, rows), net.shapes())
+    };
+    if !loss.is_finite() {
+        return Ok(loss);
+    }
+    let step = adam.begin_unclipped_update()?;
+    let mut optimizer = OptimizerBlocks {
+        step,
+        params: params.values_mut().into_iter().map(Some).collect(),
+        exp_avg: adam.exp_avg.iter_mut().map(Some).collect(),
+        exp_avg_sq: adam.exp_avg_sq.iter_mut().map(Some).collect(),
+    };
+    weight_gradients(&shapes, ws, inputs, rows, Some(&mut optimizer));
+    // The tensors no layer task updated: the log-variance bounds.
+    let rest = optimizer.params.iter_mut().zip(optimizer.exp_avg.iter_mut().zip(optimizer.exp_avg_sq.iter_mut()));
+    for (k, (p, (m, v))) in rest.enumerate() {
+        if let (Some(p), Some(m), Some(v)) = (p.take(), m.take(), v.take()) {
+            step.apply(p, &ws.gradients[k], m, v);
+        }
+    }
+    Ok(loss)
+}
+
+/// What the weight-gradient phase needs of a layer, free of the borrow of the parameters.
+#[derive(Clone, Copy)]
+struct LayerShape {
+    d_in: usize,
+    d_out: usize,
+    weight_index: usize,
+    bias_index: usize,
+}
+
+/// The parameters and Adam moments of a fused step, per tensor, each taken by the tasks that update it.
+struct OptimizerBlocks<'a> {
+    step: AdamStep<f32>,
+    params: Vec<Option<&'a mut Vec<f32>>>,
+    exp_avg: Vec<Option<&'a mut Vec<f32>>>,
+    exp_avg_sq: Vec<Option<&'a mut Vec<f32>>>,
+}
+
+impl<'a> OptimizerBlocks<'a> {
+    /// Tensor `index`'s parameters and moments, cut into `members` equal blocks.
+    fn member_blocks(&mut self, index: usize, members: usize) -> Vec<[&'a mut [f32]; 3]> {
+        let take = |list: &mut Vec<Option<&'a mut Vec<f32>>>| list[index].take().expect("each tensor taken once");
+        let (p, m, v) = (take(&mut self.params), take(&mut self.exp_avg), take(&mut self.exp_avg_sq));
+        let size = p.len() / members;
+        p.chunks_mut(size).zip(m.chunks_mut(size).zip(v.chunks_mut(size))).map(|(p, (m, v))| [p, m, v]).collect()
+    }
+}
+
+/// A (layer, member) weight-gradient task: the member's layer input and output gradient, and where its
+/// weight and bias gradients go, with the blocks Adam then updates in a fused step.
+struct WeightTask<'a> {
+    shape: LayerShape,
+    x: &'a [f32],
+    dy: &'a [f32],
+    weight_grad: &'a mut [f32],
+    bias_grad: &'a mut [f32],
+    update: Option<[[&'a mut [f32]; 3]; 2]>,
+}
+
+/// Every (layer, member) weight gradient as one independent task (one GEMM over the member's rows), each
+/// followed, in a fused step, by Adam on that member's weight and bias.
+fn weight_gradients(
+    shapes: &[LayerShape],
+    ws: &mut Workspace,
+    inputs: &[f32],
+    rows: usize,
+    mut optimizer: Option<&mut OptimizerBlocks<'_>>,
+) {
+    let mut taken: Vec<(LayerShape, Vec<f32>, Vec<f32>)> = shapes
+        .iter()
+        .map(|&shape| {
+            let weight_grad = std::mem::take(&mut ws.gradients[shape.weight_index]);
+            (shape, weight_grad, std::mem::take(&mut ws.gradients[shape.bias_index]))
+        })
+        .collect();
+    let mut tasks = Vec::new();
+    for (k, (shape, weight_grad, bias_grad)) in taken.iter_mut().enumerate() {
+        let (i, o) = (shape.d_in, shape.d_out);
+        let members = weight_grad.len() / (i * o);
+        let x: &[f32] = if k == 0 { inputs } else { &ws.activations[k - 1] };
+        let mut updates: Vec<Option<[[&mut [f32]; 3]; 2]>> = match optimizer.as_deref_mut() {
+            Some(blocks) => {
+                let weights = blocks.member_blocks(shape.weight_index, members);
+                let biases = blocks.member_blocks(shape.bias_index, members);
+                weights.into_iter().zip(biases).map(|(w, b)| Some([w, b])).collect()
+            }
+            None => (0..members).map(|_| None).collect(),
+        };
+        let grads = weight_grad.chunks_mut(i * o).zip(bias_grad.chunks_mut(o));
+        let data = x.chunks(rows * i).zip(ws.d_outputs[k].chunks(rows * o));
+        for (((weight_grad, bias_grad), (x, dy)), update) in grads.zip(data).zip(updates.iter_mut()) {
+            tasks.push(WeightTask { shape: *shape, x, dy, weight_grad, bias_grad, update: update.take() });
+        }
+    }
+    let optimizer_step = optimizer.map(|blocks| blocks.step);
+    tasks.into_par_iter().for_each(|task| {
+        let WeightTask { shape, x, dy, weight_grad, bias_grad, update } = task;
+        backward_weights(shape, x, dy, rows, weight_grad, bias_grad);
+        if let (Some([[p, m, v], [bp, bm, bv]]), Some(step)) = (update, optimizer_step) {
+            step.apply(p, weight_grad, m, v);
+            step.apply(bp, bias_grad, bm, bv);
+        }
+    });
+    for (shape, weight_grad, bias_grad) in taken {
+        ws.gradients[shape.weight_index] = weight_grad;
+        ws.gradients[shape.bias_index] = bias_grad;
+    }
+}
+
+/// One member's weight and bias gradients for its output gradients `dy` (rows × out) at its inputs `x`.
+fn backward_weights(
+    shape: LayerShape,
+    x: &[f32],
+    dy: &[f32],
+    rows: usize,
+    weight_grad: &mut [f32],
+    bias_grad: &mut [f32],
+) {
+    let (i, o) = (shape.d_in, shape.d_out);
+    matmul_here(view_mut(weight_grad, i, o), Accum::Replace, view(x, rows, i).transpose(), view(dy, rows, o));
+    bias_grad.fill(0.0);
+    add_column_sums(bias_grad, dy);
 }
 
 #[cfg(test)]
@@ -500,5 +640,79 @@ mod tests {
         let one = run(1);
         assert_eq!(one, run(2));
         assert_eq!(one, run(3));
+    }
+
+    /// The fused step (Adam applied block by block inside the gradient tasks) against the gradients followed by
+    /// the whole-set update, over three steps on one workspace, with weight decay on and a uniform learning
+    /// rate, at one to three threads: the same bytes for the loss, the weights and both moments.
+    #[test]
+    fn fused_step_equals_gradients_then_adam_on_any_pool() {
+        let mut config = PetsConfig::preset(Preset::Small);
+        (config.ensemble, config.hidden_units) = (3, 24);
+        config.optimizer.weight_decay = 1e-3;
+        let (din, dout, rows) = (4, 2, 96);
+        let net = PetsNet::init(&config, din, dout, &training_device(), &mut ChaCha8Rng::seed_from_u64(8));
+        let start = ParamSet::<f32>::from_module(&net, torch_name);
+        let sizes: Vec<usize> = start.tensors.iter().map(|t| t.values.len()).collect();
+        let mut rng = ChaCha8Rng::seed_from_u64(9);
+        let e = config.ensemble;
+        let batches: Vec<(Vec<f32>, Vec<f32>)> = (0..3)
+            .map(|_| {
+                let inputs = (0..e * rows * din).map(|_| rng.random_range(-2.0..2.0)).collect();
+                let targets = (0..e * rows * dout).map(|_| rng.random_range(-0.5..0.5)).collect();
+                (inputs, targets)
+            })
+            .collect();
+        let state = |params: &ParamSet, adam: &Adam<f32>, losses: Vec<u64>| {
+            let values: Vec<Vec<f32>> = params.tensors.iter().map(|t| t.values.clone()).collect();
+            (losses, values, adam.exp_avg.clone(), adam.exp_avg_sq.clone(), adam.step)
+        };
+        let unfused = {
+            let (mut params, mut adam, mut ws) =
+                (start.clone(), Adam::new(config.optimizer, &sizes), Workspace::default());
+            let losses = batches
+                .iter()
+                .map(|(inputs, targets)| {
+                    let net = EnsembleNet::new(&params, &config, din, dout).unwrap();
+                    let loss = net.loss_and_gradients(&params, &mut ws, inputs, targets, rows);
+                    adam.update(&mut params.values_mut(), &mut ws.gradients).unwrap();
+                    loss.to_bits()
+                })
+                .collect();
+            state(&params, &adam, losses)
+        };
+        for threads in [1, 2, 3] {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let fused = pool.install(|| {
+                let (mut params, mut adam, mut ws) =
+                    (start.clone(), Adam::new(config.optimizer, &sizes), Workspace::default());
+                let losses = batches
+                    .iter()
+                    .map(|(inputs, targets)| {
+                        let step =
+                            train_step(&mut params, &mut adam, &config, (din, dout), &mut ws, inputs, targets, rows);
+                        step.unwrap().to_bits()
+                    })
+                    .collect();
+                state(&params, &adam, losses)
+            });
+            assert!(fused == unfused, "{threads} threads: the fused step differs");
+        }
+        assert_ne!(unfused.1, start.tensors.iter().map(|t| t.values.clone()).collect::<Vec<_>>());
+    }
+
+    #[test]
+    fn fused_step_refuses_clipping() {
+        let mut config = PetsConfig::preset(Preset::Small);
+        config.optimizer.clip_grad_norm = Some(1.0);
+        let net = PetsNet::init(&config, 2, 1, &training_device(), &mut ChaCha8Rng::seed_from_u64(1));
+        let mut params = ParamSet::<f32>::from_module(&net, torch_name);
+        let sizes: Vec<usize> = params.tensors.iter().map(|t| t.values.len()).collect();
+        let mut adam = Adam::new(config.optimizer, &sizes);
+        let e = config.ensemble;
+        let (inputs, targets) = (vec![0.1f32; e * 4 * 2], vec![0.2f32; e * 4]);
+        let err = train_step(&mut params, &mut adam, &config, (2, 1), &mut Workspace::default(), &inputs, &targets, 4);
+        assert!(err.unwrap_err().to_string().contains("clip"));
+        assert_eq!(adam.step, 0);
     }
 }

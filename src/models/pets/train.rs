@@ -7,7 +7,7 @@ use rand_chacha::ChaCha8Rng;
 
 use super::config::PetsConfig;
 use super::data::Transitions;
-use super::grad::{EnsembleNet, Workspace};
+use super::grad::{train_step, EnsembleNet, Workspace};
 use super::net::{torch_name, PetsNet, INPUT_MEAN, INPUT_STD};
 use crate::error::{Error, Result};
 use crate::nn::tensor::training_device;
@@ -102,6 +102,10 @@ impl TrainingMethod for PetsTrainer {
                 inputs.extend_from_slice(&self.train.inputs[row * din..(row + 1) * din]);
                 targets.extend_from_slice(&self.train.targets[row * dout..(row + 1) * dout]);
             }
+        }
+        if self.adam.config.clip_grad_norm.is_none() {
+            let ws = &mut self.workspace;
+            return train_step(&mut self.params, &mut self.adam, &self.config, (din, dout), ws, inputs, targets, b);
         }
         let net = EnsembleNet::new(&self.params, &self.config, din, dout)?;
         let value = net.loss_and_gradients(&self.params, &mut self.workspace, inputs, targets, b);
