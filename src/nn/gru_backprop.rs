@@ -7,11 +7,16 @@
 //! The models that train through it keep burn's `GruCell` (`nn::gru`) as their reference: the context model's
 //! test holds every gradient to burn's autodiff.
 
+use std::mem::MaybeUninit;
+
 use faer::Accum;
 use rayon::prelude::*;
 
 use super::activation::{fast_sigmoid as sigmoid, fast_tanh as tanh};
-use super::backprop::{add_column_sums, block_rows, matmul, repeat_row, tensor_index, view, view_mut, zeros};
+use super::backprop::{
+    add_column_sums, assume_written, block_rows, matmul, repeat_row, slots, tensor_index, unwritten, view, view_mut,
+    zeros,
+};
 use super::params::ParamSet;
 use crate::error::Result;
 
@@ -101,45 +106,60 @@ impl<'a> Gru<'a> {
         let (e, g) = (self.e, 3 * self.e);
         let mut gh = repeat_row(self.bias_hh, rows);
         matmul(view_mut(&mut gh, rows, g), Accum::Add, view(h, rows, e), view(self.weight_hh, g, e).transpose());
-        let mut tape = GruTape { r: zeros(rows * e), z: zeros(rows * e), n: zeros(rows * e), hn: zeros(rows * e) };
+        let size = rows * e;
+        // The blocks below write every slot of the tapes only when the inputs have these sizes.
+        assert!(h.len() == size && gi.len() == rows * g, "GRU step: h or gi does not hold {rows} rows");
+        let (mut r, mut z, mut n, mut hn) = (unwritten(size), unwritten(size), unwritten(size), unwritten(size));
         let (he, hg) = (block_rows(rows, e) * e, block_rows(rows, e) * g);
-        let GruTape { r, z, n, hn } = &mut tape;
         h.par_chunks_mut(he)
-            .zip(r.par_chunks_mut(he).zip(z.par_chunks_mut(he)))
-            .zip(n.par_chunks_mut(he).zip(hn.par_chunks_mut(he)))
+            .zip(slots(&mut r, size).par_chunks_mut(he).zip(slots(&mut z, size).par_chunks_mut(he)))
+            .zip(slots(&mut n, size).par_chunks_mut(he).zip(slots(&mut hn, size).par_chunks_mut(he)))
             .zip(gi.par_chunks(hg).zip(gh.par_chunks(hg)))
             .for_each(|(((h, (r, z)), (n, hn)), (gi, gh))| {
                 for row in 0..h.len() / e {
                     let (gi, gh) = (&gi[row * g..(row + 1) * g], &gh[row * g..(row + 1) * g]);
                     for k in 0..e {
                         let at = row * e + k;
-                        r[at] = sigmoid(gi[k] + gh[k]);
-                        z[at] = sigmoid(gi[e + k] + gh[e + k]);
-                        n[at] = tanh(gi[2 * e + k] + r[at] * gh[2 * e + k]);
-                        hn[at] = gh[2 * e + k];
-                        h[at] = (1.0 - z[at]) * n[at] + z[at] * h[at];
+                        let reset = sigmoid(gi[k] + gh[k]);
+                        let update = sigmoid(gi[e + k] + gh[e + k]);
+                        let new = tanh(gi[2 * e + k] + reset * gh[2 * e + k]);
+                        r[at].write(reset);
+                        z[at].write(update);
+                        n[at].write(new);
+                        hn[at].write(gh[2 * e + k]);
+                        h[at] = (1.0 - update) * new + update * h[at];
                     }
                 }
             });
-        tape
+        // SAFETY: the blocks of h cover all `size` values, and each wrote its rows of all four tapes.
+        unsafe {
+            for buffer in [&mut r, &mut z, &mut n, &mut hn] {
+                assume_written(buffer, size);
+            }
+        }
+        GruTape { r, z, n, hn }
     }
 
-    /// Backward of one step: from dh' (rows × E) and the previous state, the input-gate gradients (written to
-    /// `d_gi`), the hidden-gate gradients (written to `d_gh`, for one W_hh GEMM over all steps later) and dh.
+    /// Backward of one step: from dh' (rows × E) and the previous state, dh and the input-gate gradients
+    /// (returned, in that order), and the hidden-gate gradients written to every slot of `d_gh` (for one W_hh
+    /// GEMM over all steps later, so the caller's buffer for all steps is never zeroed).
     pub fn step_backward(
         &self,
         tape: &GruTape,
         h_prev: &[f32],
         dh_next: &[f32],
         rows: usize,
-        d_gi: &mut [f32],
-        d_gh: &mut [f32],
-    ) -> Vec<f32> {
+        d_gh: &mut [MaybeUninit<f32>],
+    ) -> (Vec<f32>, Vec<f32>) {
         let (e, g) = (self.e, 3 * self.e);
-        let mut dh = zeros(rows * e);
+        let size = rows * e;
+        let sizes = [tape.r.len(), tape.z.len(), tape.n.len(), tape.hn.len(), h_prev.len(), dh_next.len()];
+        assert!(sizes.iter().all(|&n| n == size) && d_gh.len() == rows * g, "GRU step back: buffers of another size");
+        let (mut dh, mut d_gi) = (unwritten(size), unwritten(rows * g));
         let (he, hg) = (block_rows(rows, e) * e, block_rows(rows, e) * g);
-        dh.par_chunks_mut(he)
-            .zip(d_gi.par_chunks_mut(hg).zip(d_gh.par_chunks_mut(hg)))
+        slots(&mut dh, size)
+            .par_chunks_mut(he)
+            .zip(slots(&mut d_gi, rows * g).par_chunks_mut(hg).zip(d_gh.par_chunks_mut(hg)))
             .zip(tape.r.par_chunks(he).zip(tape.z.par_chunks(he)))
             .zip(tape.n.par_chunks(he).zip(tape.hn.par_chunks(he)))
             .zip(h_prev.par_chunks(he).zip(dh_next.par_chunks(he)))
@@ -153,18 +173,24 @@ impl<'a> Gru<'a> {
                         let dn = d * (1.0 - z) * (1.0 - n * n);
                         let dz = d * (h_prev[at] - n) * z * (1.0 - z);
                         let dr = dn * hn * r * (1.0 - r);
-                        d_gi[k] = dr;
-                        d_gi[e + k] = dz;
-                        d_gi[2 * e + k] = dn;
-                        d_gh[k] = dr;
-                        d_gh[e + k] = dz;
-                        d_gh[2 * e + k] = dn * r;
-                        dh[at] = d * z;
+                        d_gi[k].write(dr);
+                        d_gi[e + k].write(dz);
+                        d_gi[2 * e + k].write(dn);
+                        d_gh[k].write(dr);
+                        d_gh[e + k].write(dz);
+                        d_gh[2 * e + k].write(dn * r);
+                        dh[at].write(d * z);
                     }
                 }
             });
+        // SAFETY: the row blocks cover all rows, and each row wrote its E values of dh and 3E of d_gi and d_gh.
+        let d_gh = unsafe {
+            assume_written(&mut dh, size);
+            assume_written(&mut d_gi, rows * g);
+            std::slice::from_raw_parts(d_gh.as_ptr().cast::<f32>(), d_gh.len())
+        };
         matmul(view_mut(&mut dh, rows, e), Accum::Add, view(d_gh, rows, g), view(self.weight_hh, g, e));
-        dh
+        (dh, d_gi)
     }
 
     /// W_hh's and b_hh's gradients from all steps' hidden-gate gradients and previous states at once.

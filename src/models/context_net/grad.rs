@@ -11,8 +11,8 @@ use super::net::{STD_FLOOR, STD_SCALE, STD_SHIFT, VARIANCE_FLOOR};
 use crate::error::{Error, Result};
 use crate::nn::activation::{fast_sigmoid as sigmoid, fast_softplus as softplus, fast_tanh as tanh};
 use crate::nn::backprop::{
-    add_column_sums, add_into, block_rows, concat, copy_of, for_each_value, relu_backward, relu_in_place, repeat_row,
-    tensor_index, zero_gradients, zeros, zip_values, TwoLayer, TwoLayerTape,
+    add_column_sums, add_into, assume_written, block_rows, concat, copy_of, for_each_value, relu_backward,
+    relu_in_place, repeat_row, slots, tensor_index, unwritten, zero_gradients, zip_values, TwoLayer, TwoLayerTape,
 };
 use crate::nn::gru_backprop::Gru;
 use crate::nn::ParamSet;
@@ -377,36 +377,46 @@ pub fn loss_and_gradients(
     // Back through the open loop and, beside it, through the single steps; their weight gradients are then
     // added in a fixed order.
     let open_loop_back = || {
-        let mut d_gi_seq = zeros(b * t * g);
-        let mut seq_d_gh = zeros(t * b * g);
+        // Both are written in full over the steps (every chunk's gates at every step), never zeroed.
+        let (mut d_gi_seq, mut seq_d_gh) = (unwritten(b * t * g), unwritten(t * b * g));
         let mut dh = vec![0.0; b * e];
-        let mut d_gi_step = vec![0.0; b * g];
-        for k in (0..t).rev() {
-            if k >= 1 {
-                let j = k - 1;
-                for i in 0..b {
-                    let src = &d_open[(i * steps + j) * e..(i * steps + j + 1) * e];
-                    add_into(&mut dh[i * e..(i + 1) * e], src);
+        {
+            let (d_gi_slots, d_gh_slots) = (slots(&mut d_gi_seq, b * t * g), slots(&mut seq_d_gh, t * b * g));
+            for k in (0..t).rev() {
+                if k >= 1 {
+                    let j = k - 1;
+                    for i in 0..b {
+                        let src = &d_open[(i * steps + j) * e..(i * steps + j + 1) * e];
+                        add_into(&mut dh[i * e..(i + 1) * e], src);
+                    }
                 }
+                let h_prev = &seq_h_prev[k * b * e..(k + 1) * b * e];
+                let d_gh = &mut d_gh_slots[k * b * g..(k + 1) * b * g];
+                let d_gi_step;
+                (dh, d_gi_step) = net.gru.step_backward(&seq_tapes[k], h_prev, &dh, b, d_gh);
+                // Chunk i's gates at step k go to row i·T + k: whole chunks' rows per task.
+                d_gi_slots.par_chunks_mut(chunk_rows * t * g).enumerate().for_each(|(block, rows)| {
+                    for (row, chunk) in rows.chunks_mut(t * g).enumerate() {
+                        let i = block * chunk_rows + row;
+                        let src = &d_gi_step[i * g..(i + 1) * g];
+                        chunk[k * g..(k + 1) * g].iter_mut().zip(src).for_each(|(slot, x)| _ = slot.write(*x));
+                    }
+                });
             }
-            let h_prev = &seq_h_prev[k * b * e..(k + 1) * b * e];
-            let d_gh = &mut seq_d_gh[k * b * g..(k + 1) * b * g];
-            dh = net.gru.step_backward(&seq_tapes[k], h_prev, &dh, b, &mut d_gi_step, d_gh);
-            // Chunk i's gates at step k go to row i·T + k: whole chunks' rows per task.
-            d_gi_seq.par_chunks_mut(chunk_rows * t * g).enumerate().for_each(|(block, rows)| {
-                for (row, chunk) in rows.chunks_mut(t * g).enumerate() {
-                    let i = block * chunk_rows + row;
-                    chunk[k * g..(k + 1) * g].copy_from_slice(&d_gi_step[i * g..(i + 1) * g]);
-                }
-            });
+        }
+        // SAFETY: steps 0..t wrote every chunk's gates at every step into both.
+        unsafe {
+            assume_written(&mut d_gi_seq, b * t * g);
+            assume_written(&mut seq_d_gh, t * b * g);
         }
         (d_gi_seq, seq_d_gh, dh)
     };
     let single_steps_back = || {
-        let mut d_gi_single = zeros(b * t * g);
-        let mut single_d_gh = zeros(b * t * g);
-        let d_h_prev_single =
-            net.gru.step_backward(&single_tape, &h_all, d_h_single, b * t, &mut d_gi_single, &mut single_d_gh);
+        let mut single_d_gh = unwritten(b * t * g);
+        let (d_h_prev_single, d_gi_single) =
+            net.gru.step_backward(&single_tape, &h_all, d_h_single, b * t, slots(&mut single_d_gh, b * t * g));
+        // SAFETY: the step back wrote every slot of its d_gh.
+        unsafe { assume_written(&mut single_d_gh, b * t * g) };
         (d_gi_single, single_d_gh, d_h_prev_single)
     };
     let ((d_gi_seq, seq_d_gh, dh), (d_gi_single, single_d_gh, d_h_prev_single)) =
