@@ -26,7 +26,7 @@ use mbrl::nn::tensor::training_device;
 use mbrl::rl::sac::Sac;
 use mbrl::run::NullMonitor;
 use mbrl::train::TrainingMethod;
-use mbrl::util::warm_pool::run_warm;
+use mbrl::util::warm_pool::{run_warm, Warm};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -141,7 +141,7 @@ fn median(mut xs: Vec<f64>) -> f64 {
     }
 }
 
-fn time_workload(workload: &Workload, quick: bool) -> (f64, usize) {
+fn time_workload(workload: &Workload, quick: bool, warm: &Warm) -> (f64, usize) {
     let mut step = (workload.build)();
     let (warmup, repeats) = if quick {
         (workload.warmup.min(2), (workload.repeats / 5).max(2))
@@ -149,10 +149,12 @@ fn time_workload(workload: &Workload, quick: bool) -> (f64, usize) {
         (workload.warmup, workload.repeats)
     };
     for _ in 0..warmup {
+        warm.rearm();
         step();
     }
     let samples = (0..repeats)
         .map(|_| {
+            warm.rearm();
             let start = Instant::now();
             let own = step();
             own.unwrap_or(start.elapsed().as_secs_f64())
@@ -212,7 +214,7 @@ fn main() {
                 continue;
             }
             // As `train` runs its steps: on a pool thread, the other workers kept awake (`util::warm_pool`).
-            let (seconds, samples) = pool.install(|| run_warm(|| time_workload(workload, quick)));
+            let (seconds, samples) = pool.install(|| run_warm(|warm| time_workload(workload, quick, warm)));
             println!(
                 r#"{{"workload":"{}","threads":{threads},"seconds":{seconds:.6e},"samples":{samples}}}"#,
                 workload.name

@@ -8,6 +8,7 @@ use super::checkpoint::{CheckpointDir, FileEntry, Manifest, CHECKPOINT_FORMAT};
 use super::tensors::{to_bytes, StoredTensor, TensorData};
 use crate::error::{Error, Result};
 use crate::run::{JsonlMonitor, Monitor};
+use crate::util::warm_pool::Warm;
 
 pub const CONFIG_FILE: &str = "config.json";
 pub const MODEL_FILE: &str = "model.safetensors";
@@ -222,7 +223,7 @@ pub fn fit(
     resume: Option<ResumePoint>,
     monitor: &dyn Monitor,
 ) -> Result<FitOutcome> {
-    crate::util::warm_pool::run_warm(|| fit_here(method, settings, checkpoints, resume, monitor))
+    crate::util::warm_pool::run_warm(|warm| fit_here(method, settings, checkpoints, resume, monitor, warm))
 }
 
 fn fit_here(
@@ -231,6 +232,7 @@ fn fit_here(
     checkpoints: &mut (dyn Checkpointer + Send),
     resume: Option<ResumePoint>,
     monitor: &dyn Monitor,
+    warm: &Warm,
 ) -> Result<FitOutcome> {
     if settings.total_steps == 0 {
         return Err(Error::config("training needs at least one step"));
@@ -247,6 +249,7 @@ fn fit_here(
         if monitor.is_cancelled() {
             return Err(Error::cancelled());
         }
+        warm.rearm();
         let loss = method.step(step)?;
         if !loss.is_finite() {
             return Err(diverged(settings, step, "training", loss, last_checkpoint, checkpoints.persists()));
