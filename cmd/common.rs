@@ -124,6 +124,9 @@ pub fn init_threads(global: &GlobalArgs) -> anyhow::Result<()> {
     mbrl::util::budget::set_limit_gib(global.max_memory_gib);
     rayon::ThreadPoolBuilder::new()
         .num_threads(global.threads)
+        // Training runs its whole loop on a worker (`util::warm_pool`): the main thread's stack size, not
+        // rayon's default 2 MiB.
+        .stack_size(8 << 20)
         .build_global()
         .context("could not start the worker threads")
 }

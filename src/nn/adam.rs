@@ -163,6 +163,7 @@ pub struct AdamStep<T> {
 impl<T: Float> AdamStep<T> {
     /// Updates parameters `p` with gradients `g` and their moments `m`, `v` (all the same length).
     pub fn apply(&self, p: &mut [T], g: &[T], m: &mut [T], v: &mut [T]) {
+        debug_assert!(g.len() == p.len() && m.len() == p.len() && v.len() == p.len(), "Adam: block sizes differ");
         let AdamStep { beta1, beta2, epsilon, weight_decay, bias2_sqrt, step_size } = *self;
         // Zipped slices rather than indices: without bounds checks the loop vectorizes.
         let step = |p: &mut T, grad: T, m: &mut T, v: &mut T| {

@@ -270,6 +270,7 @@ pub fn unwritten(n: usize) -> Vec<f32> {
 
 /// The spare capacity of `buffer` (from [`unwritten`]), `n` slots, for a pass to write.
 pub fn slots(buffer: &mut Vec<f32>, n: usize) -> &mut [std::mem::MaybeUninit<f32>] {
+    debug_assert!(buffer.is_empty(), "slots of a buffer that already holds values");
     &mut buffer.spare_capacity_mut()[..n]
 }
 
@@ -279,7 +280,7 @@ pub fn slots(buffer: &mut Vec<f32>, n: usize) -> &mut [std::mem::MaybeUninit<f32
 /// Every one of the first `n` slots of `buffer`'s spare capacity must have been written since it came from
 /// [`unwritten`].
 pub unsafe fn assume_written(buffer: &mut Vec<f32>, n: usize) {
-    debug_assert!(n <= buffer.capacity());
+    debug_assert!(buffer.is_empty() && n <= buffer.capacity());
     // SAFETY: the caller wrote all n slots.
     unsafe { buffer.set_len(n) };
 }

@@ -12,46 +12,59 @@
 //! decides its result in the fused paths (they split work by shape, not by thread), so the bytes stay those
 //! of a cold pool.
 
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// A spinner that has found no work for this long parks its thread as rayon would. A waiting worker can pick
-/// a spinner up and run it nested above its own work (another run's, when runs overlap); the limit bounds how
-/// long that work waits, and two runs whose spinners sit above each other's work cannot wait forever.
+/// a spinner up and run it nested above its own unfinished work (another run's, when runs overlap); that work
+/// then waits until the spinner has seen no work for this long, so every such wait ends, but it can cost
+/// about this much each time runs overlap.
 const IDLE_LIMIT: Duration = Duration::from_millis(1);
 
 /// The handle `work` gets: [`Warm::rearm`] sends spinners out again after a pause has parked them.
 pub struct Warm {
     stop: Arc<AtomicBool>,
-    live: Arc<AtomicUsize>,
-    caller: Option<usize>,
-    others: usize,
+    /// Per worker of the pool: whether a spinner of this run is on it. A second copy on a worker returns at
+    /// once, so spinners never stack up on one thread.
+    spinning: Arc<Vec<AtomicBool>>,
+    caller: usize,
+    idle_limit: Duration,
 }
 
 impl Warm {
-    /// Sends a spinner to each other worker unless all are still spinning: call it before each step of a run.
+    /// Sends a spinner to every other worker that has none (after a pause parked it): call it before each step.
     pub fn rearm(&self) {
-        if self.others == 0 || self.live.load(Ordering::Acquire) >= self.others {
+        let others_spinning =
+            |(index, flag): (usize, &AtomicBool)| index == self.caller || flag.load(Ordering::Acquire);
+        if self.spinning.iter().enumerate().all(others_spinning) {
             return;
         }
-        let (stop, live, caller) = (Arc::clone(&self.stop), Arc::clone(&self.live), self.caller);
+        let (stop, spinning, caller, idle_limit) =
+            (Arc::clone(&self.stop), Arc::clone(&self.spinning), self.caller, self.idle_limit);
         rayon::spawn_broadcast(move |context| {
-            // The caller's own copy must return at once: it would run inside a wait of `work`'s.
-            if Some(context.index()) == caller {
+            // The caller's own copy returns at once: it would run inside a wait of `work`'s.
+            let Some(flag) = spinning.get(context.index()).filter(|_| context.index() != caller) else {
+                return;
+            };
+            if flag.swap(true, Ordering::AcqRel) {
                 return;
             }
-            live.fetch_add(1, Ordering::AcqRel);
             let mut last_work = Instant::now();
-            while !stop.load(Ordering::Acquire) && last_work.elapsed() < IDLE_LIMIT {
+            while !stop.load(Ordering::Acquire) && last_work.elapsed() < idle_limit {
                 if rayon::yield_now() == Some(rayon::Yield::Executed) {
                     last_work = Instant::now();
                 } else {
                     std::thread::yield_now();
                 }
             }
-            live.fetch_sub(1, Ordering::AcqRel);
+            flag.store(false, Ordering::Release);
         });
+    }
+
+    /// How many workers a spinner of this run is on now.
+    pub fn spinning_workers(&self) -> usize {
+        self.spinning.iter().filter(|f| f.load(Ordering::Acquire)).count()
     }
 }
 
@@ -59,14 +72,22 @@ impl Warm {
 /// pool's other threads kept awake while work keeps coming (see [`Warm::rearm`]) until it returns. On a pool
 /// of one thread it runs `work` where it is.
 pub fn run_warm<R: Send>(work: impl FnOnce(&Warm) -> R + Send) -> R {
+    run_warm_for(IDLE_LIMIT, work)
+}
+
+fn run_warm_for<R: Send>(idle_limit: Duration, work: impl FnOnce(&Warm) -> R + Send) -> R {
+    let warm = |caller: usize, threads: usize| Warm {
+        stop: Arc::default(),
+        spinning: Arc::new((0..threads).map(|_| AtomicBool::new(false)).collect()),
+        caller,
+        idle_limit,
+    };
     if rayon::current_num_threads() <= 1 {
-        let idle = Warm { stop: Arc::default(), live: Arc::default(), caller: None, others: 0 };
-        return work(&idle);
+        return work(&warm(0, 0));
     }
+    // The scope runs its body on a worker of the pool, so there is always a caller index.
     rayon::scope(|_| {
-        let caller = rayon::current_thread_index();
-        let others = rayon::current_num_threads() - usize::from(caller.is_some());
-        let warm = Warm { stop: Arc::default(), live: Arc::default(), caller, others };
+        let warm = warm(rayon::current_thread_index().unwrap_or(0), rayon::current_num_threads());
         let _stop = StopOnDrop(Arc::clone(&warm.stop));
         warm.rearm();
         work(&warm)
@@ -112,55 +133,56 @@ mod tests {
         assert!(outside.join().unwrap());
     }
 
-    /// CPU ticks (user + system) the pool's threads have used so far.
-    #[cfg(target_os = "linux")]
-    fn pool_ticks(pool: &rayon::ThreadPool) -> u64 {
-        let per_thread = pool.broadcast(|_| {
-            let stat = std::fs::read_to_string("/proc/thread-self/stat").unwrap();
-            // Fields after the parenthesised name; utime and stime are the 14th and 15th of the line.
-            let rest = &stat[stat.rfind(')').unwrap() + 2..];
-            let fields: Vec<u64> = rest.split(' ').skip(11).take(2).map(|f| f.parse().unwrap()).collect();
-            fields.iter().sum::<u64>()
-        });
-        per_thread.iter().sum()
-    }
-
-    /// Short parallel regions 0.2 ms apart for about 0.3 s, re-arming before each as `fit` does per step.
-    fn regions_with_short_pauses(warm: &Warm) {
-        for _ in 0..1500 {
-            warm.rearm();
-            (0..64u64).into_par_iter().for_each(|x| _ = std::hint::black_box(x));
-            std::thread::sleep(std::time::Duration::from_micros(200));
+    /// Polls `done` for up to a second.
+    fn within_a_second(done: impl Fn() -> bool) -> bool {
+        let start = Instant::now();
+        while start.elapsed() < Duration::from_secs(1) {
+            if done() {
+                return true;
+            }
+            std::thread::sleep(Duration::from_micros(100));
         }
+        done()
     }
 
     #[test]
-    #[cfg(target_os = "linux")]
-    fn the_workers_spin_through_short_pauses_and_park_after_long_ones_or_the_end() {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
-        let ticks_of = |run: &dyn Fn()| {
-            let before = pool_ticks(&pool);
-            run();
-            pool_ticks(&pool) - before
-        };
-        let busy = ticks_of(&|| pool.install(|| run_warm(regions_with_short_pauses)));
-        assert!(busy >= 3, "the other worker used {busy} ticks through 0.3 s of short pauses");
-
-        let pause = std::time::Duration::from_millis(300);
-        let paused = ticks_of(&|| pool.install(|| run_warm(|_| std::thread::sleep(pause))));
-        assert!(paused <= 2, "the workers used {paused} ticks through one long pause");
-
-        let caught = pool.install(|| {
-            std::panic::catch_unwind(|| {
-                run_warm(|warm| {
-                    regions_with_short_pauses(warm);
-                    panic!("stop")
-                })
+    fn spinners_park_after_the_idle_limit_and_come_back_when_rearmed() {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(3).build().unwrap();
+        pool.install(|| {
+            run_warm_for(Duration::from_millis(20), |warm| {
+                assert!(within_a_second(|| warm.spinning_workers() == 2), "{} spinning", warm.spinning_workers());
+                // Rearming while all spin sends none; nothing stacks on a worker.
+                (0..50).for_each(|_| warm.rearm());
+                assert!(warm.spinning_workers() <= 2);
+                std::thread::sleep(Duration::from_millis(200));
+                assert_eq!(warm.spinning_workers(), 0, "spinners outlived a pause ten times their idle limit");
+                warm.rearm();
+                assert!(within_a_second(|| warm.spinning_workers() == 2), "{} after rearming", warm.spinning_workers());
             })
         });
-        assert!(caught.is_err());
-        let after = ticks_of(&|| std::thread::sleep(pause));
-        assert!(after <= 2, "the workers used {after} ticks after the work had ended");
+    }
+
+    #[test]
+    fn the_end_of_the_work_stops_its_spinners_also_when_it_panics() {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+        for panics in [false, true] {
+            let (sender, spinners) = std::sync::mpsc::channel();
+            let caught = pool.install(|| {
+                std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                    // An idle limit far beyond the test: only the end of the work can stop these spinners.
+                    run_warm_for(Duration::from_secs(3600), |warm| {
+                        assert!(within_a_second(|| warm.spinning_workers() == 1));
+                        sender.send(Arc::clone(&warm.spinning)).unwrap();
+                        if panics {
+                            panic!("stop");
+                        }
+                    })
+                }))
+            });
+            assert_eq!(caught.is_err(), panics);
+            let flags = spinners.recv().unwrap();
+            assert!(within_a_second(|| flags.iter().all(|f| !f.load(Ordering::Acquire))), "panics: {panics}");
+        }
     }
 
     /// Runs started together from several threads (tests, or methods trained side by side) all finish.

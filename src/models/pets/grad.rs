@@ -474,6 +474,7 @@ impl<'a> OptimizerBlocks<'a> {
     fn member_blocks(&mut self, index: usize, members: usize) -> Vec<[&'a mut [f32]; 3]> {
         let take = |list: &mut Vec<Option<&'a mut Vec<f32>>>| list[index].take().expect("each tensor taken once");
         let (p, m, v) = (take(&mut self.params), take(&mut self.exp_avg), take(&mut self.exp_avg_sq));
+        debug_assert!(p.len() % members == 0 && m.len() == p.len() && v.len() == p.len(), "tensor {index}: sizes");
         let size = p.len() / members;
         p.chunks_mut(size).zip(m.chunks_mut(size).zip(v.chunks_mut(size))).map(|(p, (m, v))| [p, m, v]).collect()
     }
