@@ -17,9 +17,9 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// A spinner that has found no work for this long parks its thread as rayon would. A waiting worker can pick
-/// a spinner up and run it nested above its own unfinished work (another run's, when runs overlap); that work
-/// then waits until the spinner has seen no work for this long, so every such wait ends, but it can cost
-/// about this much each time runs overlap.
+/// a spinner up and run it nested above its own unfinished work (another run's, when runs overlap, as tests
+/// do); that work then waits until the spinner's run stops producing work for this long or ends. Every such
+/// wait ends, since a spinner's run keeps producing work only until it is done.
 const IDLE_LIMIT: Duration = Duration::from_millis(1);
 
 /// The handle `work` gets: [`Warm::rearm`] sends spinners out again after a pause has parked them.
