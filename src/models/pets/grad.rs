@@ -32,12 +32,9 @@ fn matmul_here(dst: faer::MatMut<'_, f32>, accum: Accum, a: faer::MatRef<'_, f32
 
 /// One ensemble layer's weights, [members, in, out] and [members, 1, out], as views of a parameter set.
 struct Layer<'a> {
-    d_in: usize,
-    d_out: usize,
+    shape: LayerShape,
     weight: &'a [f32],
     bias: &'a [f32],
-    weight_index: usize,
-    bias_index: usize,
 }
 
 impl<'a> Layer<'a> {
@@ -45,23 +42,20 @@ impl<'a> Layer<'a> {
         let weight_index = tensor_index(params, &format!("{prefix}.weight"), &[members, d_in, d_out])?;
         let bias_index = tensor_index(params, &format!("{prefix}.bias"), &[members, 1, d_out])?;
         Ok(Layer {
-            d_in,
-            d_out,
+            shape: LayerShape { d_in, d_out, weight_index, bias_index },
             weight: &params.tensors[weight_index].values,
             bias: &params.tensors[bias_index].values,
-            weight_index,
-            bias_index,
         })
     }
 
     fn member_weight(&self, member: usize) -> &[f32] {
-        let size = self.d_in * self.d_out;
+        let size = self.shape.d_in * self.shape.d_out;
         &self.weight[member * size..(member + 1) * size]
     }
 
     /// Member `member`'s `rows` inputs `x` → `y` (rows × out).
     fn forward(&self, member: usize, x: &[f32], rows: usize, y: &mut [f32]) {
-        let (i, o) = (self.d_in, self.d_out);
+        let (i, o) = (self.shape.d_in, self.shape.d_out);
         let bias = &self.bias[member * o..(member + 1) * o];
         y.chunks_mut(o).for_each(|row| row.copy_from_slice(bias));
         matmul_here(view_mut(y, rows, o), Accum::Add, view(x, rows, i), view(self.member_weight(member), i, o));
@@ -69,7 +63,7 @@ impl<'a> Layer<'a> {
 
     /// The input gradients `dx` (rows × in) of member `member` for output gradients `dy`.
     fn backward_input(&self, member: usize, dy: &[f32], rows: usize, dx: &mut [f32]) {
-        let (i, o) = (self.d_in, self.d_out);
+        let (i, o) = (self.shape.d_in, self.shape.d_out);
         let w = view(self.member_weight(member), i, o);
         matmul_here(view_mut(dx, rows, i), Accum::Replace, view(dy, rows, o), w.transpose());
     }
@@ -242,7 +236,7 @@ impl<'a> EnsembleNet<'a> {
         ws.activations.resize_with(hidden, Vec::new);
         ws.slopes.resize_with(hidden, Vec::new);
         ws.d_outputs.resize_with(if gradients { hidden + 1 } else { 0 }, Vec::new);
-        let widths: Vec<usize> = self.layers().map(|l| l.d_out).collect();
+        let widths: Vec<usize> = self.layers().map(|l| l.shape.d_out).collect();
         let mut activations = cut_layers(&mut ws.activations, &widths, parts, e * rows);
         let mut slopes = cut_layers(&mut ws.slopes, &widths, parts, e * rows);
         let mut d_outputs = cut_layers(&mut ws.d_outputs, &widths, parts, e * rows);
@@ -400,14 +394,7 @@ impl<'a> EnsembleNet<'a> {
     }
 
     fn shapes(&self) -> Vec<LayerShape> {
-        self.layers()
-            .map(|l| LayerShape {
-                d_in: l.d_in,
-                d_out: l.d_out,
-                weight_index: l.weight_index,
-                bias_index: l.bias_index,
-            })
-            .collect()
+        self.layers().map(|l| l.shape).collect()
     }
 }
 
@@ -452,7 +439,7 @@ pub fn train_step(
     Ok(loss)
 }
 
-/// What the weight-gradient phase needs of a layer, free of the borrow of the parameters.
+/// A layer's sizes and tensor indices: all the weight-gradient phase needs, free of the parameters' borrow.
 #[derive(Clone, Copy)]
 struct LayerShape {
     d_in: usize,
