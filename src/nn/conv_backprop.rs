@@ -13,19 +13,30 @@
 //! - convolution: y_small = im2col(x_big) · W̃ᵀ; its input gradient is col2im(dy · W̃);
 //! - transposed convolution: y_big = col2im(x_small · W̃); its input gradient is im2col(dy) · W̃ᵀ.
 //!
-//! Each image is gathered and scattered by one thread and the GEMMs split by rows only, and the images are
-//! taken in chunks whose size depends on the layer alone: the bytes do not depend on the thread count.
+//! The images are taken in chunks whose im2col buffer stays in a core's cache. A layer with enough chunks runs
+//! them as parallel tasks of whole chunks, each on one thread, and adds the tasks' weight gradients in order;
+//! one with few (a 1 × 1 grid, a small batch) runs them in turn, splitting each chunk's gathers by image and
+//! its GEMMs by rows. Which of the two, and the chunk size, depend on the layer and the batch alone, and each
+//! image is gathered and scattered by one thread: the bytes do not depend on the thread count.
 
-use faer::Accum;
+use faer::{Accum, MatMut, MatRef, Par};
 use rayon::prelude::*;
 
 use super::backprop::{add_column_sums, matmul, repeat_row, tensor_index, view, view_mut, zeros};
 use super::params::ParamSet;
 use crate::error::{Error, Result};
 
-/// The im2col buffer of one chunk of images stays near this size: large enough for long GEMMs, small enough
-/// that a batch of a thousand 64 × 64 frames does not hold a gigabyte of columns.
-const COLUMN_BYTES: usize = 16 << 20;
+/// The im2col buffer of one chunk of images stays near this size, so that the GEMM reads it back from the
+/// core's own cache: 16 MiB chunks made DLGPD's batch-256 step 6-8 % slower at one thread.
+const COLUMN_BYTES: usize = 256 << 10;
+/// ... unless a chunk would then have fewer GEMM rows than this (a 1 × 1 grid has one row per image).
+const MIN_ROWS: usize = 256;
+/// Layers with at least this many chunks run their chunks as parallel tasks, each on one thread; with fewer,
+/// the chunks run in turn and each one's gathers and GEMMs are split over the pool.
+const MIN_CHUNKS_FOR_TASKS: usize = 4;
+/// The tasks a layer's chunks are grouped into: each task sums its own weight gradient, and the tasks' sums
+/// are added in order, so a layer keeps this many partial gradients at most.
+const TASKS: usize = 16;
 
 /// Which way a layer maps between its two grids.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -78,42 +89,68 @@ impl Grids {
     }
 
     fn chunk_images(&self) -> usize {
-        (COLUMN_BYTES / (self.positions() * self.window() * 4).max(1)).max(1)
+        let by_bytes = COLUMN_BYTES / (self.positions() * self.window() * 4).max(1);
+        by_bytes.max(MIN_ROWS.div_ceil(self.positions().max(1))).max(1)
+    }
+
+    /// The images of one window gathered into `col` (positions × window).
+    fn gather_image(&self, big: &[f32], col: &mut [f32]) {
+        let (k, s, c, side) = (self.kernel, self.stride, self.big_channels, self.big_side);
+        let span = k * c;
+        for (position, row) in col.chunks_mut(self.window()).enumerate() {
+            let (y, x) = (position / self.small_side, position % self.small_side);
+            for (ky, piece) in row.chunks_mut(span).enumerate() {
+                let start = ((y * s + ky) * side + x * s) * c;
+                piece.copy_from_slice(&big[start..start + span]);
+            }
+        }
+    }
+
+    /// The adjoint of [`Grids::gather_image`] for one image.
+    fn scatter_add_image(&self, col: &[f32], big: &mut [f32]) {
+        let (k, s, c, side) = (self.kernel, self.stride, self.big_channels, self.big_side);
+        let span = k * c;
+        for (position, row) in col.chunks(self.window()).enumerate() {
+            let (y, x) = (position / self.small_side, position % self.small_side);
+            for (ky, piece) in row.chunks(span).enumerate() {
+                let start = ((y * s + ky) * side + x * s) * c;
+                big[start..start + span].iter_mut().zip(piece).for_each(|(b, p)| *b += p);
+            }
+        }
     }
 
     /// im2col of `images` big-grid images: row (image, y, x) of `col` holds the window whose corner is at
-    /// (y · stride, x · stride), ordered (ky, kx, channel).
-    fn gather(&self, big: &[f32], col: &mut [f32]) {
-        let (k, s, c, side) = (self.kernel, self.stride, self.big_channels, self.big_side);
-        let span = k * c;
-        col.par_chunks_mut(self.positions() * self.window()).zip(big.par_chunks(self.big_len())).for_each(
-            |(col, big)| {
-                for (position, row) in col.chunks_mut(self.window()).enumerate() {
-                    let (y, x) = (position / self.small_side, position % self.small_side);
-                    for (ky, piece) in row.chunks_mut(span).enumerate() {
-                        let start = ((y * s + ky) * side + x * s) * c;
-                        piece.copy_from_slice(&big[start..start + span]);
-                    }
-                }
-            },
-        );
+    /// (y · stride, x · stride), ordered (ky, kx, channel). Split over the pool by image when `split`.
+    fn gather(&self, big: &[f32], col: &mut [f32], split: bool) {
+        let per_image = self.positions() * self.window();
+        if split {
+            col.par_chunks_mut(per_image)
+                .zip(big.par_chunks(self.big_len()))
+                .for_each(|(c, b)| self.gather_image(b, c));
+        } else {
+            col.chunks_mut(per_image).zip(big.chunks(self.big_len())).for_each(|(c, b)| self.gather_image(b, c));
+        }
     }
 
     /// The adjoint of [`Grids::gather`]: adds every window of `col` back onto the big grid.
-    fn scatter_add(&self, col: &[f32], big: &mut [f32]) {
-        let (k, s, c, side) = (self.kernel, self.stride, self.big_channels, self.big_side);
-        let span = k * c;
-        big.par_chunks_mut(self.big_len()).zip(col.par_chunks(self.positions() * self.window())).for_each(
-            |(big, col)| {
-                for (position, row) in col.chunks(self.window()).enumerate() {
-                    let (y, x) = (position / self.small_side, position % self.small_side);
-                    for (ky, piece) in row.chunks(span).enumerate() {
-                        let start = ((y * s + ky) * side + x * s) * c;
-                        big[start..start + span].iter_mut().zip(piece).for_each(|(b, p)| *b += p);
-                    }
-                }
-            },
-        );
+    fn scatter_add(&self, col: &[f32], big: &mut [f32], split: bool) {
+        let per_image = self.positions() * self.window();
+        if split {
+            big.par_chunks_mut(self.big_len())
+                .zip(col.par_chunks(per_image))
+                .for_each(|(b, c)| self.scatter_add_image(c, b));
+        } else {
+            big.chunks_mut(self.big_len()).zip(col.chunks(per_image)).for_each(|(b, c)| self.scatter_add_image(c, b));
+        }
+    }
+}
+
+/// dst [+]= a · b: split over the pool (row-wise, as [`matmul`] splits) or on this thread.
+fn product(dst: MatMut<'_, f32>, accum: Accum, a: MatRef<'_, f32>, b: MatRef<'_, f32>, split: bool) {
+    if split {
+        matmul(dst, accum, a, b);
+    } else {
+        faer::linalg::matmul::matmul(dst, accum, a, b, 1.0f32, Par::Seq);
     }
 }
 
@@ -168,65 +205,116 @@ impl StridedConv {
         }
     }
 
+    /// Images per task, or `None` where the layer's chunks run in turn, each split over the pool. It depends on
+    /// the layer and the batch alone, so the bytes do not depend on the thread count.
+    fn task_images(&self, images: usize) -> Option<usize> {
+        let chunks = images.div_ceil(self.chunk);
+        (chunks >= MIN_CHUNKS_FOR_TASKS).then(|| chunks.div_ceil(TASKS) * self.chunk)
+    }
+
+    fn scratch(&self, images: usize) -> Vec<f32> {
+        vec![0.0; self.chunk.min(images) * self.grids.positions() * self.grids.window()]
+    }
+
     /// `x`: `images` inputs (NHWC) → their outputs (NHWC).
     pub fn forward(&self, x: &[f32], images: usize) -> Vec<f32> {
         debug_assert_eq!(x.len(), images * self.input_len());
         let g = &self.grids;
-        let (window, positions) = (g.window(), g.positions());
-        let chunk = self.chunk;
-        let mut col = zeros(chunk.min(images) * positions * window);
-        match self.direction {
-            Direction::Down => {
-                let mut y = repeat_row(&self.bias, images * positions);
-                for (x, y) in x.chunks(chunk * g.big_len()).zip(y.chunks_mut(chunk * g.small_len())) {
-                    self.windows_times_weight(x, &mut col, y, Accum::Add);
+        let (input_len, output_len) = (self.input_len(), self.output_len());
+        let bias_rows = match self.direction {
+            Direction::Down => images * g.positions(),
+            Direction::Up => images * g.big_side * g.big_side,
+        };
+        let mut y = repeat_row(&self.bias, bias_rows);
+        let run = |x: &[f32], y: &mut [f32], split: bool| {
+            let mut col = self.scratch(x.len() / input_len.max(1));
+            for (x, y) in x.chunks(self.chunk * input_len).zip(y.chunks_mut(self.chunk * output_len)) {
+                match self.direction {
+                    Direction::Down => self.windows_times_weight(x, &mut col, y, Accum::Add, split),
+                    Direction::Up => self.spread_onto_windows(x, &mut col, y, split),
                 }
-                y
             }
-            Direction::Up => {
-                let mut y = repeat_row(&self.bias, images * g.big_side * g.big_side);
-                for (x, y) in x.chunks(chunk * g.small_len()).zip(y.chunks_mut(chunk * g.big_len())) {
-                    self.spread_onto_windows(x, &mut col, y);
-                }
-                y
-            }
+        };
+        match self.task_images(images) {
+            Some(task) => y
+                .par_chunks_mut(task * output_len)
+                .zip(x.par_chunks(task * input_len))
+                .for_each(|(y, x)| run(x, y, false)),
+            None => run(x, &mut y, true),
         }
+        y
     }
 
     /// small (rows × small channels) [+]= im2col(big) · W̃ᵀ: a convolution, and a transposed convolution's
     /// input gradient. `col` is scratch of at least rows × window.
-    fn windows_times_weight(&self, big: &[f32], col: &mut [f32], small: &mut [f32], accum: Accum) {
+    fn windows_times_weight(&self, big: &[f32], col: &mut [f32], small: &mut [f32], accum: Accum, split: bool) {
         let rows = small.len() / self.grids.small_channels;
         let col = &mut col[..rows * self.grids.window()];
-        self.grids.gather(big, col);
-        self.columns_times_weight(col, small, accum);
+        self.grids.gather(big, col, split);
+        self.columns_times_weight(col, small, accum, split);
     }
 
     /// small [+]= col · W̃ᵀ for windows already gathered into `col` (rows × window).
-    fn columns_times_weight(&self, col: &[f32], small: &mut [f32], accum: Accum) {
+    fn columns_times_weight(&self, col: &[f32], small: &mut [f32], accum: Accum, split: bool) {
         let (window, channels) = (self.grids.window(), self.grids.small_channels);
         let rows = small.len() / channels;
-        matmul(
+        product(
             view_mut(small, rows, channels),
             accum,
             view(col, rows, window),
             view(&self.weight, channels, window).transpose(),
+            split,
         );
     }
 
     /// big += col2im(small · W̃), the adjoint of [`Self::windows_times_weight`]: a transposed convolution, and
     /// a convolution's input gradient.
-    fn spread_onto_windows(&self, small: &[f32], col: &mut [f32], big: &mut [f32]) {
+    fn spread_onto_windows(&self, small: &[f32], col: &mut [f32], big: &mut [f32], split: bool) {
         let (window, channels) = (self.grids.window(), self.grids.small_channels);
         let rows = small.len() / channels;
         let col = &mut col[..rows * window];
-        matmul(
+        product(
             view_mut(col, rows, window),
             Accum::Replace,
             view(small, rows, channels),
             view(&self.weight, channels, window),
+            split,
         );
-        self.grids.scatter_add(col, big);
+        self.grids.scatter_add(col, big, split);
+    }
+
+    /// The weight gradient (W̃'s layout) of one run of chunks, with their input gradients written to `dx` when
+    /// it is not empty.
+    fn backward_chunks(&self, small_grid: &[f32], big_grid: &[f32], dx: &mut [f32], split: bool) -> Vec<f32> {
+        let g = &self.grids;
+        let (window, small) = (g.window(), g.small_channels);
+        let mut col = self.scratch(small_grid.len() / g.small_len().max(1));
+        let mut weight_grad = vec![0.0f32; small * window];
+        let small_chunks = small_grid.chunks(self.chunk * g.small_len());
+        for (index, (small_part, big_part)) in small_chunks.zip(big_grid.chunks(self.chunk * g.big_len())).enumerate() {
+            let rows = small_part.len() / small;
+            let col = &mut col[..rows * window];
+            // The small grid's values times the big grid's windows: the weight gradient in both directions.
+            g.gather(big_part, col, split);
+            product(
+                view_mut(&mut weight_grad, small, window),
+                Accum::Add,
+                view(small_part, rows, small).transpose(),
+                view(col, rows, window),
+                split,
+            );
+            if dx.is_empty() {
+                continue;
+            }
+            let images = small_part.len() / g.small_len();
+            let dx = &mut dx[index * self.chunk * self.input_len()..][..images * self.input_len()];
+            match self.direction {
+                Direction::Down => self.spread_onto_windows(small_part, col, dx, split),
+                // `col` holds this chunk's windows of dy already, gathered for the weight gradient.
+                Direction::Up => self.columns_times_weight(col, dx, Accum::Replace, split),
+            }
+        }
+        weight_grad
     }
 
     /// Adds the weight and bias gradients for output gradients `dy` at inputs `x` to `grads` (torch's layout)
@@ -235,39 +323,36 @@ impl StridedConv {
         debug_assert_eq!(x.len(), images * self.input_len());
         debug_assert_eq!(dy.len(), images * self.output_len());
         let g = &self.grids;
-        let (window, positions, small) = (g.window(), g.positions(), g.small_channels);
-        let chunk = self.chunk;
-        let mut col = zeros(chunk.min(images) * positions * window);
-        let mut weight_grad = vec![0.0f32; small * window];
         let mut dx = if want_dx { zeros(x.len()) } else { Vec::new() };
         let (small_grid, big_grid) = match self.direction {
             Direction::Down => (dy, x),
             Direction::Up => (x, dy),
         };
-        let small_chunks = small_grid.chunks(chunk * g.small_len());
-        for (index, (small_part, big_part)) in small_chunks.zip(big_grid.chunks(chunk * g.big_len())).enumerate() {
-            let rows = small_part.len() / small;
-            let col = &mut col[..rows * window];
-            // The small grid's values times the big grid's windows: the weight gradient in both directions.
-            g.gather(big_part, col);
-            matmul(
-                view_mut(&mut weight_grad, small, window),
-                Accum::Add,
-                view(small_part, rows, small).transpose(),
-                view(col, rows, window),
-            );
-            if !want_dx {
-                continue;
+        let sums = match self.task_images(images) {
+            None => vec![self.backward_chunks(small_grid, big_grid, &mut dx, true)],
+            Some(task) => {
+                let tasks = images.div_ceil(task);
+                let dx_parts: Vec<&mut [f32]> = match want_dx {
+                    true => dx.chunks_mut(task * self.input_len()).collect(),
+                    false => (0..tasks).map(|_| <&mut [f32]>::default()).collect(),
+                };
+                dx_parts
+                    .into_par_iter()
+                    .zip(small_grid.par_chunks(task * g.small_len()))
+                    .zip(big_grid.par_chunks(task * g.big_len()))
+                    .map(|((dx, small_part), big_part)| self.backward_chunks(small_part, big_part, dx, false))
+                    .collect()
             }
-            let dx = &mut dx[index * chunk * self.input_len()..][..small_part.len() / g.small_len() * self.input_len()];
-            match self.direction {
-                Direction::Down => self.spread_onto_windows(small_part, col, dx),
-                // `col` holds this chunk's windows of dy already, gathered for the weight gradient.
-                Direction::Up => self.columns_times_weight(col, dx, Accum::Replace),
-            }
-        }
+        };
         let torch_grad = &mut grads[self.weight_index];
-        add_torch_layout(torch_grad, &weight_grad, small, g.big_channels, g.kernel * g.kernel);
+        let mut sums = sums.into_iter();
+        let mut weight_grad = sums.next().unwrap_or_default();
+        for sum in sums {
+            weight_grad.iter_mut().zip(&sum).for_each(|(w, s)| *w += s);
+        }
+        if !weight_grad.is_empty() {
+            add_torch_layout(torch_grad, &weight_grad, g.small_channels, g.big_channels, g.kernel * g.kernel);
+        }
         add_column_sums(&mut grads[self.bias_index], dy);
         dx
     }
@@ -392,7 +477,9 @@ mod tests {
         }
     }
 
-    /// A batch split over several im2col buffers gives what one buffer gives, in both directions.
+    /// A batch split over several im2col buffers gives what one buffer gives, in both directions, whether the
+    /// chunks run in turn (two-image chunks) or as parallel tasks (one-image chunks, one task each);
+    /// and the tasks give the same bytes on any number of threads.
     #[test]
     fn chunked_batches_match_one_chunk() {
         let device = training_device();
@@ -406,17 +493,31 @@ mod tests {
             (up, Grids::conv_transpose(4, 4, 3, 4, 2), Direction::Up),
         ] {
             let whole = StridedConv::new(&params, "layer", grids, direction).unwrap();
-            let mut chunked = StridedConv::new(&params, "layer", grids, direction).unwrap();
-            assert!(whole.chunk >= images);
-            chunked.chunk = 2;
+            assert!(whole.chunk >= images && whole.task_images(images).is_none());
             let x: Vec<f32> = (0..images * whole.input_len()).map(|_| rng.random_range(-1.0..1.0)).collect();
             let dy: Vec<f32> = (0..images * whole.output_len()).map(|_| rng.random_range(-1.0..1.0)).collect();
-            close(&chunked.forward(&x, images), &whole.forward(&x, images), "output");
             let (mut whole_grads, mut chunked_grads) = (zero_gradients(&params), zero_gradients(&params));
             let dx_whole = whole.backward(&x, &dy, images, &mut whole_grads, true);
-            close(&chunked.backward(&x, &dy, images, &mut chunked_grads, true), &dx_whole, "dx");
-            for (ours, theirs) in chunked_grads.iter().zip(&whole_grads) {
-                close(ours, theirs, "parameter gradient");
+            for (chunk, tasks) in [(2, false), (1, true)] {
+                let mut chunked = StridedConv::new(&params, "layer", grids, direction).unwrap();
+                chunked.chunk = chunk;
+                assert_eq!(chunked.task_images(images).is_some(), tasks);
+                close(&chunked.forward(&x, images), &whole.forward(&x, images), "output");
+                chunked_grads.iter_mut().for_each(|g| g.fill(0.0));
+                close(&chunked.backward(&x, &dy, images, &mut chunked_grads, true), &dx_whole, "dx");
+                for (ours, theirs) in chunked_grads.iter().zip(&whole_grads) {
+                    close(ours, theirs, "parameter gradient");
+                }
+                let on_threads = |threads| {
+                    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+                    pool.install(|| {
+                        let mut grads = zero_gradients(&params);
+                        let dx = chunked.backward(&x, &dy, images, &mut grads, true);
+                        (chunked.forward(&x, images), dx, grads)
+                    })
+                };
+                let one = on_threads(1);
+                assert!(on_threads(2) == one && on_threads(3) == one, "chunk {chunk}: bytes depend on the threads");
             }
         }
     }

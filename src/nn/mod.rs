@@ -8,6 +8,7 @@
 pub mod activation;
 pub mod adam;
 pub mod backprop;
+pub mod blocked_conv;
 pub mod conv;
 pub mod conv_backprop;
 pub mod dense;

@@ -1,4 +1,5 @@
-//! The image VAE's training step written out over flat f32 buffers: its convolutions as im2col GEMMs
+//! The image VAE's training step written out over flat f32 buffers: its first convolution as GEMMs straight
+//! over the frames regrouped into blocks (`nn::blocked_conv`), the others as im2col GEMMs
 //! (`nn::conv_backprop`), its heads as dense layers, the Bernoulli reconstruction and entropy terms in closed
 //! form, and the GP terms' latent gradients added where the burn path injects them. Both observations go
 //! through the encoder as one batch of 2B images. `model.rs` keeps the burn graph as the reference: a test holds
@@ -12,10 +13,9 @@ use super::vae::{FRAME_CHANNELS, FRAME_SIDE, STD_FLOOR, STD_SHIFT};
 use crate::error::{Error, Result};
 use crate::models::gp::GpHypers;
 use crate::nn::activation::{fast_sigmoid, fast_softplus};
-use crate::nn::backprop::{add_into, relu_backward, relu_in_place, zero_gradients, zeros, Dense};
-use crate::nn::conv_backprop::{
-    to_channels_first, to_channels_last, to_channels_last_into, Direction, Grids, StridedConv,
-};
+use crate::nn::backprop::{add_into, relu_backward, relu_in_place, zero_gradients, Dense};
+use crate::nn::blocked_conv::{BlockedConv, BlockedInput};
+use crate::nn::conv_backprop::{to_channels_first, to_channels_last, Direction, Grids, StridedConv};
 use crate::nn::ParamSet;
 
 /// Channels of the encoder's four convolutions (Table A.1) and of the decoder's transposed ones (Table A.2).
@@ -28,6 +28,9 @@ const FLAT: usize = 1024;
 
 /// The convolutional VAE's layers over a parameter set named as `VaeNet::params` names them.
 pub struct ConvVaeGrad<'a> {
+    /// The first convolution reads the frames themselves, regrouped into blocks.
+    first: BlockedConv,
+    /// The other three.
     encoder: Vec<StridedConv>,
     /// Channels and side of the encoder's last grid, flattened channels-first into the heads' input.
     encoder_out: (usize, usize),
@@ -39,7 +42,7 @@ pub struct ConvVaeGrad<'a> {
 
 /// What the encoder's forward pass keeps for its backward pass.
 struct EncoderTape {
-    /// The input frames and every ReLU'd convolution output, channels-last.
+    /// Every ReLU'd convolution output, channels-last.
     grids: Vec<Vec<f32>>,
     /// The last grid flattened channels-first, as the heads read it.
     flat: Vec<f32>,
@@ -54,9 +57,11 @@ struct DecoderTape {
 
 impl<'a> ConvVaeGrad<'a> {
     pub fn new(params: &'a ParamSet, latent: usize) -> Result<Self> {
+        let channels = (FRAME_CHANNELS, ENCODER_CHANNELS[0]);
+        let first = BlockedConv::new(params, "encoder.conv1", FRAME_SIDE, channels, KERNEL, STRIDE)?;
         let mut encoder = Vec::new();
-        let (mut side, mut channels) = (FRAME_SIDE, FRAME_CHANNELS);
-        for (i, &out) in ENCODER_CHANNELS.iter().enumerate() {
+        let (mut side, mut channels) = (first.out_side(), ENCODER_CHANNELS[0]);
+        for (i, &out) in ENCODER_CHANNELS.iter().enumerate().skip(1) {
             let grids = Grids::conv(side, channels, out, KERNEL, STRIDE);
             encoder.push(StridedConv::new(params, &format!("encoder.conv{}", i + 1), grids, Direction::Down)?);
             (side, channels) = (grids.small_side, out);
@@ -77,14 +82,17 @@ impl<'a> ConvVaeGrad<'a> {
             mean: Dense::new(params, "encoder.mean", flat, latent, false)?,
             std: Dense::new(params, "encoder.std", flat, latent, false)?,
             fc: Dense::new(params, "decoder.fc", latent, FLAT, false)?,
+            first,
             encoder,
             decoder,
         })
     }
 
-    /// Frames [images, 6, 64, 64] (channels-first rows) → encoder (mean, std) and the tape.
-    fn encode(&self, frames: Vec<f32>, images: usize) -> (Vec<f32>, Vec<f32>, EncoderTape) {
-        let mut grids = vec![frames];
+    /// Frames regrouped for the first convolution → encoder (mean, std) and the tape.
+    fn encode(&self, frames: &BlockedInput, images: usize) -> (Vec<f32>, Vec<f32>, EncoderTape) {
+        let mut first = self.first.forward(frames);
+        relu_in_place(&mut first);
+        let mut grids = vec![first];
         for layer in &self.encoder {
             let mut y = layer.forward(grids.last().expect("the frames at least"), images);
             relu_in_place(&mut y);
@@ -100,6 +108,7 @@ impl<'a> ConvVaeGrad<'a> {
 
     fn encode_backward(
         &self,
+        frames: &BlockedInput,
         tape: &EncoderTape,
         d_mean: &[f32],
         mut d_std: Vec<f32>,
@@ -116,8 +125,10 @@ impl<'a> ConvVaeGrad<'a> {
         let mut d = to_channels_last(&d_flat, channels, side);
         for (i, layer) in self.encoder.iter().enumerate().rev() {
             relu_backward(&mut d, &tape.grids[i + 1]);
-            d = layer.backward(&tape.grids[i], &d, images, grads, i > 0);
+            d = layer.backward(&tape.grids[i], &d, images, grads, true);
         }
+        relu_backward(&mut d, &tape.grids[0]);
+        self.first.backward(frames, &d, grads);
     }
 
     /// Latents [rows, L] → pixel logits, channels-last [rows, 64, 64, 6], and the tape.
@@ -198,17 +209,14 @@ pub fn images_loss_and_gradients(
     if batch.obs.len() != rows * width || batch.next_obs.len() != rows * width {
         return Err(Error::data(format!("DLGPD batch: {rows} rows of frames need {width} values each")));
     }
-    let mut frames = zeros(2 * rows * width);
-    let (current, next) = frames.split_at_mut(rows * width);
-    to_channels_last_into(&batch.obs, FRAME_CHANNELS, FRAME_SIDE, current);
-    to_channels_last_into(&batch.next_obs, FRAME_CHANNELS, FRAME_SIDE, next);
-    let (mean, std, tape) = net.encode(frames, 2 * rows);
+    let frames = net.first.regroup(&[&batch.obs, &batch.next_obs]);
+    let (mean, std, tape) = net.encode(&frames, 2 * rows);
     let eps = noise.0.iter().chain(noise.1);
     let samples: Vec<f32> = mean.iter().zip(&std).zip(eps).map(|((m, s), e)| m + s * e).collect();
     let (sample, next_sample) = samples.split_at(rows * latent);
     let next_std = &std[rows * latent..];
 
-    let targets = &tape.grids[0][rows * width..];
+    let targets = &to_channels_last(&batch.next_obs, FRAME_CHANNELS, FRAME_SIDE);
     let inv_rows = 1.0 / rows.max(1) as f64;
     // The decoder's passes and the GPs (f64 Cholesky factorizations, a tenth of a batch-1024 step) need only the
     // samples, so they run side by side.
@@ -251,7 +259,7 @@ pub fn images_loss_and_gradients(
                 .enumerate()
                 .map(|(i, ((d, e), s))| d * e - if i >= rows * latent { 0.5 * inv_rows as f32 / s } else { 0.0 })
                 .collect();
-            net.encode_backward(&tape, &d_mean, d_std, 2 * rows, &mut grads);
+            net.encode_backward(&frames, &tape, &d_mean, d_std, 2 * rows, &mut grads);
             grads
         }
     };

@@ -1,0 +1,349 @@
+//! A strided convolution whose kernel is a whole number of strides, run without an im2col matrix. Its input is
+//! regrouped once into stride × stride blocks ("space to depth"); the layer is then a stride-1 convolution with
+//! a (kernel / stride)² kernel over blocks, and one kernel row of it, over every output position of an image, is
+//! a single GEMM whose left operand is the regrouped image itself, read one block apart (its rows overlap).
+//!
+//! DLGPD's first encoder layer (64 × 64 × 6 frames, kernel 4, stride 2, 32 channels) is why: im2col spends
+//! most of that layer gathering 24-float pieces into a matrix 16 times the frames' size, and its 96 × 32 GEMM is
+//! too thin to hide the gather.
+//!
+//! Output positions are computed on the block grid, so each image's GEMM also yields the last block column and
+//! row, which no kernel window fits; those rows are dropped when the output is written, and zeroed in the
+//! output gradient before the weight gradient reads them. Images are independent and the weight gradient is
+//! summed over fixed groups of images in a fixed order, so the bytes do not depend on the thread count.
+
+use faer::{Accum, MatRef, Par};
+use rayon::prelude::*;
+
+use super::backprop::{add_column_sums, assume_written, filled, slots, tensor_index, unwritten, view, view_mut};
+use super::params::ParamSet;
+use crate::error::{Error, Result};
+
+/// Images whose weight gradients one task sums; the groups' sums are then added in order. Small groups keep both
+/// threads busy at DLGPD's batches, large ones keep few partial sums.
+const GRADIENT_GROUP: usize = 4;
+
+/// A convolution (torch's Conv2d without padding, weight [out, in, k, k]) over channels-first square images.
+pub struct BlockedConv {
+    side: usize,
+    channels_in: usize,
+    channels_out: usize,
+    stride: usize,
+    /// Blocks per side of the regrouped input.
+    blocks: usize,
+    /// Kernel side in blocks.
+    taps: usize,
+    out_side: usize,
+    /// For each kernel row of blocks a, the [(b, py, px, c), out] matrix that one GEMM multiplies with; the
+    /// rows of a follow those of a − 1.
+    weight: Vec<f32>,
+    bias: Vec<f32>,
+    weight_index: usize,
+    bias_index: usize,
+}
+
+/// Images regrouped into blocks for a [`BlockedConv`], kept for its backward pass.
+pub struct BlockedInput {
+    values: Vec<f32>,
+    images: usize,
+}
+
+impl BlockedConv {
+    /// The layer `prefix` (`prefix.weight`, `prefix.bias`) of `params`, over `side`² × `channels_in` images.
+    pub fn new(
+        params: &ParamSet,
+        prefix: &str,
+        side: usize,
+        (channels_in, channels_out): (usize, usize),
+        kernel: usize,
+        stride: usize,
+    ) -> Result<Self> {
+        if stride == 0 || kernel == 0 || !kernel.is_multiple_of(stride) || !side.is_multiple_of(stride) || kernel > side
+        {
+            return Err(Error::config(format!(
+                "'{prefix}': a blocked convolution needs a kernel that is a multiple of the stride and fits the \
+                 side, and a side that is a multiple of the stride; got side {side}, kernel {kernel}, stride {stride}"
+            )));
+        }
+        let weight_index =
+            tensor_index(params, &format!("{prefix}.weight"), &[channels_out, channels_in, kernel, kernel])?;
+        let bias_index = tensor_index(params, &format!("{prefix}.bias"), &[channels_out])?;
+        let (blocks, taps) = (side / stride, kernel / stride);
+        let torch = &params.tensors[weight_index].values;
+        let mut layer = BlockedConv {
+            side,
+            channels_in,
+            channels_out,
+            stride,
+            blocks,
+            taps,
+            out_side: (side - kernel) / stride + 1,
+            weight: vec![0.0; kernel * kernel * channels_in * channels_out],
+            bias: params.tensors[bias_index].values.clone(),
+            weight_index,
+            bias_index,
+        };
+        let rows: Vec<(usize, usize)> = layer.weight_rows().collect();
+        for (row, torch_index) in rows {
+            layer.weight[row * channels_out..][..channels_out]
+                .iter_mut()
+                .enumerate()
+                .for_each(|(o, w)| *w = torch[o * channels_in * kernel * kernel + torch_index]);
+        }
+        Ok(layer)
+    }
+
+    /// Each row of `weight` with the offset of its (channel, ky, kx) within one output channel of torch's layout.
+    fn weight_rows(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
+        let (s, c, k) = (self.stride, self.channels_in, self.taps * self.stride);
+        (0..self.taps * self.row_width()).map(move |row| {
+            let (a, within) = (row / self.row_width(), row % self.row_width());
+            let (b, within) = (within / self.depth(), within % self.depth());
+            let (py, px, channel) = (within / (s * c), within / c % s, within % c);
+            (row, (channel * k + a * s + py) * k + b * s + px)
+        })
+    }
+
+    /// Values per block: stride² pixels of every channel.
+    fn depth(&self) -> usize {
+        self.stride * self.stride * self.channels_in
+    }
+
+    /// Columns of one kernel row's GEMM: `taps` consecutive blocks.
+    fn row_width(&self) -> usize {
+        self.taps * self.depth()
+    }
+
+    fn blocked_len(&self) -> usize {
+        self.blocks * self.blocks * self.depth()
+    }
+
+    /// Rows of one image's GEMM: every block column of the output's block rows.
+    fn gemm_rows(&self) -> usize {
+        self.out_side * self.blocks
+    }
+
+    pub fn input_len(&self) -> usize {
+        self.side * self.side * self.channels_in
+    }
+
+    /// Values per image of the output, channels-last [out side, out side, channels out].
+    pub fn output_len(&self) -> usize {
+        self.out_side * self.out_side * self.channels_out
+    }
+
+    pub fn out_side(&self) -> usize {
+        self.out_side
+    }
+
+    /// Regroups channels-first `frames` ([images, channels, side, side], given as consecutive parts) into
+    /// blocks: value (channel, y, x) goes to block (y / s, x / s) at ((y % s) · s + x % s) · channels + channel.
+    /// The last image's final GEMM rows read up to `taps` − 1 blocks past its end, so zeros follow it.
+    pub fn regroup(&self, parts: &[&[f32]]) -> BlockedInput {
+        let images: usize = parts.iter().map(|p| p.len() / self.input_len().max(1)).sum();
+        debug_assert!(parts.iter().all(|p| p.len() % self.input_len() == 0));
+        let frames = || parts.iter().flat_map(|p| p.chunks(self.input_len()));
+        let padding = (self.taps - 1) * self.depth();
+        let image_len = self.blocked_len();
+        let (s, c, side, depth) = (self.stride, self.channels_in, self.side, self.depth());
+        let frames: Vec<&[f32]> = frames().collect();
+        let values = filled(images * image_len + padding, image_len, |start, out| {
+            for (i, out) in out.chunks_mut(image_len).enumerate() {
+                let Some(frame) = frames.get(start / image_len + i) else {
+                    out.iter_mut().for_each(|slot| _ = slot.write(0.0));
+                    continue;
+                };
+                for channel in 0..c {
+                    for y in 0..side {
+                        let row = &frame[(channel * side + y) * side..][..side];
+                        let block_row = (y / s) * self.blocks;
+                        let within_row = (y % s) * s * c + channel;
+                        for (x, &value) in row.iter().enumerate() {
+                            out[(block_row + x / s) * depth + within_row + (x % s) * c].write(value);
+                        }
+                    }
+                }
+            }
+        });
+        BlockedInput { values, images }
+    }
+
+    /// One image's GEMM rows for kernel row `a`: row (Y, X) is `taps` blocks from block (Y + a, X) on.
+    fn kernel_row_operand<'a>(&self, input: &'a BlockedInput, image: usize, a: usize, rows: usize) -> MatRef<'a, f32> {
+        let depth = self.depth();
+        let start = image * self.blocked_len() + a * self.blocks * depth;
+        let end = start + (rows - 1) * depth + self.row_width();
+        assert!(end <= input.values.len(), "a blocked operand past its buffer's padding");
+        // SAFETY: every element read, at start + r · depth + j for r < rows and j < row_width, lies below `end`,
+        // which is inside the buffer; the view is read-only, so its overlapping rows alias nothing written.
+        unsafe { MatRef::from_raw_parts(input.values.as_ptr().add(start), rows, self.row_width(), depth as isize, 1) }
+    }
+
+    fn kernel_row_weight(&self, a: usize) -> MatRef<'_, f32> {
+        let len = self.row_width() * self.channels_out;
+        view(&self.weight[a * len..][..len], self.row_width(), self.channels_out)
+    }
+
+    /// The layer's outputs before any activation, channels-last, bias added.
+    pub fn forward(&self, input: &BlockedInput) -> Vec<f32> {
+        let (out, rows) = (self.channels_out, self.gemm_rows());
+        let fill_image = |image: usize, y: &mut [std::mem::MaybeUninit<f32>], product: &mut [f32]| {
+            for a in 0..self.taps {
+                let accum = if a == 0 { Accum::Replace } else { Accum::Add };
+                let operand = self.kernel_row_operand(input, image, a, rows);
+                let product = view_mut(product, rows, out);
+                faer::linalg::matmul::matmul(product, accum, operand, self.kernel_row_weight(a), 1.0f32, Par::Seq);
+            }
+            for (position, slots) in y.chunks_mut(out).enumerate() {
+                let row = (position / self.out_side) * self.blocks + position % self.out_side;
+                let values = &product[row * out..][..out];
+                slots.iter_mut().zip(values.iter().zip(&self.bias)).for_each(|(slot, (v, b))| _ = slot.write(v + b));
+            }
+        };
+        if self.output_len() == 0 {
+            return Vec::new();
+        }
+        let mut y = unwritten(input.images * self.output_len());
+        slots(&mut y, input.images * self.output_len())
+            .par_chunks_mut(self.output_len())
+            .enumerate()
+            .for_each_init(|| vec![0.0f32; rows * out], |product, (image, y)| fill_image(image, y, product));
+        // SAFETY: every image's chunk was written in full above: each of its positions is one row of `out`.
+        unsafe { assume_written(&mut y, input.images * self.output_len()) };
+        y
+    }
+
+    /// Adds the weight and bias gradients for output gradients `dy` (channels-last, as `forward` returns) to
+    /// `grads` (torch's layout). The input gradient is not formed: this layer reads the data.
+    pub fn backward(&self, input: &BlockedInput, dy: &[f32], grads: &mut [Vec<f32>]) {
+        debug_assert_eq!(dy.len(), input.images * self.output_len());
+        let (out, rows) = (self.channels_out, self.gemm_rows());
+        let group_sums: Vec<Vec<f32>> = (0..input.images.div_ceil(GRADIENT_GROUP))
+            .into_par_iter()
+            .map(|group| {
+                let mut sum = vec![0.0f32; self.weight.len()];
+                let mut padded = vec![0.0f32; rows * out];
+                let images = group * GRADIENT_GROUP..((group + 1) * GRADIENT_GROUP).min(input.images);
+                for image in images {
+                    let dy = &dy[image * self.output_len()..][..self.output_len()];
+                    for (position, values) in dy.chunks(out).enumerate() {
+                        let row = (position / self.out_side) * self.blocks + position % self.out_side;
+                        padded[row * out..][..out].copy_from_slice(values);
+                    }
+                    for a in 0..self.taps {
+                        let operand = self.kernel_row_operand(input, image, a, rows);
+                        let sum = &mut sum[a * self.row_width() * out..][..self.row_width() * out];
+                        faer::linalg::matmul::matmul(
+                            view_mut(sum, self.row_width(), out),
+                            Accum::Add,
+                            operand.transpose(),
+                            view(&padded, rows, out),
+                            1.0f32,
+                            Par::Seq,
+                        );
+                    }
+                }
+                sum
+            })
+            .collect();
+        let torch = &mut grads[self.weight_index];
+        for sum in &group_sums {
+            for (row, torch_index) in self.weight_rows() {
+                let stride = self.channels_in * self.taps * self.stride * self.taps * self.stride;
+                for (o, g) in sum[row * out..][..out].iter().enumerate() {
+                    torch[o * stride + torch_index] += g;
+                }
+            }
+        }
+        add_column_sums(&mut grads[self.bias_index], dy);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use burn::tensor::Tensor;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    use super::*;
+    use crate::nn::backprop::zero_gradients;
+    use crate::nn::conv::Conv2dConfig;
+    use crate::nn::conv_backprop::to_channels_first;
+    use crate::nn::tensor::{tensor, training_device, values};
+
+    fn close(ours: &[f32], theirs: &[f32], what: &str) {
+        assert_eq!(ours.len(), theirs.len(), "{what}");
+        let scale = theirs.iter().fold(0.0f32, |m, x| m.max(x.abs())).max(1e-3);
+        let worst = ours.iter().zip(theirs).fold(0.0f32, |m, (x, y)| m.max((x - y).abs()));
+        assert!(worst <= 1e-5 * scale, "{what}: differs by {worst} at scale {scale}");
+    }
+
+    /// Output and parameter gradients against burn's Conv2d for the loss Σ y ⊙ R, over images given in two
+    /// parts, with kernels of one, two and three strides and a side the last window does not reach.
+    #[test]
+    fn matches_burn_forward_and_backward() {
+        let device = training_device();
+        for (side, cin, cout, k, s, images) in
+            [(8, 2, 3, 4, 2, 5), (9, 3, 4, 6, 3, 3), (6, 4, 5, 2, 2, 2), (10, 1, 2, 6, 2, 7)]
+        {
+            let mut rng = ChaCha8Rng::seed_from_u64(side as u64 * 31 + k as u64);
+            let conv = Conv2dConfig::new(cin, cout, k, s).init(&device, &mut rng);
+            let x: Vec<f32> = (0..images * cin * side * side).map(|_| rng.random_range(-1.0..1.0)).collect();
+            let out_side = (side - k) / s + 1;
+            let r: Vec<f32> = (0..images * cout * out_side * out_side).map(|_| rng.random_range(-1.0..1.0)).collect();
+            let xt: Tensor<4> = tensor(x.clone(), [images, cin, side, side], &device);
+            let y = conv.forward(xt);
+            let burn_grads = (y.clone() * tensor(r.clone(), y.dims(), &device)).sum().backward();
+            let params = ParamSet::<f32>::from_module(&conv, |n: &str| format!("layer.{n}"));
+            let ours = BlockedConv::new(&params, "layer", side, (cin, cout), k, s).unwrap();
+            let split = (images / 2) * cin * side * side;
+            let input = ours.regroup(&[&x[..split], &x[split..]]);
+            let y_ours = ours.forward(&input);
+            close(&to_channels_first(&y_ours, cout, out_side), &values(&y), "output");
+            let mut grads = zero_gradients(&params);
+            let r_last = crate::nn::conv_backprop::to_channels_last(&r, cout, out_side);
+            ours.backward(&input, &r_last, &mut grads);
+            for ((t, g), theirs) in
+                params.tensors.iter().zip(&grads).zip(ParamSet::<f32>::gradients(&conv, &burn_grads))
+            {
+                close(g, &theirs, &t.name);
+            }
+        }
+    }
+
+    #[test]
+    fn refuses_kernels_that_are_not_whole_strides() {
+        let device = training_device();
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let params = ParamSet::<f32>::from_module(&Conv2dConfig::new(2, 3, 5, 2).init(&device, &mut rng), |n: &str| {
+            format!("layer.{n}")
+        });
+        let error = BlockedConv::new(&params, "layer", 8, (2, 3), 5, 2).err().expect("kernel 5 over stride 2");
+        assert!(error.to_string().contains("multiple of the stride"), "{error}");
+    }
+
+    #[test]
+    fn bytes_do_not_depend_on_the_thread_count() {
+        let device = training_device();
+        let mut rng = ChaCha8Rng::seed_from_u64(4);
+        let conv = Conv2dConfig::new(3, 8, 4, 2).init(&device, &mut rng);
+        let params = ParamSet::<f32>::from_module(&conv, |n: &str| format!("layer.{n}"));
+        let layer = BlockedConv::new(&params, "layer", 16, (3, 8), 4, 2).unwrap();
+        let images = 11;
+        let x: Vec<f32> = (0..images * layer.input_len()).map(|_| rng.random_range(-1.0..1.0)).collect();
+        let dy: Vec<f32> = (0..images * layer.output_len()).map(|_| rng.random_range(-1.0..1.0)).collect();
+        let run = |threads| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| {
+                let input = layer.regroup(&[&x]);
+                let mut grads = zero_gradients(&params);
+                layer.backward(&input, &dy, &mut grads);
+                (layer.forward(&input), grads)
+            })
+        };
+        let one = run(1);
+        for threads in [2, 3] {
+            assert!(one == run(threads), "{threads} threads");
+        }
+    }
+}
