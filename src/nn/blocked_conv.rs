@@ -158,8 +158,12 @@ impl BlockedConv {
                         let row = &frame[(channel * side + y) * side..][..side];
                         let block_row = (y / s) * self.blocks;
                         let within_row = (y % s) * s * c + channel;
-                        for (x, &value) in row.iter().enumerate() {
-                            out[(block_row + x / s) * depth + within_row + (x % s) * c].write(value);
+                        // One block of `s` pixels at a time: no division per pixel.
+                        for (block, pixels) in row.chunks(s).enumerate() {
+                            let start = (block_row + block) * depth + within_row;
+                            for (px, &value) in pixels.iter().enumerate() {
+                                out[start + px * c].write(value);
+                            }
                         }
                     }
                 }
