@@ -248,11 +248,7 @@ pub fn zip_values(dst: &mut [f32], src: &[f32], f: impl Fn(&mut f32, f32) + Sync
 
 /// A new buffer of `n` values, each written by `fill` from its block's offset, in parallel blocks when large:
 /// a fresh multi-megabyte buffer written by one thread (memset, memcpy) leaves the other core idle.
-pub(super) fn filled(
-    n: usize,
-    block: usize,
-    fill: impl Fn(usize, &mut [std::mem::MaybeUninit<f32>]) + Sync,
-) -> Vec<f32> {
+fn filled(n: usize, block: usize, fill: impl Fn(usize, &mut [std::mem::MaybeUninit<f32>]) + Sync) -> Vec<f32> {
     let mut out = Vec::with_capacity(n);
     let slots = &mut out.spare_capacity_mut()[..n];
     if n < 2 * ELEMENTWISE_BLOCK {

@@ -7,15 +7,15 @@
 //! most of that layer gathering 24-float pieces into a matrix 16 times the frames' size, and its 96 × 32 GEMM is
 //! too thin to hide the gather.
 //!
-//! Output positions are computed on the block grid, so each image's GEMM also yields the last block column and
-//! row, which no kernel window fits; those rows are dropped when the output is written, and zeroed in the
-//! output gradient before the weight gradient reads them. Images are independent and the weight gradient is
+//! Each image's GEMM runs over whole block rows, so it also yields the last `taps` − 1 block columns of each
+//! row, where no kernel window fits; those rows are dropped when the output is written, and left zero in the
+//! output gradient the weight gradient reads. Images are independent and the weight gradient is
 //! summed over fixed groups of images in a fixed order, so the bytes do not depend on the thread count.
 
 use faer::{Accum, MatRef, Par};
 use rayon::prelude::*;
 
-use super::backprop::{add_column_sums, assume_written, filled, slots, tensor_index, unwritten, view, view_mut};
+use super::backprop::{add_column_sums, add_into, assume_written, slots, tensor_index, unwritten, view, view_mut};
 use super::params::ParamSet;
 use crate::error::{Error, Result};
 
@@ -58,11 +58,18 @@ impl BlockedConv {
         kernel: usize,
         stride: usize,
     ) -> Result<Self> {
-        if stride == 0 || kernel == 0 || !kernel.is_multiple_of(stride) || !side.is_multiple_of(stride) || kernel > side
+        if channels_in == 0
+            || channels_out == 0
+            || stride == 0
+            || kernel == 0
+            || !kernel.is_multiple_of(stride)
+            || !side.is_multiple_of(stride)
+            || kernel > side
         {
             return Err(Error::config(format!(
-                "'{prefix}': a blocked convolution needs a kernel that is a multiple of the stride and fits the \
-                 side, and a side that is a multiple of the stride; got side {side}, kernel {kernel}, stride {stride}"
+                "'{prefix}': a blocked convolution needs channels, a kernel that is a multiple of the stride and \
+                 fits the side, and a side that is a multiple of the stride; got side {side}, kernel {kernel}, \
+                 stride {stride}, channels {channels_in} → {channels_out}"
             )));
         }
         let weight_index =
@@ -139,37 +146,49 @@ impl BlockedConv {
     /// Regroups channels-first `frames` ([images, channels, side, side], given as consecutive parts) into
     /// blocks: value (channel, y, x) goes to block (y / s, x / s) at ((y % s) · s + x % s) · channels + channel.
     /// The last image's final GEMM rows read up to `taps` − 1 blocks past its end, so zeros follow it.
-    pub fn regroup(&self, parts: &[&[f32]]) -> BlockedInput {
-        let images: usize = parts.iter().map(|p| p.len() / self.input_len().max(1)).sum();
-        debug_assert!(parts.iter().all(|p| p.len() % self.input_len() == 0));
-        let frames = || parts.iter().flat_map(|p| p.chunks(self.input_len()));
-        let padding = (self.taps - 1) * self.depth();
-        let image_len = self.blocked_len();
+    pub fn regroup(&self, parts: &[&[f32]]) -> Result<BlockedInput> {
+        if let Some(part) = parts.iter().find(|p| p.len() % self.input_len() != 0) {
+            return Err(Error::data(format!(
+                "{} values are not whole {} × {} × {} images",
+                part.len(),
+                self.channels_in,
+                self.side,
+                self.side
+            )));
+        }
+        let frames: Vec<&[f32]> = parts.iter().flat_map(|p| p.chunks(self.input_len())).collect();
+        let (image_len, padding) = (self.blocked_len(), (self.taps - 1) * self.depth());
+        let len = frames.len() * image_len + padding;
+        let mut values = unwritten(len);
+        let (image_slots, padding_slots) = slots(&mut values, len).split_at_mut(frames.len() * image_len);
+        image_slots.par_chunks_mut(image_len).zip(&frames).for_each(|(out, frame)| self.regroup_image(frame, out));
+        padding_slots.iter_mut().for_each(|slot| _ = slot.write(0.0));
+        // SAFETY: regroup_image writes every slot of its image (the map is one-to-one onto them), and the
+        // padding was written just above.
+        unsafe { assume_written(&mut values, len) };
+        Ok(BlockedInput { values, images: frames.len() })
+    }
+
+    fn regroup_image(&self, frame: &[f32], out: &mut [std::mem::MaybeUninit<f32>]) {
         let (s, c, side, depth) = (self.stride, self.channels_in, self.side, self.depth());
-        let frames: Vec<&[f32]> = frames().collect();
-        let values = filled(images * image_len + padding, image_len, |start, out| {
-            for (i, out) in out.chunks_mut(image_len).enumerate() {
-                let Some(frame) = frames.get(start / image_len + i) else {
-                    out.iter_mut().for_each(|slot| _ = slot.write(0.0));
-                    continue;
-                };
-                for channel in 0..c {
-                    for y in 0..side {
-                        let row = &frame[(channel * side + y) * side..][..side];
-                        let block_row = (y / s) * self.blocks;
-                        let within_row = (y % s) * s * c + channel;
-                        // One block of `s` pixels at a time: no division per pixel.
-                        for (block, pixels) in row.chunks(s).enumerate() {
-                            let start = (block_row + block) * depth + within_row;
-                            for (px, &value) in pixels.iter().enumerate() {
-                                out[start + px * c].write(value);
-                            }
-                        }
+        for channel in 0..c {
+            for y in 0..side {
+                let row = &frame[(channel * side + y) * side..][..side];
+                let (block_row, within_row) = ((y / s) * self.blocks, (y % s) * s * c + channel);
+                // One block of `s` pixels at a time: no division per pixel.
+                for (block, pixels) in row.chunks(s).enumerate() {
+                    let first = (block_row + block) * depth + within_row;
+                    for (px, &value) in pixels.iter().enumerate() {
+                        out[first + px * c].write(value);
                     }
                 }
             }
-        });
-        BlockedInput { values, images }
+        }
+    }
+
+    /// The GEMM row of output position `position` (row-major over out side × out side).
+    fn gemm_row(&self, position: usize) -> usize {
+        (position / self.out_side) * self.blocks + position % self.out_side
     }
 
     /// One image's GEMM rows for kernel row `a`: row (Y, X) is `taps` blocks from block (Y + a, X) on.
@@ -199,8 +218,7 @@ impl BlockedConv {
                 faer::linalg::matmul::matmul(product, accum, operand, self.kernel_row_weight(a), 1.0f32, Par::Seq);
             }
             for (position, slots) in y.chunks_mut(out).enumerate() {
-                let row = (position / self.out_side) * self.blocks + position % self.out_side;
-                let values = &product[row * out..][..out];
+                let values = &product[self.gemm_row(position) * out..][..out];
                 slots.iter_mut().zip(values.iter().zip(&self.bias)).for_each(|(slot, (v, b))| _ = slot.write(v + b));
             }
         };
@@ -231,8 +249,7 @@ impl BlockedConv {
                 for image in images {
                     let dy = &dy[image * self.output_len()..][..self.output_len()];
                     for (position, values) in dy.chunks(out).enumerate() {
-                        let row = (position / self.out_side) * self.blocks + position % self.out_side;
-                        padded[row * out..][..out].copy_from_slice(values);
+                        padded[self.gemm_row(position) * out..][..out].copy_from_slice(values);
                     }
                     for a in 0..self.taps {
                         let operand = self.kernel_row_operand(input, image, a, rows);
@@ -250,13 +267,14 @@ impl BlockedConv {
                 sum
             })
             .collect();
+        let mut group_sums = group_sums.into_iter();
+        let Some(mut sum) = group_sums.next() else { return };
+        group_sums.for_each(|group| add_into(&mut sum, &group));
         let torch = &mut grads[self.weight_index];
-        for sum in &group_sums {
-            for (row, torch_index) in self.weight_rows() {
-                let stride = self.channels_in * self.taps * self.stride * self.taps * self.stride;
-                for (o, g) in sum[row * out..][..out].iter().enumerate() {
-                    torch[o * stride + torch_index] += g;
-                }
+        let per_output = self.channels_in * self.taps * self.stride * self.taps * self.stride;
+        for (row, torch_index) in self.weight_rows() {
+            for (o, g) in sum[row * out..][..out].iter().enumerate() {
+                torch[o * per_output + torch_index] += g;
             }
         }
         add_column_sums(&mut grads[self.bias_index], dy);
@@ -283,7 +301,7 @@ mod tests {
     }
 
     /// Output and parameter gradients against burn's Conv2d for the loss Σ y ⊙ R, over images given in two
-    /// parts, with kernels of one, two and three strides and a side the last window does not reach.
+    /// parts, with kernels of one, two and three strides.
     #[test]
     fn matches_burn_forward_and_backward() {
         let device = training_device();
@@ -301,7 +319,7 @@ mod tests {
             let params = ParamSet::<f32>::from_module(&conv, |n: &str| format!("layer.{n}"));
             let ours = BlockedConv::new(&params, "layer", side, (cin, cout), k, s).unwrap();
             let split = (images / 2) * cin * side * side;
-            let input = ours.regroup(&[&x[..split], &x[split..]]);
+            let input = ours.regroup(&[&x[..split], &x[split..]]).unwrap();
             let y_ours = ours.forward(&input);
             close(&to_channels_first(&y_ours, cout, out_side), &values(&y), "output");
             let mut grads = zero_gradients(&params);
@@ -339,7 +357,7 @@ mod tests {
         let run = |threads| {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             pool.install(|| {
-                let input = layer.regroup(&[&x]);
+                let input = layer.regroup(&[&x]).unwrap();
                 let mut grads = zero_gradients(&params);
                 layer.backward(&input, &dy, &mut grads);
                 (layer.forward(&input), grads)
@@ -349,5 +367,43 @@ mod tests {
         for threads in [2, 3] {
             assert!(one == run(threads), "{threads} threads");
         }
+    }
+
+    /// The im2col layer's output and gradients on DLGPD's layer shape and on kernels of one and three blocks,
+    /// with batches of several weight-gradient groups whose last group is partial.
+    #[test]
+    fn matches_the_im2col_layer_on_larger_batches() {
+        let device = training_device();
+        for (side, cin, cout, k, s, images) in [(64, 6, 32, 4, 2, 3), (32, 5, 7, 6, 2, 9), (24, 2, 3, 24, 2, 14)] {
+            let mut rng = ChaCha8Rng::seed_from_u64(side as u64);
+            let conv = Conv2dConfig::new(cin, cout, k, s).init(&device, &mut rng);
+            let params = ParamSet::<f32>::from_module(&conv, |n: &str| format!("layer.{n}"));
+            let blocked = BlockedConv::new(&params, "layer", side, (cin, cout), k, s).unwrap();
+            let grids = crate::nn::conv_backprop::Grids::conv(side, cin, cout, k, s);
+            let down = crate::nn::conv_backprop::Direction::Down;
+            let im2col = crate::nn::conv_backprop::StridedConv::new(&params, "layer", grids, down).unwrap();
+            let x: Vec<f32> = (0..images * blocked.input_len()).map(|_| rng.random_range(-1.0..1.0)).collect();
+            let input = blocked.regroup(&[&x]).unwrap();
+            let x_last = crate::nn::conv_backprop::to_channels_last(&x, cin, side);
+            let y = blocked.forward(&input);
+            close(&y, &im2col.forward(&x_last, images), "output");
+            let dy: Vec<f32> = (0..y.len()).map(|_| rng.random_range(-1.0..1.0)).collect();
+            let (mut ours, mut theirs) = (zero_gradients(&params), zero_gradients(&params));
+            blocked.backward(&input, &dy, &mut ours);
+            im2col.backward(&x_last, &dy, images, &mut theirs, false);
+            for (ours, theirs) in ours.iter().zip(&theirs) {
+                close(ours, theirs, "parameter gradient");
+            }
+        }
+    }
+
+    #[test]
+    fn parts_that_are_not_whole_images_are_errors() {
+        let device = training_device();
+        let conv = Conv2dConfig::new(2, 3, 4, 2).init(&device, &mut ChaCha8Rng::seed_from_u64(5));
+        let params = ParamSet::<f32>::from_module(&conv, |n: &str| format!("layer.{n}"));
+        let layer = BlockedConv::new(&params, "layer", 8, (2, 3), 4, 2).unwrap();
+        let error = layer.regroup(&[&[0.0; 128], &[0.0; 127]]).err().expect("127 values are not an image");
+        assert!(error.to_string().contains("not whole 2 × 8 × 8 images"), "{error}");
     }
 }

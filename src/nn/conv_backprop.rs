@@ -16,13 +16,13 @@
 //! The images are taken in chunks whose im2col buffer stays in a core's cache. A layer with enough chunks runs
 //! them as parallel tasks of whole chunks, each on one thread, and adds the tasks' weight gradients in order;
 //! one with few (a 1 × 1 grid, a small batch) runs them in turn, splitting each chunk's gathers by image and
-//! its GEMMs by rows. Which of the two, and the chunk size, depend on the layer and the batch alone, and each
+//! its GEMMs over the pool. Which of the two, and the chunk size, depend on the layer and the batch alone, and each
 //! image is gathered and scattered by one thread: the bytes do not depend on the thread count.
 
 use faer::{Accum, MatMut, MatRef, Par};
 use rayon::prelude::*;
 
-use super::backprop::{add_column_sums, matmul, repeat_row, tensor_index, view, view_mut, zeros};
+use super::backprop::{add_column_sums, add_into, matmul, repeat_row, tensor_index, view, view_mut, zeros};
 use super::params::ParamSet;
 use crate::error::{Error, Result};
 
@@ -145,7 +145,7 @@ impl Grids {
     }
 }
 
-/// dst [+]= a · b: split over the pool (row-wise, as [`matmul`] splits) or on this thread.
+/// dst [+]= a · b: split over the pool (as [`matmul`] splits it) or on this thread.
 fn product(dst: MatMut<'_, f32>, accum: Accum, a: MatRef<'_, f32>, b: MatRef<'_, f32>, split: bool) {
     if split {
         matmul(dst, accum, a, b);
@@ -344,13 +344,10 @@ impl StridedConv {
                     .collect()
             }
         };
-        let torch_grad = &mut grads[self.weight_index];
         let mut sums = sums.into_iter();
-        let mut weight_grad = sums.next().unwrap_or_default();
-        for sum in sums {
-            weight_grad.iter_mut().zip(&sum).for_each(|(w, s)| *w += s);
-        }
-        if !weight_grad.is_empty() {
+        if let Some(mut weight_grad) = sums.next() {
+            sums.for_each(|sum| add_into(&mut weight_grad, &sum));
+            let torch_grad = &mut grads[self.weight_index];
             add_torch_layout(torch_grad, &weight_grad, g.small_channels, g.big_channels, g.kernel * g.kernel);
         }
         add_column_sums(&mut grads[self.bias_index], dy);
@@ -518,6 +515,49 @@ mod tests {
                 };
                 let one = on_threads(1);
                 assert!(on_threads(2) == one && on_threads(3) == one, "chunk {chunk}: bytes depend on the threads");
+            }
+        }
+    }
+
+    /// Tasks of several chunks each, the last task and its last chunk partial, with and without the input
+    /// gradient: the same values as one chunk, and the same bytes on one thread and two.
+    #[test]
+    fn tasks_of_several_chunks_match_one_chunk() {
+        let device = training_device();
+        let mut rng = ChaCha8Rng::seed_from_u64(6);
+        let images = 35;
+        let named = |n: &str| format!("layer.{n}");
+        let down = ParamSet::<f32>::from_module(&Conv2dConfig::new(3, 4, 4, 2).init(&device, &mut rng), named);
+        let up = ParamSet::<f32>::from_module(&Conv2dConfig::new(4, 3, 4, 2).init_transposed(&device, &mut rng), named);
+        for (params, grids, direction) in [
+            (down, Grids::conv(10, 3, 4, 4, 2), Direction::Down),
+            (up, Grids::conv_transpose(4, 4, 3, 4, 2), Direction::Up),
+        ] {
+            let mut whole = StridedConv::new(&params, "layer", grids, direction).unwrap();
+            whole.chunk = images;
+            let mut chunked = StridedConv::new(&params, "layer", grids, direction).unwrap();
+            chunked.chunk = 2;
+            assert_eq!(chunked.task_images(images), Some(4), "18 chunks in 16 tasks: 2 chunks per task");
+            let x: Vec<f32> = (0..images * whole.input_len()).map(|_| rng.random_range(-1.0..1.0)).collect();
+            let dy: Vec<f32> = (0..images * whole.output_len()).map(|_| rng.random_range(-1.0..1.0)).collect();
+            close(&chunked.forward(&x, images), &whole.forward(&x, images), "output");
+            for want_dx in [true, false] {
+                let (mut whole_grads, mut chunked_grads) = (zero_gradients(&params), zero_gradients(&params));
+                let dx_whole = whole.backward(&x, &dy, images, &mut whole_grads, want_dx);
+                let dx = chunked.backward(&x, &dy, images, &mut chunked_grads, want_dx);
+                assert_eq!(dx.len(), if want_dx { x.len() } else { 0 });
+                close(&dx, &dx_whole, "dx");
+                for (ours, theirs) in chunked_grads.iter().zip(&whole_grads) {
+                    close(ours, theirs, "parameter gradient");
+                }
+                let on_threads = |threads| {
+                    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+                    pool.install(|| {
+                        let mut grads = zero_gradients(&params);
+                        (chunked.backward(&x, &dy, images, &mut grads, want_dx), grads)
+                    })
+                };
+                assert!(on_threads(1) == on_threads(2), "bytes depend on the threads");
             }
         }
     }

@@ -94,7 +94,7 @@ impl<'a> ConvVaeGrad<'a> {
         relu_in_place(&mut first);
         let mut grids = vec![first];
         for layer in &self.encoder {
-            let mut y = layer.forward(grids.last().expect("the frames at least"), images);
+            let mut y = layer.forward(grids.last().expect("the first convolution's output at least"), images);
             relu_in_place(&mut y);
             grids.push(y);
         }
@@ -209,7 +209,7 @@ pub fn images_loss_and_gradients(
     if batch.obs.len() != rows * width || batch.next_obs.len() != rows * width {
         return Err(Error::data(format!("DLGPD batch: {rows} rows of frames need {width} values each")));
     }
-    let frames = net.first.regroup(&[&batch.obs, &batch.next_obs]);
+    let frames = net.first.regroup(&[&batch.obs, &batch.next_obs])?;
     let (mean, std, tape) = net.encode(&frames, 2 * rows);
     let eps = noise.0.iter().chain(noise.1);
     let samples: Vec<f32> = mean.iter().zip(&std).zip(eps).map(|((m, s), e)| m + s * e).collect();
@@ -323,7 +323,8 @@ mod tests {
         }
     }
 
-    /// Images are gathered per thread and GEMMs split by rows, so the bytes do not depend on the threads.
+    /// Each image is gathered and regrouped by one thread, chunks and tasks depend on the batch alone and
+    /// partial sums are added in order, so the bytes do not depend on the threads.
     #[test]
     fn loss_and_gradients_do_not_depend_on_the_thread_count() {
         let device = training_device();
