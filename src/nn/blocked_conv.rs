@@ -290,15 +290,9 @@ mod tests {
     use super::*;
     use crate::nn::backprop::zero_gradients;
     use crate::nn::conv::Conv2dConfig;
+    use crate::nn::conv_backprop::tests::close;
     use crate::nn::conv_backprop::to_channels_first;
     use crate::nn::tensor::{tensor, training_device, values};
-
-    fn close(ours: &[f32], theirs: &[f32], what: &str) {
-        assert_eq!(ours.len(), theirs.len(), "{what}");
-        let scale = theirs.iter().fold(0.0f32, |m, x| m.max(x.abs())).max(1e-3);
-        let worst = ours.iter().zip(theirs).fold(0.0f32, |m, (x, y)| m.max((x - y).abs()));
-        assert!(worst <= 1e-5 * scale, "{what}: differs by {worst} at scale {scale}");
-    }
 
     /// Output and parameter gradients against burn's Conv2d for the loss Σ y ⊙ R, over images given in two
     /// parts, with kernels of one, two and three strides.

@@ -413,7 +413,7 @@ pub fn to_channels_first(x: &[f32], channels: usize, side: usize) -> Vec<f32> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use burn::module::Module;
     use burn::tensor::Tensor;
     use rand::{Rng, SeedableRng};
@@ -424,7 +424,8 @@ mod tests {
     use crate::nn::conv::Conv2dConfig;
     use crate::nn::tensor::{tensor, training_device, values};
 
-    fn close(ours: &[f32], theirs: &[f32], what: &str) {
+    /// Asserts `ours` equals `theirs` to 1e-5 of the largest |value| of `theirs`.
+    pub(crate) fn close(ours: &[f32], theirs: &[f32], what: &str) {
         assert_eq!(ours.len(), theirs.len(), "{what}");
         let scale = theirs.iter().fold(0.0f32, |m, x| m.max(x.abs())).max(1e-3);
         let worst = ours.iter().zip(theirs).fold(0.0f32, |m, (x, y)| m.max((x - y).abs()));
@@ -474,21 +475,32 @@ mod tests {
         }
     }
 
+    /// `work` run on a pool of `threads` threads.
+    fn on_pool<R: Send>(threads: usize, work: impl FnOnce() -> R + Send) -> R {
+        rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(work)
+    }
+
+    /// A convolution of 10 × 10 × 3 images to 4 channels and a transposed convolution of 4 × 4 × 4 to 3
+    /// channels, both kernel 4, stride 2.
+    fn small_layers(rng: &mut ChaCha8Rng) -> [(ParamSet, Grids, Direction); 2] {
+        let device = training_device();
+        let named = |n: &str| format!("layer.{n}");
+        let down = ParamSet::<f32>::from_module(&Conv2dConfig::new(3, 4, 4, 2).init(&device, rng), named);
+        let up = ParamSet::<f32>::from_module(&Conv2dConfig::new(4, 3, 4, 2).init_transposed(&device, rng), named);
+        [
+            (down, Grids::conv(10, 3, 4, 4, 2), Direction::Down),
+            (up, Grids::conv_transpose(4, 4, 3, 4, 2), Direction::Up),
+        ]
+    }
+
     /// A batch split over several im2col buffers gives what one buffer gives, in both directions, whether the
     /// chunks run in turn (two-image chunks) or as parallel tasks (one-image chunks, one task each);
     /// and the tasks give the same bytes on any number of threads.
     #[test]
     fn chunked_batches_match_one_chunk() {
-        let device = training_device();
         let mut rng = ChaCha8Rng::seed_from_u64(2);
         let images = 5;
-        let named = |n: &str| format!("layer.{n}");
-        let down = ParamSet::<f32>::from_module(&Conv2dConfig::new(3, 4, 4, 2).init(&device, &mut rng), named);
-        let up = ParamSet::<f32>::from_module(&Conv2dConfig::new(4, 3, 4, 2).init_transposed(&device, &mut rng), named);
-        for (params, grids, direction) in [
-            (down, Grids::conv(10, 3, 4, 4, 2), Direction::Down),
-            (up, Grids::conv_transpose(4, 4, 3, 4, 2), Direction::Up),
-        ] {
+        for (params, grids, direction) in small_layers(&mut rng) {
             let whole = StridedConv::new(&params, "layer", grids, direction).unwrap();
             assert!(whole.chunk >= images && whole.task_images(images).is_none());
             let x: Vec<f32> = (0..images * whole.input_len()).map(|_| rng.random_range(-1.0..1.0)).collect();
@@ -506,8 +518,7 @@ mod tests {
                     close(ours, theirs, "parameter gradient");
                 }
                 let on_threads = |threads| {
-                    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-                    pool.install(|| {
+                    on_pool(threads, || {
                         let mut grads = zero_gradients(&params);
                         let dx = chunked.backward(&x, &dy, images, &mut grads, true);
                         (chunked.forward(&x, images), dx, grads)
@@ -523,16 +534,9 @@ mod tests {
     /// gradient: the same values as one chunk, and the same bytes on one thread and two.
     #[test]
     fn tasks_of_several_chunks_match_one_chunk() {
-        let device = training_device();
         let mut rng = ChaCha8Rng::seed_from_u64(6);
         let images = 35;
-        let named = |n: &str| format!("layer.{n}");
-        let down = ParamSet::<f32>::from_module(&Conv2dConfig::new(3, 4, 4, 2).init(&device, &mut rng), named);
-        let up = ParamSet::<f32>::from_module(&Conv2dConfig::new(4, 3, 4, 2).init_transposed(&device, &mut rng), named);
-        for (params, grids, direction) in [
-            (down, Grids::conv(10, 3, 4, 4, 2), Direction::Down),
-            (up, Grids::conv_transpose(4, 4, 3, 4, 2), Direction::Up),
-        ] {
+        for (params, grids, direction) in small_layers(&mut rng) {
             let mut whole = StridedConv::new(&params, "layer", grids, direction).unwrap();
             whole.chunk = images;
             let mut chunked = StridedConv::new(&params, "layer", grids, direction).unwrap();
@@ -551,8 +555,7 @@ mod tests {
                     close(ours, theirs, "parameter gradient");
                 }
                 let on_threads = |threads| {
-                    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-                    pool.install(|| {
+                    on_pool(threads, || {
                         let mut grads = zero_gradients(&params);
                         (chunked.backward(&x, &dy, images, &mut grads, want_dx), grads)
                     })
