@@ -381,14 +381,8 @@ fn add_torch_layout(dst: &mut [f32], src: &[f32], rows: usize, channels: usize, 
 
 /// `images` images [channels, side, side] → [side, side, channels].
 pub fn to_channels_last(x: &[f32], channels: usize, side: usize) -> Vec<f32> {
-    let mut out = vec![0.0; x.len()];
-    to_channels_last_into(x, channels, side, &mut out);
-    out
-}
-
-/// [`to_channels_last`] into a buffer of the same length.
-pub fn to_channels_last_into(x: &[f32], channels: usize, side: usize, out: &mut [f32]) {
     let plane = side * side;
+    let mut out = vec![0.0; x.len()];
     out.par_chunks_mut(channels * plane).zip(x.par_chunks(channels * plane)).for_each(|(out, x)| {
         for c in 0..channels {
             for p in 0..plane {
@@ -396,6 +390,7 @@ pub fn to_channels_last_into(x: &[f32], channels: usize, side: usize, out: &mut 
             }
         }
     });
+    out
 }
 
 /// The inverse of [`to_channels_last`].
