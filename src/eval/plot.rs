@@ -99,6 +99,17 @@ fn axis(range: std::ops::Range<f64>) -> std::ops::Range<f64> {
     }
 }
 
+/// An axis label as plotters writes it, except that a tick at zero reads "0.0" and never "-0.0" (a range
+/// symmetric about zero puts a tick at −1e-17 or at −0).
+fn tick(value: &f64) -> String {
+    let text = plotters::data::float::FloatPrettyPrinter { allow_scientific: false, min_decimal: 1, max_decimal: 5 }
+        .print(*value);
+    match text.strip_prefix('-') {
+        Some(magnitude) if magnitude.parse::<f64>() == Ok(0.0) => magnitude.to_string(),
+        _ => text,
+    }
+}
+
 type XyChart<'a, 'b> = ChartContext<'a, BitMapBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
 /// A white canvas with a title over the given ranges, its axes not yet drawn.
@@ -129,8 +140,20 @@ fn xy_chart<'a, 'b>(
     y: std::ops::Range<f64>,
 ) -> Result<XyChart<'a, 'b>> {
     let mut chart = titled_chart(root, path, title, x, y)?;
-    chart.configure_mesh().x_desc(x_label).y_desc(y_label).draw().map_err(|e| plot_err(path, e))?;
+    draw_axes(&mut chart, path, x_label, y_label)?;
     Ok(chart)
+}
+
+/// The grid and both axes, labelled.
+fn draw_axes(chart: &mut XyChart<'_, '_>, path: &Path, x_label: &str, y_label: &str) -> Result<()> {
+    chart
+        .configure_mesh()
+        .x_label_formatter(&tick)
+        .y_label_formatter(&tick)
+        .x_desc(x_label)
+        .y_desc(y_label)
+        .draw()
+        .map_err(|e| plot_err(path, e))
 }
 
 pub fn line_plot(path: &Path, title: &str, x_label: &str, y_label: &str, series: &[Series]) -> Result<()> {
@@ -234,7 +257,7 @@ pub fn line_panels(path: &Path, title: &str, x_label: &str, panels: &[Panel]) ->
                 .build_cartesian_2d(axis(x0..x1), axis(y0..y1))
                 .map_err(|e| plot_err(path, e))?;
             let mut mesh = chart.configure_mesh();
-            mesh.y_desc(y_label.as_str());
+            mesh.x_label_formatter(&tick).y_label_formatter(&tick).y_desc(y_label.as_str());
             if k + 1 == rows {
                 mesh.x_desc(x_label);
             } else {
@@ -303,7 +326,7 @@ pub fn band_panels(
                 .y_label_area_size(52)
                 .build_cartesian_2d(axis(x0..x1), axis(0.0..y1))
                 .map_err(|e| plot_err(path, e))?;
-            chart.configure_mesh().x_desc(x_label).y_desc(y_label).draw().map_err(|e| plot_err(path, e))?;
+            draw_axes(&mut chart, path, x_label, y_label)?;
             for (i, band) in bands.iter().enumerate() {
                 draw_band(&mut chart, path, band, series_color(i))?;
             }
@@ -555,7 +578,13 @@ pub fn histogram(path: &Path, title: &str, x_label: &str, values: &[f64], bins: 
             .y_label_area_size(50)
             .build_cartesian_2d(axis(lo..hi), 0u32..top + 1)
             .map_err(|e| plot_err(path, e))?;
-        chart.configure_mesh().x_desc(x_label).y_desc("count").draw().map_err(|e| plot_err(path, e))?;
+        chart
+            .configure_mesh()
+            .x_label_formatter(&tick)
+            .x_desc(x_label)
+            .y_desc("count")
+            .draw()
+            .map_err(|e| plot_err(path, e))?;
         chart
             .draw_series(counts.iter().enumerate().map(|(i, &c)| {
                 let x0 = lo + i as f64 * width;
@@ -644,6 +673,14 @@ pub fn map_paths(path: &Path, title: &str, panels: &[MapPanel]) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_tick_at_zero_has_no_sign() {
+        assert_eq!(tick(&-0.0), "0.0");
+        assert_eq!(tick(&-1e-17), "0.0");
+        assert_eq!(tick(&-0.25), "-0.25");
+        assert_eq!(tick(&2.0), "2.0");
+    }
 
     #[test]
     fn plots_are_png_and_deterministic() {

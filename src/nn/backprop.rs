@@ -5,9 +5,10 @@
 
 use std::borrow::Cow;
 
-use faer::{Accum, MatMut, MatRef, Par};
+use faer::{Accum, MatMut, MatRef};
 use rayon::prelude::*;
 
+use super::gemm::{Finish, Kernel, Start};
 use super::params::ParamSet;
 use crate::error::{Error, Result};
 
@@ -29,38 +30,69 @@ pub fn matmul(dst: MatMut<'_, f32>, accum: Accum, a: MatRef<'_, f32>, b: MatRef<
         transposed_product(dst, accum, a, b);
         return;
     }
+    let kernel = Kernel::for_product(&dst, &a, &b);
+    matmul_by(kernel, dst, Start::of(accum), a, b, Finish::Store);
+}
+
+/// dst = finish(start + a · b) (see [`gemm::Kernel::fused`]), split over the pool as [`matmul`] splits, on
+/// `kernel`, which must be `Kernel::for_product` of this product.
+pub fn matmul_by(
+    kernel: Kernel,
+    dst: MatMut<'_, f32>,
+    start: Start<'_>,
+    a: MatRef<'_, f32>,
+    b: MatRef<'_, f32>,
+    finish: Finish<'_>,
+) {
     let pieces = if dst.nrows() * dst.ncols() * a.ncols() >= PARALLEL_WORK { rayon::current_num_threads() } else { 1 };
+    let product = Product { kernel, start, finish };
     if dst.ncols() >= 4 * dst.nrows() {
-        split_cols(dst, accum, a, b, pieces);
+        split_cols(dst, a, b, product, pieces);
     } else {
-        split_rows(dst, accum, a, b, pieces);
+        split_rows(dst, a, b, product, pieces);
     }
 }
 
-fn split_rows(dst: MatMut<'_, f32>, accum: Accum, a: MatRef<'_, f32>, b: MatRef<'_, f32>, pieces: usize) {
+/// What every piece of a split product does besides its share of the multiply-adds.
+#[derive(Clone, Copy)]
+struct Product<'a> {
+    kernel: Kernel,
+    start: Start<'a>,
+    finish: Finish<'a>,
+}
+
+fn split_rows(dst: MatMut<'_, f32>, a: MatRef<'_, f32>, b: MatRef<'_, f32>, product: Product<'_>, pieces: usize) {
     let m = dst.nrows();
     if pieces <= 1 || m < 16 {
-        faer::linalg::matmul::matmul(dst, accum, a, b, 1.0f32, Par::Seq);
+        product.kernel.fused(dst, product.start, a, b, product.finish);
         return;
     }
     let half = pieces / 2;
     let mid = m * half / pieces;
     let (top, bottom) = dst.split_at_row_mut(mid);
     let (a_top, a_bottom) = a.split_at_row(mid);
-    rayon::join(|| split_rows(top, accum, a_top, b, half), || split_rows(bottom, accum, a_bottom, b, pieces - half));
+    let upper = Product { finish: product.finish.rows(0, mid), ..product };
+    let lower = Product { finish: product.finish.rows(mid, m - mid), ..product };
+    rayon::join(|| split_rows(top, a_top, b, upper, half), || split_rows(bottom, a_bottom, b, lower, pieces - half));
 }
 
-fn split_cols(dst: MatMut<'_, f32>, accum: Accum, a: MatRef<'_, f32>, b: MatRef<'_, f32>, pieces: usize) {
+fn split_cols(dst: MatMut<'_, f32>, a: MatRef<'_, f32>, b: MatRef<'_, f32>, product: Product<'_>, pieces: usize) {
     let n = dst.ncols();
     if pieces <= 1 || n < 16 {
-        faer::linalg::matmul::matmul(dst, accum, a, b, 1.0f32, Par::Seq);
+        product.kernel.fused(dst, product.start, a, b, product.finish);
         return;
     }
     let half = pieces / 2;
     let mid = n * half / pieces;
     let (left, right) = dst.split_at_col_mut(mid);
     let (b_left, b_right) = b.split_at_col(mid);
-    rayon::join(|| split_cols(left, accum, a, b_left, half), || split_cols(right, accum, a, b_right, pieces - half));
+    let left_part = Product { start: product.start.cols(0, mid), finish: product.finish.cols(0, mid), ..product };
+    let right_part =
+        Product { start: product.start.cols(mid, n - mid), finish: product.finish.cols(mid, n - mid), ..product };
+    rayon::join(
+        || split_cols(left, a, b_left, left_part, half),
+        || split_cols(right, a, b_right, right_part, pieces - half),
+    );
 }
 
 /// A weight gradient dYᵀ·X over many rows into a row-major destination at least twice as tall as wide (a
@@ -141,15 +173,18 @@ impl<'a> Dense<'a> {
 
     /// `rows` inputs → `rows × d_out` outputs.
     pub fn forward(&self, x: &[f32], rows: usize) -> Vec<f32> {
+        self.forward_then(x, rows, Finish::Store)
+    }
+
+    /// The outputs through a ReLU.
+    pub fn forward_relu(&self, x: &[f32], rows: usize) -> Vec<f32> {
+        self.forward_then(x, rows, Finish::Relu)
+    }
+
+    fn forward_then(&self, x: &[f32], rows: usize, finish: Finish<'_>) -> Vec<f32> {
         debug_assert_eq!(x.len(), rows * self.d_in);
-        let mut y = repeat_row(self.bias, rows);
-        matmul(
-            view_mut(&mut y, rows, self.d_out),
-            Accum::Add,
-            view(x, rows, self.d_in),
-            view(&self.weight, self.d_out, self.d_in).transpose(),
-        );
-        y
+        let weight = view(&self.weight, self.d_out, self.d_in).transpose();
+        affine(view(x, rows, self.d_in), weight, self.bias, finish)
     }
 
     /// Adds this layer's weight and bias gradients for output gradients `dy` at inputs `x` to `grads`, and
@@ -176,18 +211,58 @@ impl<'a> Dense<'a> {
         }
         self.backward_input(dy, rows)
     }
+
+    /// [`Dense::backward`] with the input gradients taken on through the ReLU whose output `x` is: zero
+    /// where x ≤ 0, as [`relu_backward`] leaves them.
+    pub fn backward_through_relu(&self, x: &[f32], dy: &[f32], rows: usize, grads: &mut [Vec<f32>]) -> Vec<f32> {
+        self.backward(x, dy, rows, grads, false);
+        self.input_gradient(dy, rows, Finish::ReluGrad(view(x, rows, self.d_in)))
+    }
 }
 
 impl Dense<'_> {
     /// The input gradients for output gradients `dy`, leaving the weights' gradients alone: for a network held
     /// fixed while something upstream of it learns (SAC's critics under the actor's loss).
     pub fn backward_input(&self, dy: &[f32], rows: usize) -> Vec<f32> {
+        self.input_gradient(dy, rows, Finish::Store)
+    }
+
+    fn input_gradient(&self, dy: &[f32], rows: usize, finish: Finish<'_>) -> Vec<f32> {
         debug_assert_eq!(dy.len(), rows * self.d_out);
         let (o, i) = (self.d_out, self.d_in);
-        let mut dx = zeros(rows * i);
-        matmul(view_mut(&mut dx, rows, i), Accum::Replace, view(dy, rows, o), view(&self.weight, o, i));
-        dx
+        new_product(view(dy, rows, o), view(&self.weight, o, i), finish)
     }
+}
+
+/// finish(bias + x · weight) as a new row-major buffer: a layer's output, the bias row repeated down the rows.
+pub fn affine(x: MatRef<'_, f32>, weight: MatRef<'_, f32>, bias: &[f32], finish: Finish<'_>) -> Vec<f32> {
+    fresh_product(x, weight, Some(bias), finish)
+}
+
+/// finish(a · b) as a new row-major buffer.
+pub fn new_product(a: MatRef<'_, f32>, b: MatRef<'_, f32>, finish: Finish<'_>) -> Vec<f32> {
+    fresh_product(a, b, None, finish)
+}
+
+fn fresh_product(a: MatRef<'_, f32>, b: MatRef<'_, f32>, bias: Option<&[f32]>, finish: Finish<'_>) -> Vec<f32> {
+    let (rows, width) = (a.nrows(), b.ncols());
+    let n = rows * width;
+    let mut out = unwritten(n);
+    // SAFETY: the view covers out's capacity, row-major; the AVX-512 kernel only stores into it, and the faer
+    // branch below does not use it.
+    let dst = unsafe { MatMut::from_raw_parts_mut(out.as_mut_ptr(), rows, width, width as isize, 1) };
+    let kernel = Kernel::for_product(&dst, &a, &b);
+    if kernel != Kernel::Faer {
+        // The kernel starts every element from zero or the bias row and stores it: nothing is read.
+        matmul_by(kernel, dst, bias.map_or(Start::Zero, Start::Row), a, b, finish);
+        // SAFETY: the kernel stored every element of the rows × width output.
+        unsafe { assume_written(&mut out, n) };
+        return out;
+    }
+    // faer reads what it adds to: the bias rows, or zeros, are written first.
+    let mut out = bias.map_or_else(|| zeros(n), |bias| repeat_row(bias, rows));
+    matmul_by(kernel, view_mut(&mut out, rows, width), Start::Dst, a, b, finish);
+    out
 }
 
 /// sums[j] += Σ_rows m[row, j] for a row-major matrix with `sums.len()` columns. A large matrix is summed in
@@ -352,9 +427,15 @@ impl<'a> TwoLayer<'a> {
 
     /// The second layer's output (before any activation of the caller's) and the tape.
     pub fn forward(&self, x: &[f32], rows: usize) -> (Vec<f32>, TwoLayerTape) {
-        let mut hidden = self.first.forward(x, rows);
-        relu_in_place(&mut hidden);
+        let hidden = self.first.forward_relu(x, rows);
         let out = self.second.forward(&hidden, rows);
+        (out, TwoLayerTape { hidden })
+    }
+
+    /// [`TwoLayer::forward`] with the output through a ReLU.
+    pub fn forward_relu(&self, x: &[f32], rows: usize) -> (Vec<f32>, TwoLayerTape) {
+        let hidden = self.first.forward_relu(x, rows);
+        let out = self.second.forward_relu(&hidden, rows);
         (out, TwoLayerTape { hidden })
     }
 
@@ -367,8 +448,7 @@ impl<'a> TwoLayer<'a> {
         grads: &mut [Vec<f32>],
         want_dx: bool,
     ) -> Vec<f32> {
-        let mut d_hidden = self.second.backward(&tape.hidden, d_out, rows, grads, true);
-        relu_backward(&mut d_hidden, &tape.hidden);
+        let d_hidden = self.second.backward_through_relu(&tape.hidden, d_out, rows, grads);
         self.first.backward(x, &d_hidden, rows, grads, want_dx)
     }
 }
@@ -407,7 +487,7 @@ mod tests {
         let mut probe = start.clone();
         assert!(is_tall_weight_gradient(&view_mut(&mut probe, o, i), &a, &b));
         let mut direct = start.clone();
-        faer::linalg::matmul::matmul(view_mut(&mut direct, o, i), Accum::Add, a, b, 1.0, Par::Seq);
+        faer::linalg::matmul::matmul(view_mut(&mut direct, o, i), Accum::Add, a, b, 1.0, faer::Par::Seq);
         let run = |threads: usize, accum: Accum| {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             let mut out = start.clone();
@@ -432,22 +512,32 @@ mod tests {
         let (m, k, n) = (301, 97, 203);
         let a: Vec<f32> = (0..m * k).map(|_| rng.random_range(-1.0..1.0)).collect();
         let b: Vec<f32> = (0..k * n).map(|_| rng.random_range(-1.0..1.0)).collect();
-        let mut one = vec![0.5; m * n];
-        faer::linalg::matmul::matmul(
-            view_mut(&mut one, m, n),
-            Accum::Add,
-            view(&a, m, k),
-            view(&b, k, n),
-            1.0,
-            Par::Seq,
-        );
-        for pieces in [2, 3, 7] {
-            let mut split = vec![0.5; m * n];
-            split_rows(view_mut(&mut split, m, n), Accum::Add, view(&a, m, k), view(&b, k, n), pieces);
-            assert_eq!(split, one, "{pieces} pieces of rows");
-            let mut split = vec![0.5; m * n];
-            split_cols(view_mut(&mut split, m, n), Accum::Add, view(&a, m, k), view(&b, k, n), pieces);
-            assert_eq!(split, one, "{pieces} pieces of columns");
+        let bias: Vec<f32> = (0..n).map(|_| rng.random_range(-1.0..1.0)).collect();
+        let relu_out: Vec<f32> = (0..m * n).map(|_| rng.random_range(-1.0f32..1.0).max(0.0)).collect();
+        let mut kernels = vec![Kernel::Faer];
+        #[cfg(target_arch = "x86_64")]
+        if is_x86_feature_detected!("avx512f") {
+            kernels.push(Kernel::Avx512);
+        }
+        for kernel in kernels {
+            let cases = [
+                (Start::Dst, Finish::Store),
+                (Start::Row(&bias), Finish::Relu),
+                (Start::Zero, Finish::ReluGrad(view(&relu_out, m, n))),
+            ];
+            for (start, finish) in cases {
+                let mut one = vec![0.5; m * n];
+                kernel.fused(view_mut(&mut one, m, n), start, view(&a, m, k), view(&b, k, n), finish);
+                let product = Product { kernel, start, finish };
+                for pieces in [2, 3, 7] {
+                    let mut split = vec![0.5; m * n];
+                    split_rows(view_mut(&mut split, m, n), view(&a, m, k), view(&b, k, n), product, pieces);
+                    assert_eq!(split, one, "{kernel:?} {start:?}: {pieces} pieces of rows");
+                    let mut split = vec![0.5; m * n];
+                    split_cols(view_mut(&mut split, m, n), view(&a, m, k), view(&b, k, n), product, pieces);
+                    assert_eq!(split, one, "{kernel:?} {start:?}: {pieces} pieces of columns");
+                }
+            }
         }
     }
 

@@ -14,9 +14,10 @@ use rayon::prelude::*;
 
 use super::activation::{fast_sigmoid as sigmoid, fast_tanh as tanh};
 use super::backprop::{
-    add_column_sums, assume_written, block_rows, matmul, repeat_row, slots, tensor_index, unwritten, view, view_mut,
-    zeros,
+    add_column_sums, affine, assume_written, block_rows, matmul, new_product, slots, tensor_index, unwritten, view,
+    view_mut,
 };
+use super::gemm::Finish;
 use super::params::ParamSet;
 use crate::error::Result;
 
@@ -53,14 +54,16 @@ impl<'a> Gru<'a> {
         Ok(Gru { e, inputs, weight_ih: v(0), weight_hh: v(1), bias_ih: v(2), bias_hh: v(3), index: ix })
     }
 
-    /// b_ih, which callers broadcast over the rows before adding the input blocks' gates.
-    pub fn bias_ih(&self) -> &'a [f32] {
-        self.bias_ih
-    }
-
     /// Where b_ih's gradient goes: the column sums of the input-gate gradients.
     pub fn bias_ih_index(&self) -> usize {
         self.index[2]
+    }
+
+    /// b_ih + x · W_ih[:, block]ᵀ (rows × 3E): the input gates of block `block`, with the bias.
+    pub fn input_gates(&self, x: &[f32], rows: usize, block: usize) -> Vec<f32> {
+        let (e, g) = (self.e, 3 * self.e);
+        let weight = view(self.weight_ih, g, self.inputs * e).subcols(block * e, e).transpose();
+        affine(view(x, rows, e), weight, self.bias_ih, Finish::Store)
     }
 
     /// gates (rows × 3E) += x · W_ih[:, block]ᵀ for input block `block` (0 context, 1 action, 2 terrain).
@@ -91,21 +94,13 @@ impl<'a> Gru<'a> {
             view(d_gates, rows, g).transpose(),
             view(x, rows, e),
         );
-        let mut dx = zeros(rows * e);
-        matmul(
-            view_mut(&mut dx, rows, e),
-            Accum::Replace,
-            view(d_gates, rows, g),
-            view(self.weight_ih, g, width).subcols(block * e, e),
-        );
-        dx
+        new_product(view(d_gates, rows, g), view(self.weight_ih, g, width).subcols(block * e, e), Finish::Store)
     }
 
     /// h ← GRU(h) from complete input gates `gi` (rows × 3E, b_ih included).
     pub fn step(&self, gi: &[f32], h: &mut [f32], rows: usize) -> GruTape {
         let (e, g) = (self.e, 3 * self.e);
-        let mut gh = repeat_row(self.bias_hh, rows);
-        matmul(view_mut(&mut gh, rows, g), Accum::Add, view(h, rows, e), view(self.weight_hh, g, e).transpose());
+        let gh = affine(view(h, rows, e), view(self.weight_hh, g, e).transpose(), self.bias_hh, Finish::Store);
         let size = rows * e;
         // The blocks below write every slot of the tapes only when the inputs have these sizes.
         assert!(h.len() == size && gi.len() == rows * g, "GRU step: h or gi does not hold {rows} rows");

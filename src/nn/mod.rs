@@ -16,6 +16,7 @@ pub mod ensemble;
 pub mod fast;
 pub mod features;
 pub mod gaussian;
+pub mod gemm;
 pub mod gru;
 pub mod gru_backprop;
 pub mod init;

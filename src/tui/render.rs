@@ -209,6 +209,12 @@ fn render_panel(panel: &Panel, frame: &mut Frame, area: Rect) {
             return;
         }
     }
+    if panel.series().all(|(_, series)| series.points().is_empty()) {
+        // A metric logged every few hundred steps leaves its panel blank for a while: say so.
+        let waiting = Paragraph::new("no points yet").style(Style::default().fg(Color::DarkGray));
+        frame.render_widget(waiting.block(block), area);
+        return;
+    }
     let names: Vec<&str> = panel.series().map(|(name, _)| name).collect();
     let traces = short_names(&names)
         .into_iter()
@@ -351,6 +357,25 @@ mod tests {
         let screen = draw(&app, 100, 40);
         assert!(screen.contains("pendulum/action = "), "{screen}");
         assert!(!screen.contains("cem/best_cost = "), "{screen}");
+    }
+
+    #[test]
+    fn a_panel_without_points_says_so() {
+        let mut app = pendulum_app();
+        let layout = Event::Layout {
+            title: "train".into(),
+            panels: vec![PanelSpec {
+                title: "rare metric".into(),
+                x_label: "step".into(),
+                series: vec!["valid/rare".into()],
+                restart_on_rewind: false,
+                path: None,
+            }],
+        };
+        app.ingest(&layout);
+        assert!(draw(&app, 100, 40).contains("no points yet"));
+        app.ingest(&Event::scalar("valid/rare", 1, 0.5));
+        assert!(!draw(&app, 100, 40).contains("no points yet"));
     }
 
     #[test]

@@ -45,21 +45,11 @@ fn jaco_replays_target_velocities_from_a_given_state() {
     let rows = ["0.3,0,0,0,0,0,0,0,0"; 3].join("\n") + "\n" + &["0,0,0,0,0,0,0,0,0"; 2].join("\n") + "\n";
     std::fs::write(dir.path().join("a.csv"), rows).unwrap();
     let start = "1.5,3.0,1.5,4.0,1.5,3.0,0.2,0.2,0.2,0,0,0,0,0,0,0,0,0";
-    let out = mbrl(dir.path())
-        .args([
-            "collect",
-            "--env",
-            "lightsout:jaco",
-            "--actions",
-            "a.csv",
-            "--init-state",
-            start,
-            "--out",
-            "j.mcap",
-            "-q",
-        ])
-        .output()
-        .unwrap();
+    let replay = |state: &str, out: &str| {
+        let args = ["collect", "--env", "lightsout:jaco", "--actions", "a.csv", "--init-state", state, "--out", out];
+        mbrl(dir.path()).args(args).arg("-q").output().unwrap()
+    };
+    let out = replay(start, "j.mcap");
     assert!(out.status.success(), "{}", stderr_of(&out));
     let data = mbrl::data::read_dataset(&dir.path().join("j.mcap")).unwrap();
     assert_eq!(data.meta.env, "lightsout:jaco");
@@ -69,11 +59,15 @@ fn jaco_replays_target_velocities_from_a_given_state() {
     // The velocity servo (kv 500) tracks 0.3 rad/s closely: about 0.09 rad in three steps.
     let turned = data.steps[2].next_state[0] - 1.5;
     assert!((turned - 0.09).abs() < 0.01, "joint 1 turned {turned}");
-    let bad = mbrl(dir.path())
-        .args(["collect", "--env", "lightsout:jaco", "--actions", "a.csv", "--init-state", "1,2,3", "--out", "k.mcap"])
-        .output()
-        .unwrap();
-    assert_one_line_error(&bad, &["--init-state", "18"]);
+    assert_one_line_error(&replay("1,2,3", "k.mcap"), &["--init-state", "18"]);
+    // A joint that turns without limit still takes angles a double resolves, and no joint starts faster than
+    // ten times its servo's speed.
+    let spinning = "1.5,3.0,1.5,4.0,1.5,3.0,0.2,0.2,0.2,0,0,0,0,0,0,0,0,1e6";
+    let far = "1e300,3.0,1.5,4.0,1.5,3.0,0.2,0.2,0.2,0,0,0,0,0,0,0,0,0";
+    for (state, field) in [(spinning, "finger_3_velocity"), (far, "joint_1")] {
+        assert_one_line_error(&replay(state, "k.mcap"), &["--init-state", field]);
+    }
+    assert!(!dir.path().join("k.mcap").exists());
 }
 
 #[cfg(feature = "mujoco")]

@@ -11,8 +11,8 @@ use super::net::{STD_FLOOR, STD_SCALE, STD_SHIFT, VARIANCE_FLOOR};
 use crate::error::{Error, Result};
 use crate::nn::activation::{fast_sigmoid as sigmoid, fast_softplus as softplus, fast_tanh as tanh};
 use crate::nn::backprop::{
-    add_column_sums, add_into, assume_written, block_rows, concat, copy_of, for_each_value, relu_backward,
-    relu_in_place, repeat_row, slots, tensor_index, unwritten, zero_gradients, zip_values, TwoLayer, TwoLayerTape,
+    add_column_sums, add_into, assume_written, block_rows, concat, copy_of, for_each_value, relu_backward, slots,
+    tensor_index, unwritten, zero_gradients, zip_values, TwoLayer, TwoLayerTape,
 };
 use crate::nn::gru_backprop::Gru;
 use crate::nn::ParamSet;
@@ -192,8 +192,7 @@ pub fn loss_and_gradients(
     // Transition features of the chunk's and the context's transitions in one pass.
     let transitions = concat(&[&batch.chunk_transitions, &batch.context]);
     let enc_rows = b * t + b * m;
-    let (mut features, enc_tape) = net.transition_encoder.forward(&transitions, enc_rows);
-    relu_in_place(&mut features);
+    let (features, enc_tape) = net.transition_encoder.forward_relu(&transitions, enc_rows);
     let (chunk_pool, chunk_arg) = max_pool(&features[..b * t * f], b, t, f, None);
     let (context_pool, context_arg) = max_pool(&features[b * t * f..], b, m, f, Some(&batch.present));
     // Max pooling distributes over a union; ties go to the chunk's side, as burn's max_pair does.
@@ -217,17 +216,14 @@ pub fn loss_and_gradients(
     let starts: Vec<f32> = (0..b).flat_map(|i| &predicted[i * n * p..(i * n + t) * p]).copied().collect();
     let (mut h_all, state_tape) = net.state_encoder.forward(&starts, b * t);
     for_each_value(&mut h_all, |x| *x = tanh(*x));
-    let (mut act_emb, act_tape) = net.action_encoder.forward(&batch.actions, b * t);
-    relu_in_place(&mut act_emb);
-    let mut action_gates = repeat_row(net.gru.bias_ih(), b * t);
-    net.gru.add_input_gates(&act_emb, b * t, 1, &mut action_gates);
+    let (act_emb, act_tape) = net.action_encoder.forward_relu(&batch.actions, b * t);
+    let mut action_gates = net.gru.input_gates(&act_emb, b * t, 1);
     let terrain = net.terrain_embedding.as_ref().map(|embedding| {
         let tau: Vec<f32> = (0..b)
             .flat_map(|i| (0..t).flat_map(move |k| (i * n + k) * s + p..(i * n + k + 1) * s))
             .map(|at| batch.states[at])
             .collect();
-        let (mut emb, tape) = embedding.forward(&tau, b * t);
-        relu_in_place(&mut emb);
+        let (emb, tape) = embedding.forward_relu(&tau, b * t);
         (tau, emb, tape)
     });
     if let Some((_, emb, _)) = &terrain {
@@ -245,8 +241,7 @@ pub fn loss_and_gradients(
                 posterior.mean[i * lat + d] + posterior.std[i * lat + d] * batch.noise_single[k]
             })
             .collect();
-        let (mut ctx_single, ctx_single_tape) = net.context_embedding.forward(&beta_single, b * t);
-        relu_in_place(&mut ctx_single);
+        let (ctx_single, ctx_single_tape) = net.context_embedding.forward_relu(&beta_single, b * t);
         let mut gi_single = copy_of(&action_gates);
         net.gru.add_input_gates(&ctx_single, b * t, 0, &mut gi_single);
         let mut h_single = copy_of(&h_all);
@@ -257,8 +252,7 @@ pub fn loss_and_gradients(
         // Multi-step: one β per chunk, open loop from s_0; the predictions of s_2.. enter the sum.
         let beta: Vec<f32> =
             (0..b * lat).map(|k| posterior.mean[k] + posterior.std[k] * batch.noise_sequence[k]).collect();
-        let (mut ctx_seq, ctx_seq_tape) = net.context_embedding.forward(&beta, b);
-        relu_in_place(&mut ctx_seq);
+        let (ctx_seq, ctx_seq_tape) = net.context_embedding.forward_relu(&beta, b);
         let mut ctx_gates = vec![0.0; b * g];
         net.gru.add_input_gates(&ctx_seq, b, 0, &mut ctx_gates);
         let mut h: Vec<f32> = (0..b).flat_map(|i| h_all[i * t * e..(i * t + 1) * e].iter().copied()).collect();

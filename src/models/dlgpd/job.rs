@@ -121,7 +121,10 @@ impl Method for Dlgpd {
             vec![
                 loss_panel("loss: −ELBO (train, held-out)", true),
                 crate::run::PanelSpec {
-                    title: "reward RMSE on held-out rollouts (open loop 5, 10 steps; constant)".into(),
+                    title: format!(
+                        "reward RMSE on held-out rollouts, every {} steps (open loop 5, 10 steps; constant)",
+                        c.validate_every
+                    ),
                     x_label: "step".into(),
                     series: ["valid/reward_rmse_h5", "valid/reward_rmse_h10", "valid/reward_rmse_constant"]
                         .map(String::from)

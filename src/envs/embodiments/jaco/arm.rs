@@ -15,6 +15,7 @@ use super::{
 use crate::envs::embodiments::manipulator::{BoardPoint, Manipulator};
 use crate::envs::embodiments::BoardLayout;
 use crate::error::Result;
+use crate::util::domain::Domain;
 
 const STATE_NAMES: [&str; 2 * JOINTS] = [
     "joint_1",
@@ -278,10 +279,27 @@ impl Manipulator for Jaco {
             (1, super::ik::JOINT_LOW[1], super::ik::JOINT_HIGH[1]),
             (2, super::ik::JOINT_LOW[2], super::ik::JOINT_HIGH[2]),
         ];
-        limited.into_iter().chain((ARM_JOINTS..JOINTS).map(|j| (j, 0.15, 1.35))).find_map(|(j, low, high)| {
-            let v = *state.get(j)?;
-            (!(low..=high).contains(&v)).then(|| {
-                format!("{} = {v} is outside the joint's range; expected radians in [{low}, {high}]", STATE_NAMES[j])
+        let out_of_range =
+            limited.into_iter().chain((ARM_JOINTS..JOINTS).map(|j| (j, 0.15, 1.35))).find_map(|(j, low, high)| {
+                let v = *state.get(j)?;
+                (!(low..=high).contains(&v)).then(|| {
+                    format!(
+                        "{} = {v} is outside the joint's range; expected radians in [{low}, {high}]",
+                        STATE_NAMES[j]
+                    )
+                })
+            });
+        // The joints that turn without limit still need angles a double resolves (sin and cos of 1e300 are
+        // noise), and a start faster than ten times what the velocity servos drive is no arm's state: MuJoCo
+        // turns it into huge accelerations.
+        let turning = [0, 3, 4, 5].map(|j| (j, Domain::closed(-1e3, 1e3).in_unit("rad")));
+        let speeds = (0..JOINTS).map(|j| {
+            let servo = if j < ARM_JOINTS { ARM_MAX_VELOCITY[j] } else { FINGER_MAX_VELOCITY };
+            (JOINTS + j, Domain::closed(-10.0 * servo, 10.0 * servo).in_unit("rad/s"))
+        });
+        out_of_range.or_else(|| {
+            turning.into_iter().chain(speeds).find_map(|(index, domain)| {
+                domain.check(STATE_NAMES[index], *state.get(index)?).err().map(|e| e.to_string())
             })
         })
     }
