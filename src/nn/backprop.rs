@@ -259,9 +259,12 @@ fn fresh_product(a: MatRef<'_, f32>, b: MatRef<'_, f32>, bias: Option<&[f32]>, f
         unsafe { assume_written(&mut out, n) };
         return out;
     }
-    // faer reads what it adds to: the bias rows, or zeros, are written first.
-    let mut out = bias.map_or_else(|| zeros(n), |bias| repeat_row(bias, rows));
-    matmul_by(kernel, view_mut(&mut out, rows, width), Start::Dst, a, b, finish);
+    // faer adds to the bias rows, written first; without a bias it overwrites zeros.
+    let (mut out, start) = match bias {
+        Some(bias) => (repeat_row(bias, rows), Start::Dst),
+        None => (zeros(n), Start::Zero),
+    };
+    matmul_by(kernel, view_mut(&mut out, rows, width), start, a, b, finish);
     out
 }
 

@@ -2,7 +2,7 @@
 //! the pool and calls this per piece).
 //!
 //! faer's kernels reach 150-170 GFLOP/s on cache-sized products here, but 110-135 on the training paths' tall
-//! ones (25 000-75 000 rows by 200 inner by 128-600 out): they start each output tile with a load that misses
+//! ones (25 000-75 000 rows by 200 inner by 200-600 out): they start each output tile with a load that misses
 //! every cache level and wait for it. On AVX-512 machines those products run through the kernel below, which
 //! prefetches the next output tile and the next rows of the left operand while it works on the current ones,
 //! and which starts each tile from a bias row and ends it with a ReLU (or a ReLU's gradient mask) in cache:
@@ -10,9 +10,9 @@
 //! model's step as much again as the kernel saves. Elsewhere, and for products small enough to stay in cache,
 //! faer does the work, with the start and the finish as passes of their own.
 //!
-//! Every output element is one thread's sum in one order (its start, then k = 0, 1, … by fused multiply-adds),
-//! whatever the split of rows or columns around it, and the kernel is chosen from the whole product's shape:
-//! the bytes do not depend on the thread count.
+//! On either kernel every output element is one thread's sum in one order (on this one: its start, then
+//! k = 0, 1, … by fused multiply-adds), whatever the split of rows or columns around it, and the kernel is
+//! chosen from the whole product's shape: the bytes do not depend on the thread count.
 
 use faer::{Accum, MatMut, MatRef, Par};
 
@@ -53,7 +53,7 @@ impl<'a> Start<'a> {
         }
     }
 
-    /// The start of the output's columns `cols`.
+    /// The start of the output's columns `from..from + count`.
     pub fn cols(self, from: usize, count: usize) -> Start<'a> {
         match self {
             Start::Row(row) => Start::Row(&row[from..from + count]),
@@ -131,47 +131,50 @@ impl Kernel {
                     Start::Dst => Accum::Add,
                     Start::Row(row) => {
                         for i in 0..m {
-                            for (j, value) in row.iter().enumerate() {
-                                dst[(i, j)] = *value;
-                            }
+                            dst.as_mut().row_mut(i).iter_mut().zip(row).for_each(|(x, value)| *x = *value);
                         }
                         Accum::Add
                     }
                 };
                 faer::linalg::matmul::matmul(dst.as_mut(), accum, a, b, 1.0f32, Par::Seq);
-                match finish {
-                    Finish::Store => {}
-                    Finish::Relu => {
-                        for j in 0..n {
-                            for i in 0..m {
-                                dst[(i, j)] = dst[(i, j)].max(0.0);
-                            }
-                        }
-                    }
-                    Finish::ReluGrad(y) => {
-                        for j in 0..n {
-                            for i in 0..m {
-                                if y[(i, j)] <= 0.0 {
-                                    dst[(i, j)] = 0.0;
-                                }
-                            }
-                        }
-                    }
-                }
+                finish_pass(dst, finish);
             }
             #[cfg(target_arch = "x86_64")]
             Kernel::Avx512 => {
-                let mask_fits = match finish {
+                assert!(avx512::fits(&dst, &a, &b), "gemm: the AVX-512 kernel was chosen for a layout it cannot read");
+                let mask_by_rows = match finish {
                     Finish::ReluGrad(y) => y.col_stride() == 1 && y.row_stride() >= n as isize,
                     _ => true,
                 };
-                assert!(
-                    avx512::fits(&dst, &a, &b) && mask_fits,
-                    "gemm: the AVX-512 kernel was chosen for a layout it cannot read"
-                );
-                // SAFETY: `fits` checked that the CPU has AVX-512F and that the layouts are those the kernel
-                // reads; the start row and the ReLU output have the output's shape (asserted above).
-                unsafe { avx512::product(dst, start, a, b, finish) }
+                if mask_by_rows {
+                    // SAFETY: `fits` checked that the CPU has AVX-512F and that the layouts are those the kernel
+                    // reads; the start row and the ReLU output have the output's shape (asserted above), the
+                    // ReLU output by rows.
+                    unsafe { avx512::product(dst, start, a, b, finish) }
+                } else {
+                    // A ReLU output the tiles cannot read by rows: the mask as a pass of its own.
+                    // SAFETY: as above, with no finish in the kernel.
+                    unsafe { avx512::product(dst.as_mut(), start, a, b, Finish::Store) };
+                    finish_pass(dst, finish);
+                }
+            }
+        }
+    }
+}
+
+/// The finish as a pass over `dst`, row by row.
+fn finish_pass(mut dst: MatMut<'_, f32>, finish: Finish<'_>) {
+    match finish {
+        Finish::Store => {}
+        Finish::Relu => {
+            for i in 0..dst.nrows() {
+                dst.as_mut().row_mut(i).iter_mut().for_each(|x| *x = x.max(0.0));
+            }
+        }
+        Finish::ReluGrad(y) => {
+            for i in 0..dst.nrows() {
+                let zip = dst.as_mut().row_mut(i).iter_mut().zip(y.row(i).iter());
+                zip.for_each(|(x, y)| *x = if *y <= 0.0 { 0.0 } else { *x });
             }
         }
     }
@@ -204,7 +207,8 @@ mod avx512 {
         *DETECTED.get_or_init(|| is_x86_feature_detected!("avx512f"))
     }
 
-    /// The kernel writes `dst` by rows and reads `a` along either of its axes with a unit stride.
+    /// The layouts the kernel is fast on: `dst` written by rows (which its masked stores need), `a` read along
+    /// either axis with a unit stride and positive strides throughout (which its packing needs only for speed).
     pub(super) fn fits(dst: &MatMut<'_, f32>, a: &MatRef<'_, f32>, b: &MatRef<'_, f32>) -> bool {
         let unit_a = a.row_stride() == 1 || a.col_stride() == 1;
         let rows_of_dst = dst.col_stride() == 1 && dst.row_stride() >= dst.ncols() as isize;
@@ -228,7 +232,8 @@ mod avx512 {
         let c = dst.as_ptr_mut();
         let (ars, aks) = (a.row_stride(), a.col_stride());
         let panels = n.div_ceil(NR);
-        // Padding lanes of the last panel are never written, so they stay zero.
+        // Lanes of the last panel past the output's last column hold zeros or an earlier block's values: they
+        // feed only accumulator lanes that the masked stores leave out.
         let mut packed = vec![0.0f32; panels * KC.min(k) * NR];
         // One row block of `a` at a time, [k][row]: the kernel's broadcasts then read consecutive values.
         let mut a_block = vec![0.0f32; KC.min(k) * MR];
@@ -296,7 +301,8 @@ mod avx512 {
         }
     }
 
-    /// A block of `a`'s rows as [k][MR] (rows past its end left as they were: their outputs are never stored).
+    /// A block of `a`'s rows as [k][MR] (slots past its last row are left as they were: a kernel for fewer
+    /// rows never reads them).
     fn pack_rows(rows: MatRef<'_, f32>, out: &mut [f32]) {
         if rows.col_stride() == 1 {
             for r in 0..rows.nrows() {
@@ -608,20 +614,22 @@ mod tests {
     #[test]
     fn each_row_is_the_same_whatever_the_split() {
         let mut rng = ChaCha8Rng::seed_from_u64(4);
-        let (m, n, k) = (2100, 270, 300);
+        let (m, n, k) = (1000, 270, 300);
         let (a, b) = (random(m, k, &mut rng), random(k, n, &mut rng));
         let mut whole = vec![0.0f32; m * n];
-        product(MatMut::from_row_major_slice_mut(&mut whole, m, n), Accum::Replace, a.as_ref(), b.as_ref());
+        let dst = MatMut::from_row_major_slice_mut(&mut whole, m, n);
+        // Chosen once for the whole product, as backprop::matmul chooses; the pieces are too small to be
+        // given the AVX-512 kernel on their own.
+        let kernel = Kernel::for_product(&dst, &a.as_ref(), &b.as_ref());
+        assert_eq!(kernels().last(), Some(&kernel));
+        kernel.product(dst, Accum::Replace, a.as_ref(), b.as_ref());
         let mut pieces = vec![0.0f32; m * n];
-        let mid = 1037;
+        let mid = 437;
         let (top, bottom) = pieces.split_at_mut(mid * n);
-        product(MatMut::from_row_major_slice_mut(top, mid, n), Accum::Replace, a.subrows(0, mid), b.as_ref());
-        product(
-            MatMut::from_row_major_slice_mut(bottom, m - mid, n),
-            Accum::Replace,
-            a.subrows(mid, m - mid),
-            b.as_ref(),
-        );
+        let top = MatMut::from_row_major_slice_mut(top, mid, n);
+        kernel.product(top, Accum::Replace, a.subrows(0, mid), b.as_ref());
+        let bottom = MatMut::from_row_major_slice_mut(bottom, m - mid, n);
+        kernel.product(bottom, Accum::Replace, a.subrows(mid, m - mid), b.as_ref());
         assert!(whole.iter().zip(&pieces).all(|(x, y)| x.to_bits() == y.to_bits()));
     }
 }

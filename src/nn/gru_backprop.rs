@@ -77,9 +77,9 @@ impl<'a> Gru<'a> {
         );
     }
 
-    /// The input-gate gradients `d_gates` (rows × 3E) of block `block`'s input `x`: adds to W_ih's gradient and
-    /// returns dx.
-    pub fn input_backward(
+    /// The input-gate gradients `d_gates` (rows × 3E) of block `block`'s input `x`, a ReLU's output: adds to
+    /// W_ih's gradient and returns the gradient at the ReLU's input (zero where x ≤ 0).
+    pub fn input_backward_through_relu(
         &self,
         x: &[f32],
         d_gates: &[f32],
@@ -94,7 +94,8 @@ impl<'a> Gru<'a> {
             view(d_gates, rows, g).transpose(),
             view(x, rows, e),
         );
-        new_product(view(d_gates, rows, g), view(self.weight_ih, g, width).subcols(block * e, e), Finish::Store)
+        let weight = view(self.weight_ih, g, width).subcols(block * e, e);
+        new_product(view(d_gates, rows, g), weight, Finish::ReluGrad(view(x, rows, e)))
     }
 
     /// h ← GRU(h) from complete input gates `gi` (rows × 3E, b_ih included).

@@ -426,16 +426,13 @@ pub fn loss_and_gradients(
     let mut d_action_gates = copy_of(&d_gi_single);
     add_into(&mut d_action_gates, &d_gi_seq);
     add_column_sums(&mut grads[net.gru.bias_ih_index()], &d_action_gates);
-    let mut d_act_emb = net.gru.input_backward(&act_emb, &d_action_gates, b * t, 1, &mut grads);
-    relu_backward(&mut d_act_emb, &act_emb);
+    let d_act_emb = net.gru.input_backward_through_relu(&act_emb, &d_action_gates, b * t, 1, &mut grads);
     net.action_encoder.backward(&batch.actions, &act_tape, &d_act_emb, b * t, &mut grads, false);
     if let (Some(embedding), Some((tau, emb, tape))) = (&net.terrain_embedding, &terrain) {
-        let mut d_emb = net.gru.input_backward(emb, &d_action_gates, b * t, 2, &mut grads);
-        relu_backward(&mut d_emb, emb);
+        let d_emb = net.gru.input_backward_through_relu(emb, &d_action_gates, b * t, 2, &mut grads);
         embedding.backward(tau, tape, &d_emb, b * t, &mut grads, false);
     }
-    let mut d_ctx_single = net.gru.input_backward(&ctx_single, &d_gi_single, b * t, 0, &mut grads);
-    relu_backward(&mut d_ctx_single, &ctx_single);
+    let d_ctx_single = net.gru.input_backward_through_relu(&ctx_single, &d_gi_single, b * t, 0, &mut grads);
     let d_beta_single =
         net.context_embedding.backward(&beta_single, &ctx_single_tape, &d_ctx_single, b * t, &mut grads, true);
     let mut d_ctx_gates = vec![0.0; b * g];
@@ -444,8 +441,7 @@ pub fn loss_and_gradients(
             sum.iter_mut().zip(step).for_each(|(s, x)| *s += x);
         }
     });
-    let mut d_ctx_seq = net.gru.input_backward(&ctx_seq, &d_ctx_gates, b, 0, &mut grads);
-    relu_backward(&mut d_ctx_seq, &ctx_seq);
+    let d_ctx_seq = net.gru.input_backward_through_relu(&ctx_seq, &d_ctx_gates, b, 0, &mut grads);
     let d_beta = net.context_embedding.backward(&beta, &ctx_seq_tape, &d_ctx_seq, b, &mut grads, true);
 
     // The state encoder.
