@@ -122,7 +122,7 @@ impl Method for Dlgpd {
                 loss_panel("loss: −ELBO (train, held-out)", true),
                 crate::run::PanelSpec {
                     title: format!(
-                        "reward RMSE on held-out rollouts, every {} steps (open loop 5, 10 steps; constant)",
+                        "reward RMSE on held-out rollouts every {} steps (open loop 5, 10; constant)",
                         c.validate_every
                     ),
                     x_label: "step".into(),
