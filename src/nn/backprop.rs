@@ -517,12 +517,7 @@ mod tests {
         let b: Vec<f32> = (0..k * n).map(|_| rng.random_range(-1.0..1.0)).collect();
         let bias: Vec<f32> = (0..n).map(|_| rng.random_range(-1.0..1.0)).collect();
         let relu_out: Vec<f32> = (0..m * n).map(|_| rng.random_range(-1.0f32..1.0).max(0.0)).collect();
-        let mut kernels = vec![Kernel::Faer];
-        #[cfg(target_arch = "x86_64")]
-        if is_x86_feature_detected!("avx512f") {
-            kernels.push(Kernel::Avx512);
-        }
-        for kernel in kernels {
+        for kernel in crate::nn::gemm::available_kernels() {
             let cases = [
                 (Start::Dst, Finish::Store),
                 (Start::Row(&bias), Finish::Relu),

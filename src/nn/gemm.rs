@@ -180,9 +180,15 @@ fn finish_pass(mut dst: MatMut<'_, f32>, finish: Finish<'_>) {
     }
 }
 
-/// dst = [dst +] a · b on one thread, by the kernel `Kernel::for_product` picks.
-pub fn product(dst: MatMut<'_, f32>, accum: Accum, a: MatRef<'_, f32>, b: MatRef<'_, f32>) {
-    Kernel::for_product(&dst, &a, &b).product(dst, accum, a, b);
+/// Every kernel this machine runs, faer first: for tests that hold each of them to the same contract.
+#[cfg(test)]
+pub(crate) fn available_kernels() -> Vec<Kernel> {
+    let mut kernels = vec![Kernel::Faer];
+    #[cfg(target_arch = "x86_64")]
+    if is_x86_feature_detected!("avx512f") {
+        kernels.push(Kernel::Avx512);
+    }
+    kernels
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -571,16 +577,6 @@ mod tests {
         }
     }
 
-    /// Every kernel this machine has, with faer first.
-    fn kernels() -> Vec<Kernel> {
-        let mut kernels = vec![Kernel::Faer];
-        #[cfg(target_arch = "x86_64")]
-        if is_x86_feature_detected!("avx512f") {
-            kernels.push(Kernel::Avx512);
-        }
-        kernels
-    }
-
     #[test]
     fn a_bias_start_and_a_relu_finish_are_applied_in_place() {
         let mut rng = ChaCha8Rng::seed_from_u64(5);
@@ -592,7 +588,7 @@ mod tests {
             relu_out[7] = f32::NAN;
             let y = MatRef::from_row_major_slice(&relu_out, m, n);
             let plain = reference(&Mat::zeros(m, n), Accum::Replace, a.as_ref(), b.as_ref());
-            for kernel in kernels() {
+            for kernel in available_kernels() {
                 let mut with_bias = vec![0.0f32; m * n];
                 let dst = MatMut::from_row_major_slice_mut(&mut with_bias, m, n);
                 kernel.fused(dst, Start::Row(&bias), a.as_ref(), b.as_ref(), Finish::Relu);
@@ -621,7 +617,7 @@ mod tests {
         // Chosen once for the whole product, as backprop::matmul chooses; the pieces are too small to be
         // given the AVX-512 kernel on their own.
         let kernel = Kernel::for_product(&dst, &a.as_ref(), &b.as_ref());
-        assert_eq!(kernels().last(), Some(&kernel));
+        assert_eq!(available_kernels().last(), Some(&kernel));
         kernel.product(dst, Accum::Replace, a.as_ref(), b.as_ref());
         let mut pieces = vec![0.0f32; m * n];
         let mid = 437;

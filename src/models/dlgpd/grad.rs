@@ -133,9 +133,7 @@ impl<'a> ConvVaeGrad<'a> {
 
     /// Latents [rows, L] → pixel logits, channels-last [rows, 64, 64, 6], and the tape.
     fn decode(&self, latents: &[f32], rows: usize) -> (Vec<f32>, DecoderTape) {
-        let mut h = self.fc.forward(latents, rows);
-        relu_in_place(&mut h);
-        let mut grids = vec![h];
+        let mut grids = vec![self.fc.forward_relu(latents, rows)];
         let last = self.decoder.len() - 1;
         for (i, layer) in self.decoder.iter().enumerate() {
             let mut y = layer.forward(grids.last().expect("the dense output at least"), rows);
