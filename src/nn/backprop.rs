@@ -71,8 +71,9 @@ fn split_rows(dst: MatMut<'_, f32>, a: MatRef<'_, f32>, b: MatRef<'_, f32>, prod
     let mid = m * half / pieces;
     let (top, bottom) = dst.split_at_row_mut(mid);
     let (a_top, a_bottom) = a.split_at_row(mid);
-    let upper = Product { finish: product.finish.rows(0, mid), ..product };
-    let lower = Product { finish: product.finish.rows(mid, m - mid), ..product };
+    let upper = Product { start: product.start.rows(0, mid), finish: product.finish.rows(0, mid), ..product };
+    let lower =
+        Product { start: product.start.rows(mid, m - mid), finish: product.finish.rows(mid, m - mid), ..product };
     rayon::join(|| split_rows(top, a_top, b, upper, half), || split_rows(bottom, a_bottom, b, lower, pieces - half));
 }
 
@@ -236,15 +237,22 @@ impl Dense<'_> {
 
 /// finish(bias + x · weight) as a new row-major buffer: a layer's output, the bias row repeated down the rows.
 pub fn affine(x: MatRef<'_, f32>, weight: MatRef<'_, f32>, bias: &[f32], finish: Finish<'_>) -> Vec<f32> {
-    fresh_product(x, weight, Some(bias), finish)
+    fresh_product(x, weight, Start::Row(bias), finish)
 }
 
 /// finish(a · b) as a new row-major buffer.
 pub fn new_product(a: MatRef<'_, f32>, b: MatRef<'_, f32>, finish: Finish<'_>) -> Vec<f32> {
-    fresh_product(a, b, None, finish)
+    fresh_product(a, b, Start::Zero, finish)
 }
 
-fn fresh_product(a: MatRef<'_, f32>, b: MatRef<'_, f32>, bias: Option<&[f32]>, finish: Finish<'_>) -> Vec<f32> {
+/// start + a · b as a new row-major buffer, for a `start` (rows × b's columns, row-major) the caller keeps:
+/// on the AVX-512 kernel it is read tile by tile, with no copy of its own.
+pub fn product_from(start: &[f32], a: MatRef<'_, f32>, b: MatRef<'_, f32>) -> Vec<f32> {
+    fresh_product(a, b, Start::Matrix(view(start, a.nrows(), b.ncols())), Finish::Store)
+}
+
+/// `start` must be `Zero`, `Row` or `Matrix`: nothing in the new buffer can be read.
+fn fresh_product(a: MatRef<'_, f32>, b: MatRef<'_, f32>, start: Start<'_>, finish: Finish<'_>) -> Vec<f32> {
     let (rows, width) = (a.nrows(), b.ncols());
     let n = rows * width;
     let mut out = unwritten(n);
@@ -252,20 +260,33 @@ fn fresh_product(a: MatRef<'_, f32>, b: MatRef<'_, f32>, bias: Option<&[f32]>, f
     // branch below does not use it.
     let dst = unsafe { MatMut::from_raw_parts_mut(out.as_mut_ptr(), rows, width, width as isize, 1) };
     let kernel = Kernel::for_product(&dst, &a, &b);
-    if kernel != Kernel::Faer {
-        // The kernel starts every element from zero or the bias row and stores it: nothing is read.
-        matmul_by(kernel, dst, bias.map_or(Start::Zero, Start::Row), a, b, finish);
+    if kernel != Kernel::Faer && !matches!(start, Start::Dst) {
+        // The kernel starts every element from zero, the bias row or the start matrix and stores it: nothing
+        // of `out` is read.
+        matmul_by(kernel, dst, start, a, b, finish);
         // SAFETY: the kernel stored every element of the rows × width output.
         unsafe { assume_written(&mut out, n) };
         return out;
     }
-    // faer adds to the bias rows, written first; without a bias it overwrites zeros.
-    let (mut out, start) = match bias {
-        Some(bias) => (repeat_row(bias, rows), Start::Dst),
-        None => (zeros(n), Start::Zero),
+    // faer adds to the start, written first; with none it overwrites zeros.
+    let (mut out, start) = match start {
+        Start::Row(bias) => (repeat_row(bias, rows), Start::Dst),
+        Start::Matrix(start) => (row_major_copy(start), Start::Dst),
+        Start::Zero | Start::Dst => (zeros(n), Start::Zero),
     };
     matmul_by(kernel, view_mut(&mut out, rows, width), start, a, b, finish);
     out
+}
+
+/// The values of `m` by rows, copied in parallel blocks where they are one row-major run already.
+fn row_major_copy(m: MatRef<'_, f32>) -> Vec<f32> {
+    let (rows, cols) = (m.nrows(), m.ncols());
+    if m.col_stride() == 1 && m.row_stride() == cols as isize {
+        // SAFETY: a row-major view with rows exactly `cols` apart is rows · cols consecutive values.
+        copy_of(unsafe { std::slice::from_raw_parts(m.as_ptr(), rows * cols) })
+    } else {
+        (0..rows).flat_map(|i| m.row(i).iter().copied()).collect()
+    }
 }
 
 /// sums[j] += Σ_rows m[row, j] for a row-major matrix with `sums.len()` columns. A large matrix is summed in
@@ -517,11 +538,13 @@ mod tests {
         let b: Vec<f32> = (0..k * n).map(|_| rng.random_range(-1.0..1.0)).collect();
         let bias: Vec<f32> = (0..n).map(|_| rng.random_range(-1.0..1.0)).collect();
         let relu_out: Vec<f32> = (0..m * n).map(|_| rng.random_range(-1.0f32..1.0).max(0.0)).collect();
+        let gates: Vec<f32> = (0..m * n).map(|_| rng.random_range(-1.0..1.0)).collect();
         for kernel in crate::nn::gemm::available_kernels() {
             let cases = [
                 (Start::Dst, Finish::Store),
                 (Start::Row(&bias), Finish::Relu),
                 (Start::Zero, Finish::ReluGrad(view(&relu_out, m, n))),
+                (Start::Matrix(view(&gates, m, n)), Finish::Store),
             ];
             for (start, finish) in cases {
                 let mut one = vec![0.5; m * n];

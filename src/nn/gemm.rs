@@ -5,9 +5,9 @@
 //! ones (25 000-75 000 rows by 200 inner by 200-600 out): they start each output tile with a load that misses
 //! every cache level and wait for it. On AVX-512 machines those products run through the kernel below, which
 //! prefetches the next output tile and the next rows of the left operand while it works on the current ones,
-//! and which starts each tile from a bias row and ends it with a ReLU (or a ReLU's gradient mask) in cache:
-//! the passes that wrote the bias rows and applied the activation over every layer's output cost the context
-//! model's step as much again as the kernel saves. Elsewhere, and for products small enough to stay in cache,
+//! and which starts each tile from a bias row (or from a matrix the caller keeps) and ends it with a ReLU (or a
+//! ReLU's gradient mask) in cache: the passes that wrote the bias rows and applied the activation over every
+//! layer's output cost the context model's step as much again as the kernel saves. Elsewhere, and for products small enough to stay in cache,
 //! faer does the work, with the start and the finish as passes of their own.
 //!
 //! On either kernel every output element is one thread's sum in one order (on this one: its start, then
@@ -32,6 +32,8 @@ pub enum Start<'a> {
     Dst,
     /// The row vector (a layer's bias), the same for every row: `n` values.
     Row(&'a [f32]),
+    /// The matrix of the output's shape (gates the caller summed so far, kept for another use).
+    Matrix(MatRef<'a, f32>),
 }
 
 /// What happens to each finished output element before it is stored.
@@ -53,10 +55,19 @@ impl<'a> Start<'a> {
         }
     }
 
+    /// The start of the output's rows `from..from + count`.
+    pub fn rows(self, from: usize, count: usize) -> Start<'a> {
+        match self {
+            Start::Matrix(start) => Start::Matrix(start.subrows(from, count)),
+            other => other,
+        }
+    }
+
     /// The start of the output's columns `from..from + count`.
     pub fn cols(self, from: usize, count: usize) -> Start<'a> {
         match self {
             Start::Row(row) => Start::Row(&row[from..from + count]),
+            Start::Matrix(start) => Start::Matrix(start.subcols(from, count)),
             other => other,
         }
     }
@@ -118,8 +129,12 @@ impl Kernel {
         finish: Finish<'_>,
     ) {
         let (m, n) = (dst.nrows(), dst.ncols());
-        if let Start::Row(row) = start {
-            assert_eq!(row.len(), n, "gemm: a start row needs one value per output column");
+        match start {
+            Start::Row(row) => assert_eq!(row.len(), n, "gemm: a start row needs one value per output column"),
+            Start::Matrix(start) => {
+                assert!(start.nrows() == m && start.ncols() == n, "gemm: the start matrix must have the output's shape")
+            }
+            Start::Zero | Start::Dst => {}
         }
         if let Finish::ReluGrad(y) = finish {
             assert!(y.nrows() == m && y.ncols() == n, "gemm: the ReLU output must have the output's shape");
@@ -135,6 +150,10 @@ impl Kernel {
                         }
                         Accum::Add
                     }
+                    Start::Matrix(start) => {
+                        dst.copy_from(start);
+                        Accum::Add
+                    }
                 };
                 faer::linalg::matmul::matmul(dst.as_mut(), accum, a, b, 1.0f32, Par::Seq);
                 finish_pass(dst, finish);
@@ -146,6 +165,13 @@ impl Kernel {
                     Finish::ReluGrad(y) => y.col_stride() == 1 && y.row_stride() >= n as isize,
                     _ => true,
                 };
+                if let Start::Matrix(source) = start {
+                    if source.col_stride() != 1 {
+                        // A start the tiles cannot read by rows: copied into the output first.
+                        dst.copy_from(source);
+                        return Kernel::Avx512.fused(dst, Start::Dst, a, b, finish);
+                    }
+                }
                 if mask_by_rows {
                     // SAFETY: `fits` checked that the CPU has AVX-512F and that the layouts are those the kernel
                     // reads; the start row and the ReLU output have the output's shape (asserted above), the
@@ -213,8 +239,8 @@ mod avx512 {
         *DETECTED.get_or_init(|| is_x86_feature_detected!("avx512f"))
     }
 
-    /// The layouts the kernel is fast on: `dst` written by rows (which its masked stores need), `a` read along
-    /// either axis with a unit stride and positive strides throughout (which its packing needs only for speed).
+    /// The layouts the kernel reads: `dst` written by rows (which its masked stores need), `a` with a unit
+    /// stride along one axis (it reads `a` by rows in place and packs it by columns), positive strides.
     pub(super) fn fits(dst: &MatMut<'_, f32>, a: &MatRef<'_, f32>, b: &MatRef<'_, f32>) -> bool {
         let unit_a = a.row_stride() == 1 || a.col_stride() == 1;
         let rows_of_dst = dst.col_stride() == 1 && dst.row_stride() >= dst.ncols() as isize;
@@ -241,17 +267,23 @@ mod avx512 {
         // Lanes of the last panel past the output's last column hold zeros or an earlier block's values: they
         // feed only accumulator lanes that the masked stores leave out.
         let mut packed = vec![0.0f32; panels * KC.min(k) * NR];
-        // One row block of `a` at a time, [k][row]: the kernel's broadcasts then read consecutive values.
-        let mut a_block = vec![0.0f32; KC.min(k) * MR];
+        // `a` stored by rows is read in place, its 12 rows' values consecutive along k. Stored by columns (a
+        // weight gradient's dYᵀ), its row block is packed as [k][row]: read in place, each k's 12 values sit
+        // on lines of their own, which crowd the right operand's panel out of L1 (8 % slower).
+        let a_by_rows = aks == 1;
+        let mut a_block = if a_by_rows { Vec::new() } else { vec![0.0f32; KC.min(k) * MR] };
         for k0 in (0..k).step_by(KC) {
             let kc = (k - k0).min(KC);
-            pack(b, k0, kc, &mut packed);
+            // SAFETY: the caller guarantees AVX-512F.
+            unsafe { pack(b, k0, kc, &mut packed) };
             // The start applies to the first block of the inner dimension, the finish to the last.
-            let (begin, row) = match start {
-                _ if k0 > 0 => (Begin::Load, std::ptr::null()),
-                Start::Zero => (Begin::Zero, std::ptr::null()),
-                Start::Dst => (Begin::Load, std::ptr::null()),
-                Start::Row(row) => (Begin::Row, row.as_ptr()),
+            // A `Matrix` start is read as the output is on later blocks: from a tile of rows `lds` apart.
+            let (begin, row, start_at, lds) = match start {
+                _ if k0 > 0 => (Begin::Load, std::ptr::null(), c.cast_const(), ldc),
+                Start::Zero => (Begin::Zero, std::ptr::null(), c.cast_const(), ldc),
+                Start::Dst => (Begin::Load, std::ptr::null(), c.cast_const(), ldc),
+                Start::Row(row) => (Begin::Row, row.as_ptr(), c.cast_const(), ldc),
+                Start::Matrix(source) => (Begin::Load, std::ptr::null(), source.as_ptr(), source.row_stride() as usize),
             };
             let (end, relu_out, ldy) = match finish {
                 _ if k0 + kc < k => (End::Store, std::ptr::null(), 0),
@@ -261,7 +293,14 @@ mod avx512 {
             };
             for i0 in (0..m).step_by(MR) {
                 let rows = (m - i0).min(MR);
-                pack_rows(a.subrows(i0, rows).subcols(k0, kc), &mut a_block);
+                let a_rows = if a_by_rows {
+                    // SAFETY: row i0 < m and column k0 < k lie inside `a`.
+                    unsafe { a.as_ptr().offset(i0 as isize * ars + k0 as isize) }
+                } else {
+                    // SAFETY: as above; `a`'s row stride is 1, and the caller guarantees AVX-512F.
+                    unsafe { pack_columns(a.subrows(i0, rows).subcols(k0, kc), &mut a_block) };
+                    a_block.as_ptr()
+                };
                 // Rows read along k stream from memory: the next block's are fetched while this one works.
                 let (next_a, prefetch_rows) = if aks == 1 && i0 + MR < m {
                     // SAFETY: row i0 + MR < m, column k0 < k: inside `a`.
@@ -282,13 +321,17 @@ mod avx512 {
                         tile
                     };
                     let call = Call {
-                        a: a_block.as_ptr(),
+                        a: a_rows,
+                        lda: if a_by_rows { ars as usize } else { MR },
                         b: unsafe { packed.as_ptr().add(p * kc * NR) },
                         kc,
                         c: tile,
                         ldc,
                         masks: masks(cols),
                         begin,
+                        // SAFETY: (i0, j0) lies inside the start matrix, which has the output's shape.
+                        load_from: unsafe { start_at.add(i0 * lds + j0) },
+                        lds,
                         // SAFETY: column j0 < n of the start row and (i0, j0) of the ReLU output exist.
                         row: if row.is_null() { row } else { unsafe { row.add(j0) } },
                         end,
@@ -301,26 +344,24 @@ mod avx512 {
                     };
                     // SAFETY: the tile's `rows` × `cols` values lie inside `dst` (masks cover the columns), the
                     // packed blocks hold kc steps, and the caller guarantees AVX-512F.
-                    unsafe { dispatch(rows, cols > 16, &call) };
+                    unsafe { dispatch(rows, cols > 16, a_by_rows, &call) };
                 }
             }
         }
     }
 
-    /// A block of `a`'s rows as [k][MR] (slots past its last row are left as they were: a kernel for fewer
-    /// rows never reads them).
-    fn pack_rows(rows: MatRef<'_, f32>, out: &mut [f32]) {
-        if rows.col_stride() == 1 {
-            for r in 0..rows.nrows() {
-                for (kk, value) in rows.row(r).iter().enumerate() {
-                    out[kk * MR + r] = *value;
-                }
-            }
-        } else {
-            for kk in 0..rows.ncols() {
-                for (r, value) in rows.col(kk).iter().enumerate() {
-                    out[kk * MR + r] = *value;
-                }
+    /// A block of `a`'s rows, stored by columns, as [k][MR]: each k's values are consecutive, one masked
+    /// vector copy (slots past the block's last row are left as they were: a kernel for fewer rows never reads
+    /// them).
+    #[target_feature(enable = "avx512f")]
+    unsafe fn pack_columns(rows: MatRef<'_, f32>, out: &mut [f32]) {
+        let mask = ((1u32 << rows.nrows()) - 1) as __mmask16;
+        assert!(rows.row_stride() == 1 && rows.nrows() <= MR && out.len() >= rows.ncols() * MR);
+        for kk in 0..rows.ncols() {
+            // SAFETY: column kk holds nrows consecutive values; out holds MR values at kk·MR.
+            unsafe {
+                let column = _mm512_maskz_loadu_ps(mask, rows.as_ptr().offset(kk as isize * rows.col_stride()));
+                _mm512_mask_storeu_ps(out.as_mut_ptr().add(kk * MR), mask, column);
             }
         }
     }
@@ -332,17 +373,26 @@ mod avx512 {
     }
 
     /// Rows k0..k0 + kc of `b` as panels of 32 columns, [panel][k][32].
-    fn pack(b: MatRef<'_, f32>, k0: usize, kc: usize, packed: &mut [f32]) {
+    #[target_feature(enable = "avx512f")]
+    unsafe fn pack(b: MatRef<'_, f32>, k0: usize, kc: usize, packed: &mut [f32]) {
         let n = b.ncols();
         for p in 0..n.div_ceil(NR) {
             let cols = (n - p * NR).min(NR);
             let panel = &mut packed[p * kc * NR..(p + 1) * kc * NR];
             if b.col_stride() == 1 {
+                // Two masked vector copies per row: a copy_from_slice of a run-time length is a memmove call
+                // per 32 values, which cost the weight gradients' packing more than the copying.
+                let masks = masks(cols);
                 for (kk, row) in panel.chunks_exact_mut(NR).enumerate() {
-                    let src = b.subrows(k0 + kk, 1).subcols(p * NR, cols);
-                    // SAFETY: a 1 × cols view with unit column stride is `cols` contiguous values.
-                    let src = unsafe { std::slice::from_raw_parts(src.as_ptr(), cols) };
-                    row[..cols].copy_from_slice(src);
+                    // SAFETY: row k0 + kk < k and columns p·NR.. of `b` exist; the masks cover `cols` of them,
+                    // and `row` holds NR values.
+                    unsafe {
+                        let src = b.as_ptr().offset((k0 + kk) as isize * b.row_stride() + (p * NR) as isize);
+                        for (v, &mask) in masks.iter().enumerate() {
+                            let values = _mm512_maskz_loadu_ps(mask, src.add(16 * v));
+                            _mm512_storeu_ps(row.as_mut_ptr().add(16 * v), values);
+                        }
+                    }
                 }
             } else {
                 for jj in 0..cols {
@@ -370,14 +420,19 @@ mod avx512 {
     }
 
     struct Call {
-        /// The row block, [k][MR].
+        /// The tile's rows of `a` at the block's first k: in place by rows (`lda` values apart), or packed as
+        /// [k][MR] (each k `lda` = MR values after the last).
         a: *const f32,
+        lda: usize,
         b: *const f32,
         kc: usize,
         c: *mut f32,
         ldc: usize,
         masks: [__mmask16; 2],
         begin: Begin,
+        /// Where a `Load` begin reads the tile (the output itself, or the start matrix), rows `lds` apart.
+        load_from: *const f32,
+        lds: usize,
         /// The start row at the tile's first column.
         row: *const f32,
         end: End,
@@ -391,37 +446,56 @@ mod avx512 {
     }
 
     macro_rules! by_rows {
-        ($rows:expr, $v:literal, $call:expr) => {
+        ($rows:expr, $v:literal, $direct:literal, $call:expr) => {
             match $rows {
-                12 => kernel::<12, $v>($call),
-                11 => kernel::<11, $v>($call),
-                10 => kernel::<10, $v>($call),
-                9 => kernel::<9, $v>($call),
-                8 => kernel::<8, $v>($call),
-                7 => kernel::<7, $v>($call),
-                6 => kernel::<6, $v>($call),
-                5 => kernel::<5, $v>($call),
-                4 => kernel::<4, $v>($call),
-                3 => kernel::<3, $v>($call),
-                2 => kernel::<2, $v>($call),
-                _ => kernel::<1, $v>($call),
+                12 => kernel::<12, $v, $direct>($call),
+                11 => kernel::<11, $v, $direct>($call),
+                10 => kernel::<10, $v, $direct>($call),
+                9 => kernel::<9, $v, $direct>($call),
+                8 => kernel::<8, $v, $direct>($call),
+                7 => kernel::<7, $v, $direct>($call),
+                6 => kernel::<6, $v, $direct>($call),
+                5 => kernel::<5, $v, $direct>($call),
+                4 => kernel::<4, $v, $direct>($call),
+                3 => kernel::<3, $v, $direct>($call),
+                2 => kernel::<2, $v, $direct>($call),
+                _ => kernel::<1, $v, $direct>($call),
             }
         };
     }
 
     #[target_feature(enable = "avx512f")]
-    unsafe fn dispatch(rows: usize, two_vectors: bool, call: &Call) {
-        if two_vectors {
-            by_rows!(rows, 2, call)
-        } else {
-            by_rows!(rows, 1, call)
+    unsafe fn dispatch(rows: usize, two_vectors: bool, a_by_rows: bool, call: &Call) {
+        match (two_vectors, a_by_rows) {
+            (true, true) => by_rows!(rows, 2, true, call),
+            (true, false) => by_rows!(rows, 2, false, call),
+            (false, true) => by_rows!(rows, 1, true, call),
+            (false, false) => by_rows!(rows, 1, false, call),
         }
     }
 
     /// One R × 16·V tile of the output over kc steps of the inner dimension.
     #[target_feature(enable = "avx512f")]
-    unsafe fn kernel<const R: usize, const V: usize>(call: &Call) {
-        let &Call { a, b, kc, c, ldc, masks, begin, row, end, next_c, next_a, next_a_stride, prefetch_rows, .. } = call;
+    unsafe fn kernel<const R: usize, const V: usize, const A_BY_ROWS: bool>(call: &Call) {
+        let &Call {
+            a,
+            lda,
+            b,
+            kc,
+            c,
+            ldc,
+            masks,
+            begin,
+            load_from,
+            lds,
+            row,
+            end,
+            next_c,
+            next_a,
+            next_a_stride,
+            prefetch_rows,
+            ..
+        } = call;
         unsafe {
             // Prefetch addresses may lie past the output's last row or column (a shorter next block): a
             // prefetch never faults, and wrapping arithmetic keeps the pointer computation defined.
@@ -436,7 +510,7 @@ mod avx512 {
                 Begin::Load => {
                     for (r, values) in acc.iter_mut().enumerate() {
                         for (v, lane) in values.iter_mut().enumerate() {
-                            *lane = _mm512_maskz_loadu_ps(masks[v], c.add(r * ldc + 16 * v));
+                            *lane = _mm512_maskz_loadu_ps(masks[v], load_from.add(r * lds + 16 * v));
                         }
                     }
                 }
@@ -462,9 +536,9 @@ mod avx512 {
                 for (v, lane) in bv.iter_mut().enumerate() {
                     *lane = _mm512_loadu_ps(b.add(kk * NR + 16 * v));
                 }
-                let a_k = a.add(kk * MR);
                 for (r, values) in acc.iter_mut().enumerate() {
-                    let broadcast = _mm512_set1_ps(*a_k.add(r));
+                    let value = if A_BY_ROWS { *a.add(r * lda + kk) } else { *a.add(kk * lda + r) };
+                    let broadcast = _mm512_set1_ps(value);
                     for (v, lane) in values.iter_mut().enumerate() {
                         *lane = _mm512_fmadd_ps(broadcast, bv[v], *lane);
                     }
@@ -595,6 +669,14 @@ mod tests {
                 let mut masked = vec![1.0f32; m * n];
                 let dst = MatMut::from_row_major_slice_mut(&mut masked, m, n);
                 kernel.fused(dst, Start::Zero, a.as_ref(), b.as_ref(), Finish::ReluGrad(y));
+                // A start matrix read by rows, and one read by columns (the kernel copies it first).
+                let mut from_rows = vec![f32::NAN; m * n];
+                let dst = MatMut::from_row_major_slice_mut(&mut from_rows, m, n);
+                kernel.fused(dst, Start::Matrix(y), a.as_ref(), b.as_ref(), Finish::Store);
+                let y_by_columns = y.to_owned();
+                let mut from_columns = vec![f32::NAN; m * n];
+                let dst = MatMut::from_row_major_slice_mut(&mut from_columns, m, n);
+                kernel.fused(dst, Start::Matrix(y_by_columns.as_ref()), a.as_ref(), b.as_ref(), Finish::Store);
                 let tol = 1e-5 * (k as f64).sqrt() * 4.0;
                 for x in 0..m * n {
                     let (i, j) = (x / n, x % n);
@@ -602,7 +684,14 @@ mod tests {
                     let want_grad = if relu_out[x] <= 0.0 { 0.0 } else { plain[(i, j)] };
                     assert!((with_bias[x] as f64 - want_relu).abs() <= tol, "{kernel:?} relu {m}×{n}×{k} at {x}");
                     assert!((masked[x] as f64 - want_grad).abs() <= tol, "{kernel:?} relu grad {m}×{n}×{k} at {x}");
+                    if x != 7 {
+                        let want = plain[(i, j)] + relu_out[x] as f64;
+                        assert!((from_rows[x] as f64 - want).abs() <= tol, "{kernel:?} start {m}×{n}×{k} at {x}");
+                    }
                 }
+                assert!(from_rows[7].is_nan(), "{kernel:?}: the start matrix's NaN is kept");
+                let same_bits = from_rows.iter().zip(&from_columns).all(|(r, c)| r.to_bits() == c.to_bits());
+                assert!(same_bits, "{kernel:?}: a start by columns gives the bytes of one by rows");
             }
         }
     }

@@ -14,8 +14,8 @@ use rayon::prelude::*;
 
 use super::activation::{fast_sigmoid as sigmoid, fast_tanh as tanh};
 use super::backprop::{
-    add_column_sums, affine, assume_written, block_rows, matmul, new_product, slots, tensor_index, unwritten, view,
-    view_mut,
+    add_column_sums, affine, assume_written, block_rows, matmul, new_product, product_from, slots, tensor_index,
+    unwritten, view, view_mut,
 };
 use super::gemm::Finish;
 use super::params::ParamSet;
@@ -64,6 +64,13 @@ impl<'a> Gru<'a> {
         let (e, g) = (self.e, 3 * self.e);
         let weight = view(self.weight_ih, g, self.inputs * e).subcols(block * e, e).transpose();
         affine(view(x, rows, e), weight, self.bias_ih, Finish::Store)
+    }
+
+    /// gates + x · W_ih[:, block]ᵀ as a new buffer (rows × 3E), leaving `gates` as they are.
+    pub fn input_gates_from(&self, gates: &[f32], x: &[f32], rows: usize, block: usize) -> Vec<f32> {
+        let (e, g) = (self.e, 3 * self.e);
+        let weight = view(self.weight_ih, g, self.inputs * e).subcols(block * e, e).transpose();
+        product_from(gates, view(x, rows, e), weight)
     }
 
     /// gates (rows × 3E) += x · W_ih[:, block]ᵀ for input block `block` (0 context, 1 action, 2 terrain).

@@ -242,8 +242,7 @@ pub fn loss_and_gradients(
             })
             .collect();
         let (ctx_single, ctx_single_tape) = net.context_embedding.forward_relu(&beta_single, b * t);
-        let mut gi_single = copy_of(&action_gates);
-        net.gru.add_input_gates(&ctx_single, b * t, 0, &mut gi_single);
+        let gi_single = net.gru.input_gates_from(&action_gates, &ctx_single, b * t, 0);
         let mut h_single = copy_of(&h_all);
         let single_tape = net.gru.step(&gi_single, &mut h_single, b * t);
         (beta_single, ctx_single, ctx_single_tape, h_single, single_tape)
@@ -364,9 +363,8 @@ pub fn loss_and_gradients(
         }
         (Variance::Decoder(_), None) => unreachable!("a variance decoder's forward pass leaves its tape"),
     }
-    let mut d_h_all = copy_of(&d_decoded[..b * t * e]);
-    let d_h_single = &d_decoded[b * t * e..2 * b * t * e];
-    let d_open = &d_decoded[2 * b * t * e..];
+    let (d_h_all, d_predicted) = d_decoded.split_at_mut(b * t * e);
+    let (d_h_single, d_open) = (&d_predicted[..b * t * e], &d_predicted[b * t * e..]);
 
     // Back through the open loop and, beside it, through the single steps; their weight gradients are then
     // added in a fixed order.
@@ -420,10 +418,14 @@ pub fn loss_and_gradients(
     }
     net.gru.hidden_weight_backward(&seq_h_prev, &seq_d_gh, t * b, &mut grads);
     net.gru.hidden_weight_backward(&h_all, &single_d_gh, b * t, &mut grads);
-    add_into(&mut d_h_all, &d_h_prev_single);
+    add_into(d_h_all, &d_h_prev_single);
 
-    // The input gates: the action (and terrain) part and b_ih are shared by both predictions.
-    let mut d_action_gates = copy_of(&d_gi_single);
+    // The single steps' context block first: its input-gate gradients then become, in place, the action (and
+    // terrain) block's, which both predictions share with b_ih. The blocks are W_ih's disjoint columns.
+    let d_ctx_single = net.gru.input_backward_through_relu(&ctx_single, &d_gi_single, b * t, 0, &mut grads);
+    let d_beta_single =
+        net.context_embedding.backward(&beta_single, &ctx_single_tape, &d_ctx_single, b * t, &mut grads, true);
+    let mut d_action_gates = d_gi_single;
     add_into(&mut d_action_gates, &d_gi_seq);
     add_column_sums(&mut grads[net.gru.bias_ih_index()], &d_action_gates);
     let d_act_emb = net.gru.input_backward_through_relu(&act_emb, &d_action_gates, b * t, 1, &mut grads);
@@ -432,9 +434,6 @@ pub fn loss_and_gradients(
         let d_emb = net.gru.input_backward_through_relu(emb, &d_action_gates, b * t, 2, &mut grads);
         embedding.backward(tau, tape, &d_emb, b * t, &mut grads, false);
     }
-    let d_ctx_single = net.gru.input_backward_through_relu(&ctx_single, &d_gi_single, b * t, 0, &mut grads);
-    let d_beta_single =
-        net.context_embedding.backward(&beta_single, &ctx_single_tape, &d_ctx_single, b * t, &mut grads, true);
     let mut d_ctx_gates = vec![0.0; b * g];
     d_ctx_gates.par_chunks_mut(g).zip(d_gi_seq.par_chunks(t * g)).for_each(|(sum, steps)| {
         for step in steps.chunks(g) {
@@ -445,9 +444,9 @@ pub fn loss_and_gradients(
     let d_beta = net.context_embedding.backward(&beta, &ctx_seq_tape, &d_ctx_seq, b, &mut grads, true);
 
     // The state encoder.
-    let mut d_state = d_h_all;
-    zip_values(&mut d_state, &h_all, |d, y| *d *= 1.0 - y * y);
-    net.state_encoder.backward(&starts, &state_tape, &d_state, b * t, &mut grads, false);
+    let d_state = d_h_all;
+    zip_values(d_state, &h_all, |d, y| *d *= 1.0 - y * y);
+    net.state_encoder.backward(&starts, &state_tape, d_state, b * t, &mut grads, false);
 
     // The beliefs: reparameterized samples and the KL terms.
     let mut d_post_mean = vec![0.0; b * lat];
