@@ -9,8 +9,11 @@ first runs `cargo run --release --example ball_loss_case`, which writes them wit
 training losses to target/ball_loss_case.json, then `benches/pytorch/ball_reference.py --check` on that file,
 and stops if the reference no longer computes mbrl's loss; neither counts towards either side's load figures.
 
-A step meets the target when mbrl is at least 2x PyTorch, or when mbrl reaches at least 85 % of the GEMM
-ceiling without being slower than PyTorch (where PyTorch itself already runs near the ceiling).
+A step meets the target when mbrl is at least 2x PyTorch, or, for the steps whose PyTorch side already runs
+near the ceiling (PETS medium and DLGPD's conv VAE, as issue 39 names them), when mbrl reaches at least 85 %
+of the GEMM ceiling without being slower than PyTorch. The other steps' GFLOP/s divide PyTorch's FLOP count,
+which can exceed the work mbrl does (the context model shares its action embedding between the single-step and
+multi-step predictions), so their share of the ceiling is not a target.
 
 Usage: python3 benches/vs_pytorch.py [--quick] [--only NAME[,NAME...]] [--python PY] [--markdown FILE]
 (`make bench-vs-pytorch` runs it; PYTORCH_PYTHON names an interpreter that has torch.)
@@ -39,6 +42,9 @@ LABELS = {
     "dlgpd_b1024": "DLGPD step without Adam, batch 1024",
     "ball_b64x50": "ball EKF, 64 chunks × 50 frames",
 }
+
+# The steps whose PyTorch side runs near the GEMM ceiling, where 85 % of it is the alternative to 2x.
+NEAR_CEILING = {"pets_medium", "dlgpd_b256", "dlgpd_b1024"}
 
 
 def machine_busy_seconds():
@@ -135,7 +141,7 @@ def main():
         share = our_rate / ceiling[threads] if our_rate and threads in ceiling else None
         if ratio is None:
             verdict = "no PyTorch reference"
-        elif ratio >= 2.0 or (share is not None and share >= 0.85 and ratio >= 1.0):
+        elif ratio >= 2.0 or (name in NEAR_CEILING and share is not None and share >= 0.85 and ratio >= 1.0):
             verdict = "met"
         else:
             verdict = "not met"

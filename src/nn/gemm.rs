@@ -523,26 +523,40 @@ mod avx512 {
                 }
             }
             // The next rows' kc values, one 16-value line per step, row by row.
-            let lines_per_row = kc.div_ceil(16);
-            let prefetch_steps = prefetch_rows * lines_per_row;
-            for kk in 0..kc {
-                if kk < prefetch_steps {
-                    let (ahead, line) = (kk / lines_per_row, kk % lines_per_row);
-                    _mm_prefetch::<_MM_HINT_T0>(
-                        next_a.wrapping_offset(ahead as isize * next_a_stride + 16 * line as isize) as *const i8,
-                    );
-                }
-                let mut bv = [_mm512_setzero_ps(); V];
-                for (v, lane) in bv.iter_mut().enumerate() {
-                    *lane = _mm512_loadu_ps(b.add(kk * NR + 16 * v));
-                }
-                for (r, values) in acc.iter_mut().enumerate() {
-                    let value = if A_BY_ROWS { *a.add(r * lda + kk) } else { *a.add(kk * lda + r) };
-                    let broadcast = _mm512_set1_ps(value);
-                    for (v, lane) in values.iter_mut().enumerate() {
-                        *lane = _mm512_fmadd_ps(broadcast, bv[v], *lane);
+            macro_rules! step {
+                ($kk:expr) => {{
+                    let kk = $kk;
+                    let mut bv = [_mm512_setzero_ps(); V];
+                    for (v, lane) in bv.iter_mut().enumerate() {
+                        *lane = _mm512_loadu_ps(b.add(kk * NR + 16 * v));
                     }
+                    for (r, values) in acc.iter_mut().enumerate() {
+                        let value = if A_BY_ROWS { *a.add(r * lda + kk) } else { *a.add(kk * lda + r) };
+                        let broadcast = _mm512_set1_ps(value);
+                        for (v, lane) in values.iter_mut().enumerate() {
+                            *lane = _mm512_fmadd_ps(broadcast, bv[v], *lane);
+                        }
+                    }
+                }};
+            }
+            // The first steps each fetch one 16-value line of the next rows' kc values, row by row; the steps
+            // are split into loops over rows and lines so no step divides to find its line.
+            let lines_per_row = kc.div_ceil(16);
+            let mut kk = 0;
+            'prefetching: for ahead in 0..prefetch_rows {
+                let next_row = next_a.wrapping_offset(ahead as isize * next_a_stride);
+                for line in 0..lines_per_row {
+                    if kk == kc {
+                        break 'prefetching;
+                    }
+                    _mm_prefetch::<_MM_HINT_T0>(next_row.wrapping_add(16 * line) as *const i8);
+                    step!(kk);
+                    kk += 1;
                 }
+            }
+            while kk < kc {
+                step!(kk);
+                kk += 1;
             }
             for (r, values) in acc.iter().enumerate() {
                 for (v, lane) in values.iter().enumerate() {

@@ -37,8 +37,9 @@ pub struct GruTape {
     r: Vec<f32>,
     z: Vec<f32>,
     n: Vec<f32>,
-    /// W_hn h + b_hn, which the reset gate scales.
-    hn: Vec<f32>,
+    /// The hidden gates W_hh h + b_hh (rows × 3E): the backward pass needs their third block, W_hn h + b_hn,
+    /// which the reset gate scales, and keeping the product spares a copy of it.
+    gh: Vec<f32>,
 }
 
 impl<'a> Gru<'a> {
@@ -112,13 +113,13 @@ impl<'a> Gru<'a> {
         let size = rows * e;
         // The blocks below write every slot of the tapes only when the inputs have these sizes.
         assert!(h.len() == size && gi.len() == rows * g, "GRU step: h or gi does not hold {rows} rows");
-        let (mut r, mut z, mut n, mut hn) = (unwritten(size), unwritten(size), unwritten(size), unwritten(size));
+        let (mut r, mut z, mut n) = (unwritten(size), unwritten(size), unwritten(size));
         let (he, hg) = (block_rows(rows, e) * e, block_rows(rows, e) * g);
         h.par_chunks_mut(he)
             .zip(slots(&mut r, size).par_chunks_mut(he).zip(slots(&mut z, size).par_chunks_mut(he)))
-            .zip(slots(&mut n, size).par_chunks_mut(he).zip(slots(&mut hn, size).par_chunks_mut(he)))
+            .zip(slots(&mut n, size).par_chunks_mut(he))
             .zip(gi.par_chunks(hg).zip(gh.par_chunks(hg)))
-            .for_each(|(((h, (r, z)), (n, hn)), (gi, gh))| {
+            .for_each(|(((h, (r, z)), n), (gi, gh))| {
                 for row in 0..h.len() / e {
                     let (gi, gh) = (&gi[row * g..(row + 1) * g], &gh[row * g..(row + 1) * g]);
                     for k in 0..e {
@@ -129,18 +130,17 @@ impl<'a> Gru<'a> {
                         r[at].write(reset);
                         z[at].write(update);
                         n[at].write(new);
-                        hn[at].write(gh[2 * e + k]);
                         h[at] = (1.0 - update) * new + update * h[at];
                     }
                 }
             });
-        // SAFETY: the blocks of h cover all `size` values, and each wrote its rows of all four tapes.
+        // SAFETY: the blocks of h cover all `size` values, and each wrote its rows of all three tapes.
         unsafe {
-            for buffer in [&mut r, &mut z, &mut n, &mut hn] {
+            for buffer in [&mut r, &mut z, &mut n] {
                 assume_written(buffer, size);
             }
         }
-        GruTape { r, z, n, hn }
+        GruTape { r, z, n, gh }
     }
 
     /// Backward of one step: from dh' (rows × E) and the previous state, dh and the input-gate gradients
@@ -156,22 +156,27 @@ impl<'a> Gru<'a> {
     ) -> (Vec<f32>, Vec<f32>) {
         let (e, g) = (self.e, 3 * self.e);
         let size = rows * e;
-        let sizes = [tape.r.len(), tape.z.len(), tape.n.len(), tape.hn.len(), h_prev.len(), dh_next.len()];
-        assert!(sizes.iter().all(|&n| n == size) && d_gh.len() == rows * g, "GRU step back: buffers of another size");
+        let sizes = [tape.r.len(), tape.z.len(), tape.n.len(), h_prev.len(), dh_next.len()];
+        let gate_sizes = [tape.gh.len(), d_gh.len()];
+        assert!(
+            sizes.iter().all(|&n| n == size) && gate_sizes.iter().all(|&n| n == rows * g),
+            "GRU step back: buffers of another size"
+        );
         let (mut dh, mut d_gi) = (unwritten(size), unwritten(rows * g));
         let (he, hg) = (block_rows(rows, e) * e, block_rows(rows, e) * g);
         slots(&mut dh, size)
             .par_chunks_mut(he)
             .zip(slots(&mut d_gi, rows * g).par_chunks_mut(hg).zip(d_gh.par_chunks_mut(hg)))
             .zip(tape.r.par_chunks(he).zip(tape.z.par_chunks(he)))
-            .zip(tape.n.par_chunks(he).zip(tape.hn.par_chunks(he)))
+            .zip(tape.n.par_chunks(he).zip(tape.gh.par_chunks(hg)))
             .zip(h_prev.par_chunks(he).zip(dh_next.par_chunks(he)))
-            .for_each(|((((dh, (d_gi, d_gh)), (r, z)), (n, hn)), (h_prev, dh_next))| {
+            .for_each(|((((dh, (d_gi, d_gh)), (r, z)), (n, gh)), (h_prev, dh_next))| {
                 for row in 0..dh.len() / e {
                     let (d_gi, d_gh) = (&mut d_gi[row * g..(row + 1) * g], &mut d_gh[row * g..(row + 1) * g]);
+                    let hn = &gh[row * g + 2 * e..(row + 1) * g];
                     for k in 0..e {
                         let at = row * e + k;
-                        let (r, z, n, hn) = (r[at], z[at], n[at], hn[at]);
+                        let (r, z, n, hn) = (r[at], z[at], n[at], hn[k]);
                         let d = dh_next[at];
                         let dn = d * (1.0 - z) * (1.0 - n * n);
                         let dz = d * (h_prev[at] - n) * z * (1.0 - z);
