@@ -44,12 +44,26 @@ pub fn matmul_by(
     b: MatRef<'_, f32>,
     finish: Finish<'_>,
 ) {
+    matmul_summing(kernel, dst, start, a, b, finish, None);
+}
+
+/// [`matmul_by`], and with `row_sums` also row_sums[i] += Σ_k a[i, k] (see [`Kernel::fused_summing`]): each
+/// row's sum is one piece's, in order of k, whatever the split.
+pub fn matmul_summing(
+    kernel: Kernel,
+    dst: MatMut<'_, f32>,
+    start: Start<'_>,
+    a: MatRef<'_, f32>,
+    b: MatRef<'_, f32>,
+    finish: Finish<'_>,
+    row_sums: Option<&mut [f32]>,
+) {
     let pieces = if dst.nrows() * dst.ncols() * a.ncols() >= PARALLEL_WORK { rayon::current_num_threads() } else { 1 };
     let product = Product { kernel, start, finish };
     if dst.ncols() >= 4 * dst.nrows() {
-        split_cols(dst, a, b, product, pieces);
+        split_cols(dst, a, b, product, pieces, row_sums);
     } else {
-        split_rows(dst, a, b, product, pieces);
+        split_rows(dst, a, b, product, pieces, row_sums);
     }
 }
 
@@ -61,10 +75,17 @@ struct Product<'a> {
     finish: Finish<'a>,
 }
 
-fn split_rows(dst: MatMut<'_, f32>, a: MatRef<'_, f32>, b: MatRef<'_, f32>, product: Product<'_>, pieces: usize) {
+fn split_rows(
+    dst: MatMut<'_, f32>,
+    a: MatRef<'_, f32>,
+    b: MatRef<'_, f32>,
+    product: Product<'_>,
+    pieces: usize,
+    row_sums: Option<&mut [f32]>,
+) {
     let m = dst.nrows();
     if pieces <= 1 || m < 16 {
-        product.kernel.fused(dst, product.start, a, b, product.finish);
+        product.kernel.fused_summing(dst, product.start, a, b, product.finish, row_sums);
         return;
     }
     let half = pieces / 2;
@@ -74,13 +95,31 @@ fn split_rows(dst: MatMut<'_, f32>, a: MatRef<'_, f32>, b: MatRef<'_, f32>, prod
     let upper = Product { start: product.start.rows(0, mid), finish: product.finish.rows(0, mid), ..product };
     let lower =
         Product { start: product.start.rows(mid, m - mid), finish: product.finish.rows(mid, m - mid), ..product };
-    rayon::join(|| split_rows(top, a_top, b, upper, half), || split_rows(bottom, a_bottom, b, lower, pieces - half));
+    let (sums_top, sums_bottom) = match row_sums {
+        Some(sums) => {
+            let (top, bottom) = sums.split_at_mut(mid);
+            (Some(top), Some(bottom))
+        }
+        None => (None, None),
+    };
+    rayon::join(
+        || split_rows(top, a_top, b, upper, half, sums_top),
+        || split_rows(bottom, a_bottom, b, lower, pieces - half, sums_bottom),
+    );
 }
 
-fn split_cols(dst: MatMut<'_, f32>, a: MatRef<'_, f32>, b: MatRef<'_, f32>, product: Product<'_>, pieces: usize) {
+/// Every piece reads all of `a`'s rows: the first one (from column 0) adds the row sums.
+fn split_cols(
+    dst: MatMut<'_, f32>,
+    a: MatRef<'_, f32>,
+    b: MatRef<'_, f32>,
+    product: Product<'_>,
+    pieces: usize,
+    row_sums: Option<&mut [f32]>,
+) {
     let n = dst.ncols();
     if pieces <= 1 || n < 16 {
-        product.kernel.fused(dst, product.start, a, b, product.finish);
+        product.kernel.fused_summing(dst, product.start, a, b, product.finish, row_sums);
         return;
     }
     let half = pieces / 2;
@@ -91,8 +130,8 @@ fn split_cols(dst: MatMut<'_, f32>, a: MatRef<'_, f32>, b: MatRef<'_, f32>, prod
     let right_part =
         Product { start: product.start.cols(mid, n - mid), finish: product.finish.cols(mid, n - mid), ..product };
     rayon::join(
-        || split_cols(left, a, b_left, left_part, half),
-        || split_cols(right, a, b_right, right_part, pieces - half),
+        || split_cols(left, a, b_left, left_part, half, row_sums),
+        || split_cols(right, a, b_right, right_part, pieces - half, None),
     );
 }
 
@@ -114,6 +153,18 @@ fn transposed_product(mut dst: MatMut<'_, f32>, accum: Accum, a: MatRef<'_, f32>
     match accum {
         Accum::Add => dst += product,
         Accum::Replace => dst.copy_from(product),
+    }
+}
+
+/// Two distinct buffers of `buffers`, both writable.
+fn two_mut(buffers: &mut [Vec<f32>], first: usize, second: usize) -> (&mut Vec<f32>, &mut Vec<f32>) {
+    assert_ne!(first, second, "two_mut: one buffer twice");
+    if first < second {
+        let (head, tail) = buffers.split_at_mut(second);
+        (&mut head[first], &mut tail[0])
+    } else {
+        let (head, tail) = buffers.split_at_mut(first);
+        (&mut tail[0], &mut head[second])
     }
 }
 
@@ -193,7 +244,7 @@ impl<'a> Dense<'a> {
     pub fn backward(&self, x: &[f32], dy: &[f32], rows: usize, grads: &mut [Vec<f32>], want_dx: bool) -> Vec<f32> {
         debug_assert_eq!(dy.len(), rows * self.d_out);
         let (o, i) = (self.d_out, self.d_in);
-        let weight_grad = &mut grads[self.weight_index];
+        let (weight_grad, bias_grad) = two_mut(grads, self.weight_index, self.bias_index);
         if self.non_negative {
             // Only the positive raw weights act, so only they receive gradient (burn's ReLU backward).
             let mut acting = vec![0.0; o * i];
@@ -204,9 +255,16 @@ impl<'a> Dense<'a> {
                 }
             }
         } else {
-            matmul(view_mut(weight_grad, o, i), Accum::Add, view(dy, rows, o).transpose(), view(x, rows, i));
+            let (dst, a, b) = (view_mut(weight_grad, o, i), view(dy, rows, o).transpose(), view(x, rows, i));
+            let kernel = Kernel::for_product(&dst, &a, &b);
+            if kernel != Kernel::Faer && !is_tall_weight_gradient(&dst, &a, &b) {
+                // The bias gradient, dY's column sums, added up as the kernel packs dYᵀ.
+                matmul_summing(kernel, dst, Start::Dst, a, b, Finish::Store, Some(bias_grad));
+                return if want_dx { self.backward_input(dy, rows) } else { Vec::new() };
+            }
+            matmul(dst, Accum::Add, a, b);
         }
-        add_column_sums(&mut grads[self.bias_index], dy);
+        add_column_sums(bias_grad, dy);
         if !want_dx {
             return Vec::new();
         }
@@ -496,6 +554,7 @@ pub fn relu_backward(d: &mut [f32], y: &[f32]) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::nn::params::NamedTensor;
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
@@ -546,19 +605,79 @@ mod tests {
                 (Start::Zero, Finish::ReluGrad(view(&relu_out, m, n))),
                 (Start::Matrix(view(&gates, m, n)), Finish::Store),
             ];
+            // `a` stored by rows and by columns (a weight gradient's dYᵀ), which the kernel reads differently.
+            let a_by_columns: Vec<f32> = (0..m * k).map(|x| a[(x % m) * k + x / m]).collect();
             for (start, finish) in cases {
-                let mut one = vec![0.5; m * n];
-                kernel.fused(view_mut(&mut one, m, n), start, view(&a, m, k), view(&b, k, n), finish);
-                let product = Product { kernel, start, finish };
-                for pieces in [2, 3, 7] {
-                    let mut split = vec![0.5; m * n];
-                    split_rows(view_mut(&mut split, m, n), view(&a, m, k), view(&b, k, n), product, pieces);
-                    assert_eq!(split, one, "{kernel:?} {start:?}: {pieces} pieces of rows");
-                    let mut split = vec![0.5; m * n];
-                    split_cols(view_mut(&mut split, m, n), view(&a, m, k), view(&b, k, n), product, pieces);
-                    assert_eq!(split, one, "{kernel:?} {start:?}: {pieces} pieces of columns");
+                for a_view in [view(&a, m, k), view(&a_by_columns, k, m).transpose()] {
+                    let mut one = vec![0.5; m * n];
+                    let mut one_sums = vec![0.25; m];
+                    let dst = view_mut(&mut one, m, n);
+                    kernel.fused_summing(dst, start, a_view, view(&b, k, n), finish, Some(&mut one_sums));
+                    let product = Product { kernel, start, finish };
+                    for pieces in [2, 3, 7] {
+                        for by_rows in [true, false] {
+                            let (mut split, mut sums) = (vec![0.5; m * n], vec![0.25; m]);
+                            let dst = view_mut(&mut split, m, n);
+                            let split_by = if by_rows { split_rows } else { split_cols };
+                            split_by(dst, a_view, view(&b, k, n), product, pieces, Some(&mut sums));
+                            let what = if by_rows { "rows" } else { "columns" };
+                            assert_eq!(split, one, "{kernel:?} {start:?}: {pieces} pieces of {what}");
+                            assert_eq!(sums, one_sums, "{kernel:?} {start:?}: row sums, {pieces} pieces of {what}");
+                        }
+                    }
+                    for (i, sum) in one_sums.iter().enumerate() {
+                        let want = 0.25 + (0..k).map(|kk| a[i * k + kk] as f64).sum::<f64>();
+                        assert!((*sum as f64 - want).abs() <= 1e-4, "{kernel:?}: row {i} sums to {sum}, not {want}");
+                    }
                 }
             }
+        }
+    }
+
+    /// A layer's gradients on a batch large enough for the AVX-512 kernel, which sums the bias gradient as it
+    /// packs dYᵀ: the sums of an f64 reference, and the same bytes on any pool.
+    #[test]
+    fn a_large_layers_gradients_are_the_sums_on_any_pool() {
+        let mut rng = ChaCha8Rng::seed_from_u64(6);
+        let (rows, d_in, d_out) = (3000, 150, 200);
+        let mut random = |n: usize| (0..n).map(|_| rng.random_range(-1.0f32..1.0)).collect::<Vec<_>>();
+        let params = ParamSet {
+            tensors: vec![
+                NamedTensor { name: "layer.weight".into(), shape: vec![d_out, d_in], values: random(d_out * d_in) },
+                NamedTensor { name: "layer.bias".into(), shape: vec![d_out], values: random(d_out) },
+            ],
+        };
+        let (x, dy) = (random(rows * d_in), random(rows * d_out));
+        let layer = Dense::new(&params, "layer", d_in, d_out, false).unwrap();
+        let mut probe = vec![0.0; d_out * d_in];
+        let (dst, a, b) = (view_mut(&mut probe, d_out, d_in), view(&dy, rows, d_out).transpose(), view(&x, rows, d_in));
+        assert!(!is_tall_weight_gradient(&dst, &a, &b));
+        assert_eq!(Some(&Kernel::for_product(&dst, &a, &b)), crate::nn::gemm::available_kernels().last());
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| {
+                let mut grads = vec![vec![0.5; d_out * d_in], vec![0.25; d_out]];
+                let dx = layer.backward(&x, &dy, rows, &mut grads, true);
+                (grads, dx)
+            })
+        };
+        let (grads, dx) = run(1);
+        for o in 0..d_out {
+            let bias = 0.25 + (0..rows).map(|r| dy[r * d_out + o] as f64).sum::<f64>();
+            assert!((grads[1][o] as f64 - bias).abs() <= 1e-3, "bias {o}: {} vs {bias}", grads[1][o]);
+            for i in (0..d_in).step_by(7) {
+                let weight = 0.5 + (0..rows).map(|r| dy[r * d_out + o] as f64 * x[r * d_in + i] as f64).sum::<f64>();
+                let got = grads[0][o * d_in + i] as f64;
+                assert!((got - weight).abs() <= 1e-3, "weight ({o}, {i}): {got} vs {weight}");
+            }
+        }
+        let w = &params.tensors[0].values;
+        for r in (0..rows).step_by(97) {
+            let want = (0..d_out).map(|o| dy[r * d_out + o] as f64 * w[o * d_in] as f64).sum::<f64>();
+            assert!((dx[r * d_in] as f64 - want).abs() <= 1e-3, "dx row {r}");
+        }
+        for threads in [2, 3] {
+            assert_eq!(run(threads), (grads.clone(), dx.clone()), "{threads} threads");
         }
     }
 

@@ -122,13 +122,31 @@ impl Kernel {
     /// each tile in registers, which spares the training paths a pass over every layer's output.
     pub fn fused(
         self,
-        mut dst: MatMut<'_, f32>,
+        dst: MatMut<'_, f32>,
         start: Start<'_>,
         a: MatRef<'_, f32>,
         b: MatRef<'_, f32>,
         finish: Finish<'_>,
     ) {
+        self.fused_summing(dst, start, a, b, finish, None);
+    }
+
+    /// [`Kernel::fused`], and with `row_sums` (m values) also row_sums[i] += Σ_k a[i, k], each summed in order
+    /// of k: a layer's bias gradient beside its weight gradient dYᵀ·X, which the AVX-512 kernel adds up as it
+    /// packs dYᵀ instead of in a pass of its own over dY.
+    pub fn fused_summing(
+        self,
+        mut dst: MatMut<'_, f32>,
+        start: Start<'_>,
+        a: MatRef<'_, f32>,
+        b: MatRef<'_, f32>,
+        finish: Finish<'_>,
+        row_sums: Option<&mut [f32]>,
+    ) {
         let (m, n) = (dst.nrows(), dst.ncols());
+        if let Some(sums) = &row_sums {
+            assert_eq!(sums.len(), m, "gemm: row sums need one value per row of a");
+        }
         match start {
             Start::Row(row) => assert_eq!(row.len(), n, "gemm: a start row needs one value per output column"),
             Start::Matrix(start) => {
@@ -157,6 +175,9 @@ impl Kernel {
                 };
                 faer::linalg::matmul::matmul(dst.as_mut(), accum, a, b, 1.0f32, Par::Seq);
                 finish_pass(dst, finish);
+                if let Some(sums) = row_sums {
+                    add_row_sums(sums, a);
+                }
             }
             #[cfg(target_arch = "x86_64")]
             Kernel::Avx512 => {
@@ -169,22 +190,29 @@ impl Kernel {
                     if source.col_stride() != 1 {
                         // A start the tiles cannot read by rows: copied into the output first.
                         dst.copy_from(source);
-                        return Kernel::Avx512.fused(dst, Start::Dst, a, b, finish);
+                        return Kernel::Avx512.fused_summing(dst, Start::Dst, a, b, finish, row_sums);
                     }
                 }
                 if mask_by_rows {
                     // SAFETY: `fits` checked that the CPU has AVX-512F and that the layouts are those the kernel
                     // reads; the start row and the ReLU output have the output's shape (asserted above), the
                     // ReLU output by rows.
-                    unsafe { avx512::product(dst, start, a, b, finish) }
+                    unsafe { avx512::product(dst, start, a, b, finish, row_sums) }
                 } else {
                     // A ReLU output the tiles cannot read by rows: the mask as a pass of its own.
                     // SAFETY: as above, with no finish in the kernel.
-                    unsafe { avx512::product(dst.as_mut(), start, a, b, Finish::Store) };
+                    unsafe { avx512::product(dst.as_mut(), start, a, b, Finish::Store, row_sums) };
                     finish_pass(dst, finish);
                 }
             }
         }
+    }
+}
+
+/// sums[i] += Σ_k a[i, k], in order of k.
+fn add_row_sums(sums: &mut [f32], a: MatRef<'_, f32>) {
+    for (i, sum) in sums.iter_mut().enumerate() {
+        *sum = a.row(i).iter().fold(*sum, |total, x| total + x);
     }
 }
 
@@ -250,13 +278,14 @@ mod avx512 {
 
     /// # Safety
     /// The CPU supports AVX-512F and `fits(&dst, &a, &b)` holds; a `Row` start has n values, a `ReluGrad`
-    /// matrix is m × n with unit column stride.
+    /// matrix is m × n with unit column stride, `row_sums` has m values.
     pub(super) unsafe fn product(
         dst: MatMut<'_, f32>,
         start: Start<'_>,
         a: MatRef<'_, f32>,
         b: MatRef<'_, f32>,
         finish: Finish<'_>,
+        mut row_sums: Option<&mut [f32]>,
     ) {
         let (m, n, k) = (dst.nrows(), dst.ncols(), a.ncols());
         assert!(a.nrows() == m && b.nrows() == k && b.ncols() == n, "gemm: operand shapes do not fit");
@@ -293,12 +322,18 @@ mod avx512 {
             };
             for i0 in (0..m).step_by(MR) {
                 let rows = (m - i0).min(MR);
+                let block = a.subrows(i0, rows).subcols(k0, kc);
+                // Each row's sum goes on from the last block of k, so it is summed in order of k throughout.
+                let sums = row_sums.as_deref_mut().map(|sums| &mut sums[i0..i0 + rows]);
                 let a_rows = if a_by_rows {
+                    if let Some(sums) = sums {
+                        super::add_row_sums(sums, block);
+                    }
                     // SAFETY: row i0 < m and column k0 < k lie inside `a`.
                     unsafe { a.as_ptr().offset(i0 as isize * ars + k0 as isize) }
                 } else {
                     // SAFETY: as above; `a`'s row stride is 1, and the caller guarantees AVX-512F.
-                    unsafe { pack_columns(a.subrows(i0, rows).subcols(k0, kc), &mut a_block) };
+                    unsafe { pack_columns(block, &mut a_block, sums) };
                     a_block.as_ptr()
                 };
                 // Rows read along k stream from memory: the next block's are fetched while this one works.
@@ -353,16 +388,26 @@ mod avx512 {
     /// A block of `a`'s rows, stored by columns, as [k][MR]: each k's values are consecutive, one masked
     /// vector copy (slots past the block's last row are left as they were: a kernel for fewer rows never reads
     /// them).
+    /// With `sums` (one per row), adds each row's values to its sum in order of k.
     #[target_feature(enable = "avx512f")]
-    unsafe fn pack_columns(rows: MatRef<'_, f32>, out: &mut [f32]) {
+    unsafe fn pack_columns(rows: MatRef<'_, f32>, out: &mut [f32], sums: Option<&mut [f32]>) {
         let mask = ((1u32 << rows.nrows()) - 1) as __mmask16;
         assert!(rows.row_stride() == 1 && rows.nrows() <= MR && out.len() >= rows.ncols() * MR);
+        assert!(sums.as_ref().is_none_or(|sums| sums.len() == rows.nrows()));
+        // SAFETY: `sums` holds nrows values, which the mask covers.
+        let mut total =
+            sums.as_ref().map_or(_mm512_setzero_ps(), |sums| unsafe { _mm512_maskz_loadu_ps(mask, sums.as_ptr()) });
         for kk in 0..rows.ncols() {
             // SAFETY: column kk holds nrows consecutive values; out holds MR values at kk·MR.
             unsafe {
                 let column = _mm512_maskz_loadu_ps(mask, rows.as_ptr().offset(kk as isize * rows.col_stride()));
                 _mm512_mask_storeu_ps(out.as_mut_ptr().add(kk * MR), mask, column);
+                total = _mm512_add_ps(total, column);
             }
+        }
+        if let Some(sums) = sums {
+            // SAFETY: as above.
+            unsafe { _mm512_mask_storeu_ps(sums.as_mut_ptr(), mask, total) };
         }
     }
 
