@@ -309,7 +309,7 @@ pub fn product_from(start: &[f32], a: MatRef<'_, f32>, b: MatRef<'_, f32>) -> Ve
     fresh_product(a, b, Start::Matrix(view(start, a.nrows(), b.ncols())), Finish::Store)
 }
 
-/// `start` must be `Zero`, `Row` or `Matrix`: nothing in the new buffer can be read.
+/// Nothing in the new buffer can be read, so a `Dst` start is taken as `Zero`.
 fn fresh_product(a: MatRef<'_, f32>, b: MatRef<'_, f32>, start: Start<'_>, finish: Finish<'_>) -> Vec<f32> {
     let (rows, width) = (a.nrows(), b.ncols());
     let n = rows * width;

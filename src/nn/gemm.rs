@@ -7,8 +7,8 @@
 //! prefetches the next output tile and the next rows of the left operand while it works on the current ones,
 //! and which starts each tile from a bias row (or from a matrix the caller keeps) and ends it with a ReLU (or a
 //! ReLU's gradient mask) in cache: the passes that wrote the bias rows and applied the activation over every
-//! layer's output cost the context model's step as much again as the kernel saves. Elsewhere, and for products small enough to stay in cache,
-//! faer does the work, with the start and the finish as passes of their own.
+//! layer's output cost the context model's step as much again as the kernel saves. Elsewhere, and for products
+//! small enough to stay in cache, faer does the work, with the start and the finish as passes of their own.
 //!
 //! On either kernel every output element is one thread's sum in one order (on this one: its start, then
 //! k = 0, 1, … by fused multiply-adds), whatever the split of rows or columns around it, and the kernel is
@@ -187,8 +187,8 @@ impl Kernel {
                     _ => true,
                 };
                 if let Start::Matrix(source) = start {
-                    if source.col_stride() != 1 {
-                        // A start the tiles cannot read by rows: copied into the output first.
+                    if source.col_stride() != 1 || source.row_stride() < 0 {
+                        // A start the tiles cannot read by rows, forwards: copied into the output first.
                         dst.copy_from(source);
                         return Kernel::Avx512.fused_summing(dst, Start::Dst, a, b, finish, row_sums);
                     }
@@ -277,8 +277,10 @@ mod avx512 {
     }
 
     /// # Safety
-    /// The CPU supports AVX-512F and `fits(&dst, &a, &b)` holds; a `Row` start has n values, a `ReluGrad`
-    /// matrix is m × n with unit column stride, `row_sums` has m values.
+    /// The CPU supports AVX-512F and `fits(&dst, &a, &b)` holds; a `Row` start has n values, a `Matrix` start
+    /// and a `ReluGrad` matrix are m × n with unit column stride (the start also with a row stride ≥ 0),
+    /// `row_sums` has m values. A tile's second vector may lie past a buffer's end where its mask is empty:
+    /// masked loads and stores never touch those lanes, and its address is computed with wrapping arithmetic.
     pub(super) unsafe fn product(
         dst: MatMut<'_, f32>,
         start: Start<'_>,
@@ -434,7 +436,7 @@ mod avx512 {
                     unsafe {
                         let src = b.as_ptr().offset((k0 + kk) as isize * b.row_stride() + (p * NR) as isize);
                         for (v, &mask) in masks.iter().enumerate() {
-                            let values = _mm512_maskz_loadu_ps(mask, src.add(16 * v));
+                            let values = _mm512_maskz_loadu_ps(mask, src.wrapping_add(16 * v));
                             _mm512_storeu_ps(row.as_mut_ptr().add(16 * v), values);
                         }
                     }
@@ -555,19 +557,18 @@ mod avx512 {
                 Begin::Load => {
                     for (r, values) in acc.iter_mut().enumerate() {
                         for (v, lane) in values.iter_mut().enumerate() {
-                            *lane = _mm512_maskz_loadu_ps(masks[v], load_from.add(r * lds + 16 * v));
+                            *lane = _mm512_maskz_loadu_ps(masks[v], load_from.wrapping_add(r * lds + 16 * v));
                         }
                     }
                 }
                 Begin::Row => {
                     for values in acc.iter_mut() {
                         for (v, lane) in values.iter_mut().enumerate() {
-                            *lane = _mm512_maskz_loadu_ps(masks[v], row.add(16 * v));
+                            *lane = _mm512_maskz_loadu_ps(masks[v], row.wrapping_add(16 * v));
                         }
                     }
                 }
             }
-            // The next rows' kc values, one 16-value line per step, row by row.
             macro_rules! step {
                 ($kk:expr) => {{
                     let kk = $kk;
@@ -605,7 +606,7 @@ mod avx512 {
             }
             for (r, values) in acc.iter().enumerate() {
                 for (v, lane) in values.iter().enumerate() {
-                    _mm512_mask_storeu_ps(c.add(r * ldc + 16 * v), masks[v], *lane);
+                    _mm512_mask_storeu_ps(c.wrapping_add(r * ldc + 16 * v), masks[v], *lane);
                 }
             }
             if end != End::Store {
@@ -624,14 +625,14 @@ mod avx512 {
         for r in 0..R {
             for (v, &mask) in masks.iter().enumerate().take(V) {
                 unsafe {
-                    let at = c.add(r * ldc + 16 * v);
+                    let at = c.wrapping_add(r * ldc + 16 * v);
                     let value = _mm512_maskz_loadu_ps(mask, at);
                     let value = match end {
                         End::Store => value,
                         // max_ps gives its second operand where the first is NaN: 0, as f32::max does.
                         End::Relu => _mm512_max_ps(value, zero),
                         End::ReluGrad => {
-                            let y = _mm512_maskz_loadu_ps(mask, relu_out.add(r * ldy + 16 * v));
+                            let y = _mm512_maskz_loadu_ps(mask, relu_out.wrapping_add(r * ldy + 16 * v));
                             // Zero where y ≤ 0 (a NaN y keeps the gradient, as relu_backward does).
                             _mm512_mask_mov_ps(value, _mm512_cmp_ps_mask::<_CMP_LE_OQ>(y, zero), zero)
                         }
@@ -736,9 +737,18 @@ mod tests {
                 let mut from_columns = vec![f32::NAN; m * n];
                 let dst = MatMut::from_row_major_slice_mut(&mut from_columns, m, n);
                 kernel.fused(dst, Start::Matrix(y_by_columns.as_ref()), a.as_ref(), b.as_ref(), Finish::Store);
+                // And one whose rows run backwards (a negative row stride), which the kernel also copies first.
+                let mut from_reversed = vec![f32::NAN; m * n];
+                let dst = MatMut::from_row_major_slice_mut(&mut from_reversed, m, n);
+                kernel.fused(dst, Start::Matrix(y.reverse_rows()), a.as_ref(), b.as_ref(), Finish::Store);
                 let tol = 1e-5 * (k as f64).sqrt() * 4.0;
                 for x in 0..m * n {
                     let (i, j) = (x / n, x % n);
+                    let reversed = relu_out[(m - 1 - i) * n + j] as f64;
+                    if !reversed.is_nan() {
+                        let want = plain[(i, j)] + reversed;
+                        assert!((from_reversed[x] as f64 - want).abs() <= tol, "{kernel:?} reversed start at {x}");
+                    }
                     let want_relu = (plain[(i, j)] + bias[j] as f64).max(0.0);
                     let want_grad = if relu_out[x] <= 0.0 { 0.0 } else { plain[(i, j)] };
                     assert!((with_bias[x] as f64 - want_relu).abs() <= tol, "{kernel:?} relu {m}×{n}×{k} at {x}");
