@@ -31,25 +31,13 @@ pub fn matmul(dst: MatMut<'_, f32>, accum: Accum, a: MatRef<'_, f32>, b: MatRef<
         return;
     }
     let kernel = Kernel::for_product(&dst, &a, &b);
-    matmul_by(kernel, dst, Start::of(accum), a, b, Finish::Store);
+    matmul_by(kernel, dst, Start::of(accum), a, b, Finish::Store, None);
 }
 
 /// dst = finish(start + a · b) (see [`gemm::Kernel::fused`]), split over the pool as [`matmul`] splits, on
-/// `kernel`, which must be `Kernel::for_product` of this product.
+/// `kernel`, which must be `Kernel::for_product` of this product; with `row_sums` also row_sums[i] +=
+/// Σ_k a[i, k] (see [`Kernel::fused_summing`]): each row's sum is one piece's, in order of k, whatever the split.
 pub fn matmul_by(
-    kernel: Kernel,
-    dst: MatMut<'_, f32>,
-    start: Start<'_>,
-    a: MatRef<'_, f32>,
-    b: MatRef<'_, f32>,
-    finish: Finish<'_>,
-) {
-    matmul_summing(kernel, dst, start, a, b, finish, None);
-}
-
-/// [`matmul_by`], and with `row_sums` also row_sums[i] += Σ_k a[i, k] (see [`Kernel::fused_summing`]): each
-/// row's sum is one piece's, in order of k, whatever the split.
-pub fn matmul_summing(
     kernel: Kernel,
     dst: MatMut<'_, f32>,
     start: Start<'_>,
@@ -245,6 +233,7 @@ impl<'a> Dense<'a> {
         debug_assert_eq!(dy.len(), rows * self.d_out);
         let (o, i) = (self.d_out, self.d_in);
         let (weight_grad, bias_grad) = two_mut(grads, self.weight_index, self.bias_index);
+        let mut bias_summed = false;
         if self.non_negative {
             // Only the positive raw weights act, so only they receive gradient (burn's ReLU backward).
             let mut acting = vec![0.0; o * i];
@@ -259,12 +248,15 @@ impl<'a> Dense<'a> {
             let kernel = Kernel::for_product(&dst, &a, &b);
             if kernel != Kernel::Faer && !is_tall_weight_gradient(&dst, &a, &b) {
                 // The bias gradient, dY's column sums, added up as the kernel packs dYᵀ.
-                matmul_summing(kernel, dst, Start::Dst, a, b, Finish::Store, Some(bias_grad));
-                return if want_dx { self.backward_input(dy, rows) } else { Vec::new() };
+                matmul_by(kernel, dst, Start::Dst, a, b, Finish::Store, Some(&mut bias_grad[..]));
+                bias_summed = true;
+            } else {
+                matmul(dst, Accum::Add, a, b);
             }
-            matmul(dst, Accum::Add, a, b);
         }
-        add_column_sums(bias_grad, dy);
+        if !bias_summed {
+            add_column_sums(bias_grad, dy);
+        }
         if !want_dx {
             return Vec::new();
         }
@@ -321,7 +313,7 @@ fn fresh_product(a: MatRef<'_, f32>, b: MatRef<'_, f32>, start: Start<'_>, finis
     if kernel != Kernel::Faer && !matches!(start, Start::Dst) {
         // The kernel starts every element from zero, the bias row or the start matrix and stores it: nothing
         // of `out` is read.
-        matmul_by(kernel, dst, start, a, b, finish);
+        matmul_by(kernel, dst, start, a, b, finish, None);
         // SAFETY: the kernel stored every element of the rows × width output.
         unsafe { assume_written(&mut out, n) };
         return out;
@@ -332,7 +324,7 @@ fn fresh_product(a: MatRef<'_, f32>, b: MatRef<'_, f32>, start: Start<'_>, finis
         Start::Matrix(start) => (row_major_copy(start), Start::Dst),
         Start::Zero | Start::Dst => (zeros(n), Start::Zero),
     };
-    matmul_by(kernel, view_mut(&mut out, rows, width), start, a, b, finish);
+    matmul_by(kernel, view_mut(&mut out, rows, width), start, a, b, finish, None);
     out
 }
 

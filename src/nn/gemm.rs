@@ -302,6 +302,7 @@ mod avx512 {
         // weight gradient's dYᵀ), its row block is packed as [k][row]: read in place, each k's 12 values sit
         // on lines of their own, which crowd the right operand's panel out of L1 (8 % slower).
         let a_by_rows = aks == 1;
+        let lda = if a_by_rows { ars as usize } else { MR };
         let mut a_block = if a_by_rows { Vec::new() } else { vec![0.0f32; KC.min(k) * MR] };
         for k0 in (0..k).step_by(KC) {
             let kc = (k - k0).min(KC);
@@ -339,7 +340,7 @@ mod avx512 {
                     a_block.as_ptr()
                 };
                 // Rows read along k stream from memory: the next block's are fetched while this one works.
-                let (next_a, prefetch_rows) = if aks == 1 && i0 + MR < m {
+                let (next_a, prefetch_rows) = if a_by_rows && i0 + MR < m {
                     // SAFETY: row i0 + MR < m, column k0 < k: inside `a`.
                     (unsafe { a.as_ptr().offset((i0 + MR) as isize * ars + k0 as isize) }, (m - i0 - MR).min(MR))
                 } else {
@@ -359,7 +360,7 @@ mod avx512 {
                     };
                     let call = Call {
                         a: a_rows,
-                        lda: if a_by_rows { ars as usize } else { MR },
+                        lda,
                         b: unsafe { packed.as_ptr().add(p * kc * NR) },
                         kc,
                         c: tile,
