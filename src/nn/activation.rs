@@ -3,6 +3,8 @@
 use burn::tensor::{activation, Tensor};
 use serde::{Deserialize, Serialize};
 
+use crate::util::wide::widest_fn;
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Activation {
@@ -26,22 +28,10 @@ impl Activation {
     }
 
     /// The planning path's activation. libm's `expf` is a call per element and took two thirds of a PETS MPC
-    /// step; [`fast_exp`] is branch-free arithmetic the compiler vectorizes, and on CPUs with AVX2 and FMA
-    /// (checked at run time, so the binary still runs everywhere) it runs eight lanes with fused multiply-adds.
+    /// step; [`fast_exp`] is branch-free arithmetic the compiler vectorizes, at the widest width the CPU has
+    /// (checked at run time, so the binary still runs everywhere: `util::wide`).
     pub fn apply_in_place(self, xs: &mut [f32]) {
-        #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
-            // SAFETY: the CPU supports the features the function is compiled for (checked just above).
-            unsafe { self.apply_avx2_fma(xs) };
-            return;
-        }
-        self.apply_portable(xs);
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma")]
-    fn apply_avx2_fma(self, xs: &mut [f32]) {
-        self.apply_portable(xs);
+        activate_widest(self, xs);
     }
 
     #[inline(always)]
@@ -70,19 +60,7 @@ impl Activation {
     /// hand-written backward pass multiplies by it without recomputing any exponential.
     pub fn apply_with_derivative(self, xs: &mut [f32], derivative: &mut [f32]) {
         assert_eq!(xs.len(), derivative.len(), "one derivative per element");
-        #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
-            // SAFETY: the CPU supports the features the function is compiled for (checked just above).
-            unsafe { self.apply_with_derivative_avx2_fma(xs, derivative) };
-            return;
-        }
-        self.apply_with_derivative_portable(xs, derivative);
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma")]
-    fn apply_with_derivative_avx2_fma(self, xs: &mut [f32], derivative: &mut [f32]) {
-        self.apply_with_derivative_portable(xs, derivative);
+        activate_with_derivative_widest(self, xs, derivative);
     }
 
     #[inline(always)]
@@ -180,9 +158,40 @@ pub fn fast_softplus(x: f32) -> f32 {
     x.max(0.0) + series
 }
 
+widest_fn! {
+    fn activate_widest(activation: Activation, xs: &mut [f32]) {
+        activation.apply_portable(xs)
+    }
+}
+
+widest_fn! {
+    fn activate_with_derivative_widest(activation: Activation, xs: &mut [f32], derivative: &mut [f32]) {
+        activation.apply_with_derivative_portable(xs, derivative)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The copies compiled for the CPU's widest vectors give the bits of the baseline loop (`util::wide`).
+    #[test]
+    fn every_vector_width_gives_the_same_bits() {
+        let xs: Vec<f32> = (0..1003).map(|i| (i as f32 * 0.37).sin() * 12.0).collect();
+        let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        for activation in [Activation::Relu, Activation::Silu, Activation::Tanh, Activation::Sigmoid] {
+            let (mut wide, mut wide_slope) = (xs.clone(), vec![0.0; xs.len()]);
+            activation.apply_with_derivative(&mut wide, &mut wide_slope);
+            let (mut base, mut base_slope) = (xs.clone(), vec![0.0; xs.len()]);
+            for (x, d) in base.iter_mut().zip(base_slope.iter_mut()) {
+                activation.derivative_block(std::slice::from_mut(x), std::slice::from_mut(d));
+            }
+            assert_eq!((bits(&wide), bits(&wide_slope)), (bits(&base), bits(&base_slope)), "{activation:?}");
+            let mut applied = xs.clone();
+            activation.apply_in_place(&mut applied);
+            assert_eq!(bits(&applied), bits(&base), "{activation:?}");
+        }
+    }
 
     #[test]
     fn fast_exp_is_accurate_over_the_range_networks_use() {

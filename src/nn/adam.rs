@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 use crate::util::domain::number;
+use crate::util::wide::widest_fn;
 
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -163,6 +164,11 @@ pub struct AdamStep<T> {
 impl<T: Float> AdamStep<T> {
     /// Updates parameters `p` with gradients `g` and their moments `m`, `v` (all the same length).
     pub fn apply(&self, p: &mut [T], g: &[T], m: &mut [T], v: &mut [T]) {
+        apply_widest(self, p, g, m, v);
+    }
+
+    #[inline(always)]
+    fn apply_here(&self, p: &mut [T], g: &[T], m: &mut [T], v: &mut [T]) {
         debug_assert!(g.len() == p.len() && m.len() == p.len() && v.len() == p.len(), "Adam: block sizes differ");
         let AdamStep { beta1, beta2, epsilon, weight_decay, bias2_sqrt, step_size } = *self;
         // Zipped slices rather than indices: without bounds checks the loop vectorizes.
@@ -178,6 +184,12 @@ impl<T: Float> AdamStep<T> {
         } else {
             each.for_each(|((p, &g), (m, v))| step(p, g, m, v));
         }
+    }
+}
+
+widest_fn! {
+    fn apply_widest[T: Float](step: &AdamStep<T>, p: &mut [T], g: &[T], m: &mut [T], v: &mut [T]) {
+        step.apply_here(p, g, m, v)
     }
 }
 
@@ -220,6 +232,25 @@ mod tests {
         let mut g = vec![vec![0.5, -3.0]];
         adam.update(&mut [&mut p], &mut g).unwrap();
         assert!((p[0] - 0.9).abs() < 1e-6 && (p[1] + 0.9).abs() < 1e-6, "{p:?}");
+    }
+
+    /// The update compiled for the CPU's widest vectors gives the bits of one element at a time.
+    #[test]
+    fn every_vector_width_gives_the_same_bits() {
+        let mut adam = Adam::<f32>::new(AdamConfig { weight_decay: 1e-4, ..config() }, &[1001]);
+        let params: Vec<f32> = (0..1001).map(|i| (i as f32 * 0.61).cos()).collect();
+        let grads: Vec<f32> = (0..1001).map(|i| (i as f32 * 0.37).sin() * 1e-3).collect();
+        adam.exp_avg_sq[0].iter_mut().enumerate().for_each(|(i, v)| *v = i as f32 * 1e-7);
+        let step = adam.begin_unclipped_update().unwrap();
+        let (mut p, mut m, mut v) = (params.clone(), adam.exp_avg[0].clone(), adam.exp_avg_sq[0].clone());
+        step.apply(&mut p, &grads, &mut m, &mut v);
+        let (mut p1, mut m1, mut v1) = (params, adam.exp_avg[0].clone(), adam.exp_avg_sq[0].clone());
+        for i in 0..p1.len() {
+            let one = i..i + 1;
+            step.apply_here(&mut p1[one.clone()], &grads[one.clone()], &mut m1[one.clone()], &mut v1[one]);
+        }
+        let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!((bits(&p), bits(&m), bits(&v)), (bits(&p1), bits(&m1), bits(&v1)));
     }
 
     #[test]

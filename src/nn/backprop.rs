@@ -11,6 +11,7 @@ use rayon::prelude::*;
 use super::gemm::{Finish, Kernel, Start};
 use super::params::ParamSet;
 use crate::error::{Error, Result};
+use crate::util::wide::widest_fn;
 
 /// Below this many multiply-adds a GEMM stays on one thread: splitting costs more than it saves.
 const PARALLEL_WORK: usize = 1 << 19;
@@ -344,11 +345,7 @@ fn row_major_copy(m: MatRef<'_, f32>) -> Vec<f32> {
 /// bytes do not depend on the threads.
 pub fn add_column_sums(sums: &mut [f32], m: &[f32]) {
     let width = sums.len();
-    let add_rows = |sums: &mut [f32], block: &[f32]| {
-        for row in block.chunks(width) {
-            sums.iter_mut().zip(row).for_each(|(s, x)| *s += x);
-        }
-    };
+    let add_rows = |sums: &mut [f32], block: &[f32]| add_rows_widest(sums, block, width);
     if width == 0 || m.len() < 2 * ELEMENTWISE_BLOCK {
         add_rows(sums, m);
         return;
@@ -377,9 +374,9 @@ pub fn block_rows(rows: usize, width: usize) -> usize {
 /// Applies `f` to every value, in parallel blocks when the buffer is large.
 pub fn for_each_value(xs: &mut [f32], f: impl Fn(&mut f32) + Sync) {
     if xs.len() < 2 * ELEMENTWISE_BLOCK {
-        xs.iter_mut().for_each(f);
+        for_each_widest(xs, &f);
     } else {
-        xs.par_chunks_mut(ELEMENTWISE_BLOCK).for_each(|block| block.iter_mut().for_each(&f));
+        xs.par_chunks_mut(ELEMENTWISE_BLOCK).for_each(|block| for_each_widest(block, &f));
     }
 }
 
@@ -387,11 +384,38 @@ pub fn for_each_value(xs: &mut [f32], f: impl Fn(&mut f32) + Sync) {
 pub fn zip_values(dst: &mut [f32], src: &[f32], f: impl Fn(&mut f32, f32) + Sync) {
     debug_assert_eq!(dst.len(), src.len());
     if dst.len() < 2 * ELEMENTWISE_BLOCK {
-        dst.iter_mut().zip(src).for_each(|(d, s)| f(d, *s));
+        zip_widest(dst, src, &f);
     } else {
         dst.par_chunks_mut(ELEMENTWISE_BLOCK)
             .zip(src.par_chunks(ELEMENTWISE_BLOCK))
-            .for_each(|(d, s)| d.iter_mut().zip(s).for_each(|(d, s)| f(d, *s)));
+            .for_each(|(d, s)| zip_widest(d, s, &f));
+    }
+}
+
+widest_fn! {
+    fn for_each_widest[F: Fn(&mut f32)](xs: &mut [f32], f: &F) {
+        xs.iter_mut().for_each(f)
+    }
+}
+
+widest_fn! {
+    fn zip_widest[F: Fn(&mut f32, f32)](dst: &mut [f32], src: &[f32], f: &F) {
+        dst.iter_mut().zip(src).for_each(|(d, s)| f(d, *s))
+    }
+}
+
+widest_fn! {
+    fn add_rows_widest(sums: &mut [f32], block: &[f32], width: usize) {
+        for row in block.chunks(width) {
+            sums.iter_mut().zip(row).for_each(|(s, x)| *s += x);
+        }
+    }
+}
+
+widest_fn! {
+    /// d[i] *= s[i].
+    pub fn mul_into(d: &mut [f32], s: &[f32]) {
+        d.iter_mut().zip(s).for_each(|(d, s)| *d *= s)
     }
 }
 

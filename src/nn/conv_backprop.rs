@@ -25,6 +25,7 @@ use rayon::prelude::*;
 use super::backprop::{add_column_sums, add_into, matmul, repeat_row, tensor_index, view, view_mut, zeros};
 use super::params::ParamSet;
 use crate::error::{Error, Result};
+use crate::util::wide::widest_fn;
 
 /// The im2col buffer of one chunk of images stays near this size, so that the GEMM reads it back from the
 /// core's own cache: 16 MiB chunks made DLGPD's batch-256 step 6-8 % slower at one thread.
@@ -108,15 +109,7 @@ impl Grids {
 
     /// The adjoint of [`Grids::gather_image`] for one image.
     fn scatter_add_image(&self, col: &[f32], big: &mut [f32]) {
-        let (k, s, c, side) = (self.kernel, self.stride, self.big_channels, self.big_side);
-        let span = k * c;
-        for (position, row) in col.chunks(self.window()).enumerate() {
-            let (y, x) = (position / self.small_side, position % self.small_side);
-            for (ky, piece) in row.chunks(span).enumerate() {
-                let start = ((y * s + ky) * side + x * s) * c;
-                big[start..start + span].iter_mut().zip(piece).for_each(|(b, p)| *b += p);
-            }
-        }
+        scatter_add_image_widest(self, col, big);
     }
 
     /// im2col of `images` big-grid images: row (image, y, x) of `col` holds the window whose corner is at
@@ -141,6 +134,20 @@ impl Grids {
                 .for_each(|(b, c)| self.scatter_add_image(c, b));
         } else {
             big.chunks_mut(self.big_len()).zip(col.chunks(per_image)).for_each(|(b, c)| self.scatter_add_image(c, b));
+        }
+    }
+}
+
+widest_fn! {
+    fn scatter_add_image_widest(grids: &Grids, col: &[f32], big: &mut [f32]) {
+        let (k, s, c, side) = (grids.kernel, grids.stride, grids.big_channels, grids.big_side);
+        let span = k * c;
+        for (position, row) in col.chunks(grids.window()).enumerate() {
+            let (y, x) = (position / grids.small_side, position % grids.small_side);
+            for (ky, piece) in row.chunks(span).enumerate() {
+                let start = ((y * s + ky) * side + x * s) * c;
+                big[start..start + span].iter_mut().zip(piece).for_each(|(b, p)| *b += p);
+            }
         }
     }
 }

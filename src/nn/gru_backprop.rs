@@ -20,6 +20,7 @@ use super::backprop::{
 use super::gemm::Finish;
 use super::params::ParamSet;
 use crate::error::Result;
+use crate::util::wide::widest_fn;
 
 /// The cell's weights as views of a parameter set (torch's layout: W_ih [3E, blocks·E], W_hh [3E, E]).
 pub struct Gru<'a> {
@@ -120,21 +121,7 @@ impl<'a> Gru<'a> {
             .zip(slots(&mut r, size).par_chunks_mut(he).zip(slots(&mut z, size).par_chunks_mut(he)))
             .zip(slots(&mut n, size).par_chunks_mut(he))
             .zip(gi.par_chunks(hg).zip(gh.par_chunks(hg)))
-            .for_each(|(((h, (r, z)), n), (gi, gh))| {
-                for row in 0..h.len() / e {
-                    let (gi, gh) = (&gi[row * g..(row + 1) * g], &gh[row * g..(row + 1) * g]);
-                    for k in 0..e {
-                        let at = row * e + k;
-                        let reset = sigmoid(gi[k] + gh[k]);
-                        let update = sigmoid(gi[e + k] + gh[e + k]);
-                        let new = tanh(gi[2 * e + k] + reset * gh[2 * e + k]);
-                        r[at].write(reset);
-                        z[at].write(update);
-                        n[at].write(new);
-                        h[at] = (1.0 - update) * new + update * h[at];
-                    }
-                }
-            });
+            .for_each(|(((h, (r, z)), n), (gi, gh))| gates_forward(h, r, z, n, gi, gh, e));
         // SAFETY: the blocks of h cover all `size` values, and each wrote its rows of all three tapes.
         unsafe {
             for buffer in [&mut r, &mut z, &mut n] {
@@ -172,25 +159,7 @@ impl<'a> Gru<'a> {
             .zip(tape.n.par_chunks(he).zip(tape.gh.par_chunks(hg)))
             .zip(h_prev.par_chunks(he).zip(dh_next.par_chunks(he)))
             .for_each(|((((dh, (d_gi, d_gh)), (r, z)), (n, gh)), (h_prev, dh_next))| {
-                for row in 0..dh.len() / e {
-                    let (d_gi, d_gh) = (&mut d_gi[row * g..(row + 1) * g], &mut d_gh[row * g..(row + 1) * g]);
-                    let hn = &gh[row * g + 2 * e..(row + 1) * g];
-                    for k in 0..e {
-                        let at = row * e + k;
-                        let (r, z, n, hn) = (r[at], z[at], n[at], hn[k]);
-                        let d = dh_next[at];
-                        let dn = d * (1.0 - z) * (1.0 - n * n);
-                        let dz = d * (h_prev[at] - n) * z * (1.0 - z);
-                        let dr = dn * hn * r * (1.0 - r);
-                        d_gi[k].write(dr);
-                        d_gi[e + k].write(dz);
-                        d_gi[2 * e + k].write(dn);
-                        d_gh[k].write(dr);
-                        d_gh[e + k].write(dz);
-                        d_gh[2 * e + k].write(dn * r);
-                        dh[at].write(d * z);
-                    }
-                }
+                gates_backward(GateGradients { dh, d_gi, d_gh }, GateTape { r, z, n, gh }, h_prev, dh_next, e)
             });
         // SAFETY: the row blocks cover all rows, and each row wrote its E values of dh and 3E of d_gi and d_gh.
         let d_gh = unsafe {
@@ -212,5 +181,75 @@ impl<'a> Gru<'a> {
             view(h_prev, rows, e),
         );
         add_column_sums(&mut grads[self.index[3]], d_gh);
+    }
+}
+
+widest_fn! {
+    /// Rows of a step forward: the gates from their input and hidden parts, the new state over the old.
+    fn gates_forward(
+        h: &mut [f32],
+        r: &mut [MaybeUninit<f32>],
+        z: &mut [MaybeUninit<f32>],
+        n: &mut [MaybeUninit<f32>],
+        gi: &[f32],
+        gh: &[f32],
+        e: usize,
+    ) {
+        let g = 3 * e;
+        for row in 0..h.len() / e {
+            let (gi, gh) = (&gi[row * g..(row + 1) * g], &gh[row * g..(row + 1) * g]);
+            for k in 0..e {
+                let at = row * e + k;
+                let reset = sigmoid(gi[k] + gh[k]);
+                let update = sigmoid(gi[e + k] + gh[e + k]);
+                let new = tanh(gi[2 * e + k] + reset * gh[2 * e + k]);
+                r[at].write(reset);
+                z[at].write(update);
+                n[at].write(new);
+                h[at] = (1.0 - update) * new + update * h[at];
+            }
+        }
+    }
+}
+
+/// A block of rows' outputs of a step back.
+struct GateGradients<'a> {
+    dh: &'a mut [MaybeUninit<f32>],
+    d_gi: &'a mut [MaybeUninit<f32>],
+    d_gh: &'a mut [MaybeUninit<f32>],
+}
+
+/// A block of rows of a step's tape.
+struct GateTape<'a> {
+    r: &'a [f32],
+    z: &'a [f32],
+    n: &'a [f32],
+    gh: &'a [f32],
+}
+
+widest_fn! {
+    /// Rows of a step back: dh without its W_hh term, and the input- and hidden-gate gradients.
+    fn gates_backward(out: GateGradients<'_>, tape: GateTape<'_>, h_prev: &[f32], dh_next: &[f32], e: usize) {
+        let g = 3 * e;
+        let GateGradients { dh, d_gi, d_gh } = out;
+        for row in 0..dh.len() / e {
+            let (d_gi, d_gh) = (&mut d_gi[row * g..(row + 1) * g], &mut d_gh[row * g..(row + 1) * g]);
+            let hn = &tape.gh[row * g + 2 * e..(row + 1) * g];
+            for k in 0..e {
+                let at = row * e + k;
+                let (r, z, n, hn) = (tape.r[at], tape.z[at], tape.n[at], hn[k]);
+                let d = dh_next[at];
+                let dn = d * (1.0 - z) * (1.0 - n * n);
+                let dz = d * (h_prev[at] - n) * z * (1.0 - z);
+                let dr = dn * hn * r * (1.0 - r);
+                d_gi[k].write(dr);
+                d_gi[e + k].write(dz);
+                d_gi[2 * e + k].write(dn);
+                d_gh[k].write(dr);
+                d_gh[e + k].write(dz);
+                d_gh[2 * e + k].write(dn * r);
+                dh[at].write(d * z);
+            }
+        }
     }
 }

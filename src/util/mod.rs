@@ -15,3 +15,4 @@ pub mod seeding;
 pub mod suggest;
 pub mod table;
 pub mod warm_pool;
+pub mod wide;

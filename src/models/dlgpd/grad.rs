@@ -17,6 +17,7 @@ use crate::nn::backprop::{add_into, relu_backward, relu_in_place, zero_gradients
 use crate::nn::blocked_conv::{BlockedConv, BlockedInput};
 use crate::nn::conv_backprop::{to_channels_first, to_channels_last, Direction, Grids, StridedConv};
 use crate::nn::ParamSet;
+use crate::util::wide::widest_fn;
 
 /// Channels of the encoder's four convolutions (Table A.1) and of the decoder's transposed ones (Table A.2).
 const ENCODER_CHANNELS: [usize; 4] = [32, 64, 128, 256];
@@ -171,23 +172,28 @@ impl<'a> ConvVaeGrad<'a> {
 /// the loss's gradient scaled by `scale`. Each frame is summed by one thread, in `LANES` f32 partial sums (so
 /// the loop vectorizes without reordering any sum) added up in f64.
 fn bce_into_gradient(logits: &mut [f32], targets: &[f32], scale: f32) -> f64 {
-    const LANES: usize = 16;
     let frame = FRAME_CHANNELS * FRAME_SIDE * FRAME_SIDE;
     let sums: Vec<f64> = logits
         .par_chunks_mut(frame)
         .zip(targets.par_chunks(frame))
-        .map(|(logits, targets)| {
-            let mut lanes = [0.0f32; LANES];
-            for (logits, targets) in logits.chunks_mut(LANES).zip(targets.chunks(LANES)) {
-                for ((lane, l), &t) in lanes.iter_mut().zip(logits.iter_mut()).zip(targets) {
-                    *lane += fast_softplus(*l) - *l * t;
-                    *l = (fast_sigmoid(*l) - t) * scale;
-                }
-            }
-            lanes.iter().map(|&s| s as f64).sum::<f64>()
-        })
+        .map(|(logits, targets)| frame_bce_into_gradient(logits, targets, scale))
         .collect();
     sums.iter().sum()
+}
+
+widest_fn! {
+    /// One frame's part of [`bce_into_gradient`].
+    fn frame_bce_into_gradient(logits: &mut [f32], targets: &[f32], scale: f32) -> f64 {
+        const LANES: usize = 16;
+        let mut lanes = [0.0f32; LANES];
+        for (logits, targets) in logits.chunks_mut(LANES).zip(targets.chunks(LANES)) {
+            for ((lane, l), &t) in lanes.iter_mut().zip(logits.iter_mut()).zip(targets) {
+                *lane += fast_softplus(*l) - *l * t;
+                *l = (fast_sigmoid(*l) - t) * scale;
+            }
+        }
+        lanes.iter().map(|&s| s as f64).sum::<f64>()
+    }
 }
 
 /// The image VAE's loss (and, when wanted, gradients in the order of `params`) on a batch, as

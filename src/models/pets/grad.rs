@@ -19,7 +19,7 @@ use super::config::PetsConfig;
 use crate::error::Result;
 use crate::nn::activation::{fast_exp, fast_sigmoid as sigmoid, fast_softplus as softplus, Activation};
 use crate::nn::adam::AdamStep;
-use crate::nn::backprop::{add_column_sums, tensor_index, view, view_mut, zero_gradients};
+use crate::nn::backprop::{add_column_sums, mul_into, tensor_index, view, view_mut, zero_gradients};
 use crate::nn::{Adam, ParamSet};
 
 /// mbrl-lib's weight on Σ max_logvar − Σ min_logvar.
@@ -308,7 +308,7 @@ impl<'a> EnsembleNet<'a> {
             let (below, above) = buffers.d_outputs.split_at_mut(k);
             let dx = &mut *below[k - 1];
             layers[k].backward_input(part.member, above[0], part.rows(), dx);
-            dx.iter_mut().zip(buffers.slopes[k - 1].iter()).for_each(|(d, s)| *d *= s);
+            mul_into(dx, buffers.slopes[k - 1]);
         }
     }
 
