@@ -96,15 +96,21 @@ impl Grids {
 
     /// The images of one window gathered into `col` (positions × window).
     fn gather_image(&self, big: &[f32], col: &mut [f32]) {
-        let (k, s, c, side) = (self.kernel, self.stride, self.big_channels, self.big_side);
-        let span = k * c;
-        for (position, row) in col.chunks_mut(self.window()).enumerate() {
-            let (y, x) = (position / self.small_side, position % self.small_side);
-            for (ky, piece) in row.chunks_mut(span).enumerate() {
-                let start = ((y * s + ky) * side + x * s) * c;
-                piece.copy_from_slice(&big[start..start + span]);
-            }
+        let span = self.kernel * self.big_channels;
+        for (col_at, big_at) in self.window_rows() {
+            col[col_at..col_at + span].copy_from_slice(&big[big_at..big_at + span]);
         }
+    }
+
+    /// Where the pieces of one image's im2col rows lie: for each output position and kernel row, the offset of
+    /// its `kernel · big channels` values in the rows and in the big grid.
+    #[inline(always)]
+    fn window_rows(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
+        let (k, s, c, side) = (self.kernel, self.stride, self.big_channels, self.big_side);
+        (0..self.positions()).flat_map(move |position| {
+            let (y, x) = (position / self.small_side, position % self.small_side);
+            (0..k).map(move |ky| ((position * k + ky) * k * c, ((y * s + ky) * side + x * s) * c))
+        })
     }
 
     /// The adjoint of [`Grids::gather_image`] for one image.
@@ -140,14 +146,9 @@ impl Grids {
 
 widest_fn! {
     fn scatter_add_image_widest(grids: &Grids, col: &[f32], big: &mut [f32]) {
-        let (k, s, c, side) = (grids.kernel, grids.stride, grids.big_channels, grids.big_side);
-        let span = k * c;
-        for (position, row) in col.chunks(grids.window()).enumerate() {
-            let (y, x) = (position / grids.small_side, position % grids.small_side);
-            for (ky, piece) in row.chunks(span).enumerate() {
-                let start = ((y * s + ky) * side + x * s) * c;
-                big[start..start + span].iter_mut().zip(piece).for_each(|(b, p)| *b += p);
-            }
+        let span = grids.kernel * grids.big_channels;
+        for (col_at, big_at) in grids.window_rows() {
+            big[big_at..big_at + span].iter_mut().zip(&col[col_at..col_at + span]).for_each(|(b, p)| *b += p);
         }
     }
 }
