@@ -21,6 +21,7 @@ use crate::nn::activation::{fast_exp, fast_sigmoid as sigmoid, fast_softplus as 
 use crate::nn::adam::AdamStep;
 use crate::nn::backprop::{add_column_sums, mul_into, tensor_index, view, view_mut, zero_gradients};
 use crate::nn::{Adam, ParamSet};
+use crate::util::wide::widest_fn;
 
 /// mbrl-lib's weight on Σ max_logvar − Σ min_logvar.
 const BOUNDS_PENALTY: f32 = 0.01;
@@ -183,6 +184,7 @@ struct BoundedLogVar {
     lower_slope: f32,
 }
 
+#[inline(always)]
 fn bounded(raw: f32, min: f32, max: f32) -> BoundedLogVar {
     let upper = max - softplus(max - raw);
     BoundedLogVar {
@@ -280,25 +282,10 @@ impl<'a> EnsembleNet<'a> {
     /// The part's rows' losses and bounds' gradient terms, and its output gradient written into the last of
     /// `d_outputs`. `scale` is 1 / (rows · target_dim), the member mean's weight.
     fn loss_part(&self, buffers: &mut PartBuffers<'_>, targets: &[f32], scale: f32) {
-        let d = self.target_dim;
         let d_output = buffers.d_outputs.last_mut().expect("the output layer's gradient");
-        let rows = buffers.output.chunks(2 * d).zip(targets.chunks(d)).zip(d_output.chunks_mut(2 * d));
-        let row_terms = buffers.row_losses.iter_mut().zip(buffers.row_bounds.chunks_mut(2 * d));
-        for (((out, y), d_out), (row_loss, bounds)) in rows.zip(row_terms) {
-            let mut sum = 0.0f64;
-            for j in 0..d {
-                let b = bounded(out[d + j], self.min_logvar[j], self.max_logvar[j]);
-                let error = out[j] - y[j];
-                let precision = fast_exp(-b.logvar);
-                sum += f64::from(0.5 * (error * error * precision + b.logvar));
-                d_out[j] = error * precision * scale;
-                let d_logvar = 0.5 * (1.0 - error * error * precision) * scale;
-                d_out[d + j] = d_logvar * b.lower_slope * b.upper_slope;
-                bounds[j] = d_logvar * b.lower_slope * (1.0 - b.upper_slope);
-                bounds[d + j] = d_logvar * (1.0 - b.lower_slope);
-            }
-            *row_loss = sum;
-        }
+        let rows = RowLosses { losses: buffers.row_losses, bounds: buffers.row_bounds, d_output };
+        let bounds = (self.min_logvar, self.max_logvar);
+        loss_rows(rows, buffers.output, targets, bounds, scale);
     }
 
     /// Carries the output gradient back to every hidden layer's output, before its activation.
@@ -395,6 +382,61 @@ impl<'a> EnsembleNet<'a> {
 
     fn shapes(&self) -> Vec<LayerShape> {
         self.layers().map(|l| l.shape).collect()
+    }
+}
+
+/// What the loss writes for a part's rows.
+struct RowLosses<'a> {
+    losses: &'a mut [f64],
+    /// Per row, the d max_logvar then d min_logvar terms.
+    bounds: &'a mut [f32],
+    /// Per row, d mean then d raw log-variance.
+    d_output: &'a mut [f32],
+}
+
+widest_fn! {
+    /// The loss of rows of `output` (mean, then raw log-variance) against `targets`, by blocks of 16 rows so that
+    /// the exponentials run across rows in vector lanes (a row has only a few outputs). Each row still sums its
+    /// outputs in order, from zero.
+    fn loss_rows(into: RowLosses<'_>, output: &[f32], targets: &[f32], bounds: (&[f32], &[f32]), scale: f32) {
+        const LANES: usize = 16;
+        let d = bounds.0.len();
+        let rows = into.losses.len();
+        for start in (0..rows).step_by(LANES) {
+            let n = LANES.min(rows - start);
+            let mut sums = [0.0f64; LANES];
+            for j in 0..d {
+                let (mut mean, mut raw, mut target) = ([0.0f32; LANES], [0.0f32; LANES], [0.0f32; LANES]);
+                for r in 0..n {
+                    let row = start + r;
+                    mean[r] = output[row * 2 * d + j];
+                    raw[r] = output[row * 2 * d + d + j];
+                    target[r] = targets[row * d + j];
+                }
+                let (min, max) = (bounds.0[j], bounds.1[j]);
+                let mut terms = [[0.0f32; LANES]; 5];
+                for r in 0..LANES {
+                    let b = bounded(raw[r], min, max);
+                    let error = mean[r] - target[r];
+                    let precision = fast_exp(-b.logvar);
+                    let d_logvar = 0.5 * (1.0 - error * error * precision) * scale;
+                    terms[0][r] = 0.5 * (error * error * precision + b.logvar);
+                    terms[1][r] = error * precision * scale;
+                    terms[2][r] = d_logvar * b.lower_slope * b.upper_slope;
+                    terms[3][r] = d_logvar * b.lower_slope * (1.0 - b.upper_slope);
+                    terms[4][r] = d_logvar * (1.0 - b.lower_slope);
+                }
+                for r in 0..n {
+                    let row = start + r;
+                    sums[r] += f64::from(terms[0][r]);
+                    into.d_output[row * 2 * d + j] = terms[1][r];
+                    into.d_output[row * 2 * d + d + j] = terms[2][r];
+                    into.bounds[row * 2 * d + j] = terms[3][r];
+                    into.bounds[row * 2 * d + d + j] = terms[4][r];
+                }
+            }
+            into.losses[start..start + n].copy_from_slice(&sums[..n]);
+        }
     }
 }
 
