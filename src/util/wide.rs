@@ -17,7 +17,12 @@
 pub fn has_avx512() -> bool {
     #[cfg(target_arch = "x86_64")]
     {
-        std::arch::is_x86_feature_detected!("avx512f") && std::arch::is_x86_feature_detected!("avx512vl")
+        // Every feature the copies are compiled for, though no CPU with AVX-512 F and VL lacks the rest.
+        std::arch::is_x86_feature_detected!("avx512f")
+            && std::arch::is_x86_feature_detected!("avx512vl")
+            && std::arch::is_x86_feature_detected!("avx512bw")
+            && std::arch::is_x86_feature_detected!("avx512dq")
+            && has_avx2_fma()
     }
     #[cfg(not(target_arch = "x86_64"))]
     {
