@@ -234,7 +234,6 @@ impl<'a> Dense<'a> {
         debug_assert_eq!(dy.len(), rows * self.d_out);
         let (o, i) = (self.d_out, self.d_in);
         let (weight_grad, bias_grad) = two_mut(grads, self.weight_index, self.bias_index);
-        let mut bias_summed = false;
         if self.non_negative {
             // Only the positive raw weights act, so only they receive gradient (burn's ReLU backward).
             let mut acting = vec![0.0; o * i];
@@ -244,19 +243,17 @@ impl<'a> Dense<'a> {
                     *g += a;
                 }
             }
+            add_column_sums(bias_grad, dy);
         } else {
             let (dst, a, b) = (view_mut(weight_grad, o, i), view(dy, rows, o).transpose(), view(x, rows, i));
             let kernel = Kernel::for_product(&dst, &a, &b);
             if kernel != Kernel::Faer && !is_tall_weight_gradient(&dst, &a, &b) {
                 // The bias gradient, dY's column sums, added up as the kernel packs dYᵀ.
                 matmul_by(kernel, dst, Start::Dst, a, b, Finish::Store, Some(&mut bias_grad[..]));
-                bias_summed = true;
             } else {
                 matmul(dst, Accum::Add, a, b);
+                add_column_sums(bias_grad, dy);
             }
-        }
-        if !bias_summed {
-            add_column_sums(bias_grad, dy);
         }
         if !want_dx {
             return Vec::new();
@@ -345,9 +342,8 @@ fn row_major_copy(m: MatRef<'_, f32>) -> Vec<f32> {
 /// bytes do not depend on the threads.
 pub fn add_column_sums(sums: &mut [f32], m: &[f32]) {
     let width = sums.len();
-    let add_rows = |sums: &mut [f32], block: &[f32]| add_rows_widest(sums, block, width);
     if width == 0 || m.len() < 2 * ELEMENTWISE_BLOCK {
-        add_rows(sums, m);
+        add_rows_widest(sums, m, width);
         return;
     }
     let block = ELEMENTWISE_BLOCK.div_ceil(width) * width;
@@ -355,7 +351,7 @@ pub fn add_column_sums(sums: &mut [f32], m: &[f32]) {
         .par_chunks(block)
         .map(|rows| {
             let mut partial = vec![0.0; width];
-            add_rows(&mut partial, rows);
+            add_rows_widest(&mut partial, rows, width);
             partial
         })
         .collect();

@@ -9,6 +9,7 @@ use faer::{Mat, Side};
 use super::kernel::SeArd;
 use crate::error::{Error, Result};
 use crate::util::fast_exp::scaled_exp_in_place;
+use crate::util::wide::widest_fn;
 
 const LN_2PI: f64 = 1.837_877_066_409_345_5;
 /// Jitter added to the diagonal when the factorization fails, relative to the mean diagonal, tried in turn.
@@ -58,24 +59,12 @@ fn check_finite(what: &str, values: &[f64]) -> Result<()> {
     }
 }
 
-/// `column[j] = outputscale · exp(−½ Σ_c (points_c[j] − query_c)²)`, in one sweep per dimension. Compiled
-/// twice: for AVX2 where the CPU has it (4 lanes instead of SSE2's 2) and for the baseline; both do the same
-/// IEEE operations in the same order, so the results are identical.
-fn cross_column(points: &[Vec<f64>], query: &[f64], outputscale: f64, column: &mut [f64]) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU supports AVX2, checked just above.
-            return unsafe { cross_column_avx2(points, query, outputscale, column) };
-        }
+widest_fn! {
+    /// `column[j] = outputscale · exp(−½ Σ_c (points_c[j] − query_c)²)`, in one sweep per dimension, at the
+    /// CPU's widest vector width (`util::wide`: the same bits on every width).
+    fn cross_column(points: &[Vec<f64>], query: &[f64], outputscale: f64, column: &mut [f64]) {
+        cross_column_portable(points, query, outputscale, column)
     }
-    cross_column_portable(points, query, outputscale, column)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn cross_column_avx2(points: &[Vec<f64>], query: &[f64], outputscale: f64, column: &mut [f64]) {
-    cross_column_portable(points, query, outputscale, column)
 }
 
 #[inline(always)]
