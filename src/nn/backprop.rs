@@ -454,6 +454,18 @@ pub unsafe fn assume_written(buffer: &mut Vec<f32>, n: usize) {
     unsafe { buffer.set_len(n) };
 }
 
+/// Writes `row` over `slots` again and again (`slots` holds whole rows; a one-value row fills them with that
+/// value) and returns them as values: a layer's chunk of outputs starting from its bias.
+pub fn fill_with_row<'a>(slots: &'a mut [std::mem::MaybeUninit<f32>], row: &[f32]) -> &'a mut [f32] {
+    assert!(!row.is_empty() && slots.len().is_multiple_of(row.len()), "fill_with_row: slots of whole rows");
+    for chunk in slots.chunks_exact_mut(row.len()) {
+        chunk.iter_mut().zip(row).for_each(|(slot, x)| _ = slot.write(*x));
+    }
+    // SAFETY: every slot was written just above (the chunks cover them all, the rows being whole), and
+    // MaybeUninit<f32> has f32's layout.
+    unsafe { &mut *(slots as *mut [std::mem::MaybeUninit<f32>] as *mut [f32]) }
+}
+
 /// `n` zeros.
 pub fn zeros(n: usize) -> Vec<f32> {
     filled(n, ELEMENTWISE_BLOCK, |_, chunk| chunk.iter_mut().for_each(|slot| _ = slot.write(0.0)))

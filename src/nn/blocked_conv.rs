@@ -207,8 +207,8 @@ impl BlockedConv {
         view(&self.weight[a * len..][..len], self.row_width(), self.channels_out)
     }
 
-    /// The layer's outputs before any activation, channels-last, bias added.
-    pub fn forward(&self, input: &BlockedInput) -> Vec<f32> {
+    /// The layer's outputs, channels-last, bias added, through a ReLU when `relu`.
+    pub fn forward(&self, input: &BlockedInput, relu: bool) -> Vec<f32> {
         let (out, rows) = (self.channels_out, self.gemm_rows());
         let fill_image = |image: usize, y: &mut [std::mem::MaybeUninit<f32>], product: &mut [f32]| {
             for a in 0..self.taps {
@@ -219,7 +219,9 @@ impl BlockedConv {
             }
             for (position, slots) in y.chunks_mut(out).enumerate() {
                 let values = &product[self.gemm_row(position) * out..][..out];
-                slots.iter_mut().zip(values.iter().zip(&self.bias)).for_each(|(slot, (v, b))| _ = slot.write(v + b));
+                let activate = |x: f32| if relu { x.max(0.0) } else { x };
+                let pairs = slots.iter_mut().zip(values.iter().zip(&self.bias));
+                pairs.for_each(|(slot, (v, b))| _ = slot.write(activate(v + b)));
             }
         };
         if self.output_len() == 0 {
@@ -236,21 +238,35 @@ impl BlockedConv {
     }
 
     /// Adds the weight and bias gradients for output gradients `dy` (channels-last, as `forward` returns) to
-    /// `grads` (torch's layout). The input gradient is not formed: this layer reads the data.
-    pub fn backward(&self, input: &BlockedInput, dy: &[f32], grads: &mut [Vec<f32>]) {
+    /// `grads` (torch's layout). With `relu_output` (this layer's output, through a ReLU), `dy` is the gradient
+    /// at the ReLU's output, masked as it is read. The input gradient is not formed: this layer reads the data.
+    pub fn backward(&self, input: &BlockedInput, dy: &[f32], relu_output: Option<&[f32]>, grads: &mut [Vec<f32>]) {
         debug_assert_eq!(dy.len(), input.images * self.output_len());
+        debug_assert!(relu_output.is_none_or(|y| y.len() == dy.len()));
         let (out, rows) = (self.channels_out, self.gemm_rows());
-        let group_sums: Vec<Vec<f32>> = (0..input.images.div_ceil(GRADIENT_GROUP))
+        let group_sums: Vec<(Vec<f32>, Vec<f32>)> = (0..input.images.div_ceil(GRADIENT_GROUP))
             .into_par_iter()
             .map(|group| {
                 let mut sum = vec![0.0f32; self.weight.len()];
+                let mut bias_sum = vec![0.0f32; out];
                 let mut padded = vec![0.0f32; rows * out];
                 let images = group * GRADIENT_GROUP..((group + 1) * GRADIENT_GROUP).min(input.images);
                 for image in images {
-                    let dy = &dy[image * self.output_len()..][..self.output_len()];
+                    let at = image * self.output_len();
+                    let dy = &dy[at..][..self.output_len()];
                     for (position, values) in dy.chunks(out).enumerate() {
-                        padded[self.gemm_row(position) * out..][..out].copy_from_slice(values);
+                        let row = &mut padded[self.gemm_row(position) * out..][..out];
+                        match relu_output {
+                            Some(y) => {
+                                let y = &y[at + position * out..][..out];
+                                let masked = row.iter_mut().zip(values.iter().zip(y));
+                                masked.for_each(|(to, (d, y))| *to = if *y <= 0.0 { 0.0 } else { *d });
+                            }
+                            None => row.copy_from_slice(values),
+                        }
                     }
+                    // The rows no kernel window fits stay zero, so they add nothing.
+                    add_column_sums(&mut bias_sum, &padded);
                     for a in 0..self.taps {
                         let operand = self.kernel_row_operand(input, image, a, rows);
                         let sum = &mut sum[a * self.row_width() * out..][..self.row_width() * out];
@@ -264,12 +280,15 @@ impl BlockedConv {
                         );
                     }
                 }
-                sum
+                (sum, bias_sum)
             })
             .collect();
         let mut group_sums = group_sums.into_iter();
-        let Some(mut sum) = group_sums.next() else { return };
-        group_sums.for_each(|group| add_into(&mut sum, &group));
+        let Some((mut sum, mut bias_sum)) = group_sums.next() else { return };
+        group_sums.for_each(|(group, bias)| {
+            add_into(&mut sum, &group);
+            add_into(&mut bias_sum, &bias);
+        });
         let torch = &mut grads[self.weight_index];
         let per_output = self.channels_in * self.taps * self.stride * self.taps * self.stride;
         for (row, torch_index) in self.weight_rows() {
@@ -277,7 +296,7 @@ impl BlockedConv {
                 torch[o * per_output + torch_index] += g;
             }
         }
-        add_column_sums(&mut grads[self.bias_index], dy);
+        add_into(&mut grads[self.bias_index], &bias_sum);
     }
 }
 
@@ -314,11 +333,11 @@ mod tests {
             let ours = BlockedConv::new(&params, "layer", side, (cin, cout), k, s).unwrap();
             let split = (images / 2) * cin * side * side;
             let input = ours.regroup(&[&x[..split], &x[split..]]).unwrap();
-            let y_ours = ours.forward(&input);
+            let y_ours = ours.forward(&input, false);
             close(&to_channels_first(&y_ours, cout, out_side), &values(&y), "output");
             let mut grads = zero_gradients(&params);
             let r_last = crate::nn::conv_backprop::to_channels_last(&r, cout, out_side);
-            ours.backward(&input, &r_last, &mut grads);
+            ours.backward(&input, &r_last, None, &mut grads);
             for ((t, g), theirs) in
                 params.tensors.iter().zip(&grads).zip(ParamSet::<f32>::gradients(&conv, &burn_grads))
             {
@@ -353,8 +372,8 @@ mod tests {
             pool.install(|| {
                 let input = layer.regroup(&[&x]).unwrap();
                 let mut grads = zero_gradients(&params);
-                layer.backward(&input, &dy, &mut grads);
-                (layer.forward(&input), grads)
+                layer.backward(&input, &dy, None, &mut grads);
+                (layer.forward(&input, false), grads)
             })
         };
         let one = run(1);
@@ -379,15 +398,40 @@ mod tests {
             let x: Vec<f32> = (0..images * blocked.input_len()).map(|_| rng.random_range(-1.0..1.0)).collect();
             let input = blocked.regroup(&[&x]).unwrap();
             let x_last = crate::nn::conv_backprop::to_channels_last(&x, cin, side);
-            let y = blocked.forward(&input);
-            close(&y, &im2col.forward(&x_last, images), "output");
+            let y = blocked.forward(&input, false);
+            close(&y, &im2col.forward(&x_last, images, false), "output");
             let dy: Vec<f32> = (0..y.len()).map(|_| rng.random_range(-1.0..1.0)).collect();
             let (mut ours, mut theirs) = (zero_gradients(&params), zero_gradients(&params));
-            blocked.backward(&input, &dy, &mut ours);
-            im2col.backward(&x_last, &dy, images, &mut theirs, false);
+            blocked.backward(&input, &dy, None, &mut ours);
+            im2col.backward(&x_last, &mut dy.clone(), None, images, &mut theirs, false);
             for (ours, theirs) in ours.iter().zip(&theirs) {
                 close(ours, theirs, "parameter gradient");
             }
+        }
+    }
+
+    /// The ReLU in the forward pass and the mask in the backward pass give what separate passes give.
+    #[test]
+    fn fused_relu_matches_separate_passes() {
+        let device = training_device();
+        let mut rng = ChaCha8Rng::seed_from_u64(9);
+        let conv = Conv2dConfig::new(3, 5, 4, 2).init(&device, &mut rng);
+        let params = ParamSet::<f32>::from_module(&conv, |n: &str| format!("layer.{n}"));
+        let layer = BlockedConv::new(&params, "layer", 12, (3, 5), 4, 2).unwrap();
+        let images = 9;
+        let x: Vec<f32> = (0..images * layer.input_len()).map(|_| rng.random_range(-1.0..1.0)).collect();
+        let input = layer.regroup(&[&x]).unwrap();
+        let mut y = layer.forward(&input, false);
+        crate::nn::backprop::relu_in_place(&mut y);
+        assert!(layer.forward(&input, true) == y, "the fused ReLU changed the output's bits");
+        let dy: Vec<f32> = (0..y.len()).map(|_| rng.random_range(-1.0..1.0)).collect();
+        let mut masked = dy.clone();
+        crate::nn::backprop::relu_backward(&mut masked, &y);
+        let (mut separate, mut fused) = (zero_gradients(&params), zero_gradients(&params));
+        layer.backward(&input, &masked, None, &mut separate);
+        layer.backward(&input, &dy, Some(&y), &mut fused);
+        for (ours, theirs) in fused.iter().zip(&separate) {
+            close(ours, theirs, "parameter gradient");
         }
     }
 

@@ -22,7 +22,12 @@
 use faer::{Accum, MatMut, MatRef, Par};
 use rayon::prelude::*;
 
-use super::backprop::{add_column_sums, add_into, matmul, repeat_row, tensor_index, view, view_mut, zeros};
+use std::mem::MaybeUninit;
+
+use super::backprop::{
+    add_column_sums, add_into, assume_written, fill_with_row, matmul, relu_backward, relu_in_place, slots,
+    tensor_index, unwritten, view, view_mut,
+};
 use super::params::ParamSet;
 use crate::error::{Error, Result};
 use crate::util::wide::widest_fn;
@@ -224,32 +229,37 @@ impl StridedConv {
         vec![0.0; self.chunk.min(images) * self.grids.positions() * self.grids.window()]
     }
 
-    /// `x`: `images` inputs (NHWC) → their outputs (NHWC).
-    pub fn forward(&self, x: &[f32], images: usize) -> Vec<f32> {
+    /// `x`: `images` inputs (NHWC) → their outputs (NHWC), through a ReLU when `relu`. Each chunk's outputs
+    /// start from the bias and go through the ReLU while they are in cache, not in passes of their own over
+    /// the whole batch.
+    pub fn forward(&self, x: &[f32], images: usize, relu: bool) -> Vec<f32> {
         debug_assert_eq!(x.len(), images * self.input_len());
-        let g = &self.grids;
         let (input_len, output_len) = (self.input_len(), self.output_len());
-        let bias_rows = match self.direction {
-            Direction::Down => images * g.positions(),
-            Direction::Up => images * g.big_side * g.big_side,
-        };
-        let mut y = repeat_row(&self.bias, bias_rows);
-        let run = |x: &[f32], y: &mut [f32], split: bool| {
+        let len = images * output_len;
+        let mut y = unwritten(len);
+        let run = |x: &[f32], y: &mut [MaybeUninit<f32>], split: bool| {
             let mut col = self.scratch(x.len() / input_len.max(1));
             for (x, y) in x.chunks(self.chunk * input_len).zip(y.chunks_mut(self.chunk * output_len)) {
+                let y = fill_with_row(y, &self.bias);
                 match self.direction {
                     Direction::Down => self.windows_times_weight(x, &mut col, y, Accum::Add, split),
                     Direction::Up => self.spread_onto_windows(x, &mut col, y, split),
                 }
+                if relu {
+                    relu_in_place(y);
+                }
             }
         };
+        let y_slots = slots(&mut y, len);
         match self.task_images(images) {
-            Some(task) => y
+            Some(task) => y_slots
                 .par_chunks_mut(task * output_len)
                 .zip(x.par_chunks(task * input_len))
                 .for_each(|(y, x)| run(x, y, false)),
-            None => run(x, &mut y, true),
+            None => run(x, y_slots, true),
         }
+        // SAFETY: the chunks cover the output, and fill_with_row wrote each of them before the products.
+        unsafe { assume_written(&mut y, len) };
         y
     }
 
@@ -291,15 +301,33 @@ impl StridedConv {
         self.grids.scatter_add(col, big, split);
     }
 
-    /// The weight gradient (W̃'s layout) of one run of chunks, with their input gradients written to `dx` when
-    /// it is not empty.
-    fn backward_chunks(&self, small_grid: &[f32], big_grid: &[f32], dx: &mut [f32], split: bool) -> Vec<f32> {
+    /// The weight gradient (W̃'s layout) and the bias gradient of one run of chunks, with their input gradients
+    /// written to `dx` when it is not empty. Each chunk of `dy` is first masked by the ReLU where there is one.
+    fn backward_chunks(
+        &self,
+        x: &[f32],
+        dy: &mut [f32],
+        relu_output: Option<&[f32]>,
+        dx: &mut [MaybeUninit<f32>],
+        split: bool,
+    ) -> (Vec<f32>, Vec<f32>) {
         let g = &self.grids;
         let (window, small) = (g.window(), g.small_channels);
-        let mut col = self.scratch(small_grid.len() / g.small_len().max(1));
+        let (input_len, output_len) = (self.input_len(), self.output_len());
+        let mut col = self.scratch(x.len() / input_len.max(1));
         let mut weight_grad = vec![0.0f32; small * window];
-        let small_chunks = small_grid.chunks(self.chunk * g.small_len());
-        for (index, (small_part, big_part)) in small_chunks.zip(big_grid.chunks(self.chunk * g.big_len())).enumerate() {
+        let mut bias_grad = vec![0.0f32; self.bias.len()];
+        let chunks = x.chunks(self.chunk * input_len).zip(dy.chunks_mut(self.chunk * output_len));
+        for (index, (x_part, dy_part)) in chunks.enumerate() {
+            if let Some(y) = relu_output {
+                relu_backward(dy_part, &y[index * self.chunk * output_len..][..dy_part.len()]);
+            }
+            add_column_sums(&mut bias_grad, dy_part);
+            let dy_part = &*dy_part;
+            let (small_part, big_part) = match self.direction {
+                Direction::Down => (dy_part, x_part),
+                Direction::Up => (x_part, dy_part),
+            };
             let rows = small_part.len() / small;
             let col = &mut col[..rows * window];
             // The small grid's values times the big grid's windows: the weight gradient in both directions.
@@ -314,51 +342,70 @@ impl StridedConv {
             if dx.is_empty() {
                 continue;
             }
-            let images = small_part.len() / g.small_len();
-            let dx = &mut dx[index * self.chunk * self.input_len()..][..images * self.input_len()];
+            // Zeroed chunk by chunk, just before it is added to, while it stays in cache.
+            let dx = fill_with_row(&mut dx[index * self.chunk * input_len..][..x_part.len()], &[0.0]);
             match self.direction {
                 Direction::Down => self.spread_onto_windows(small_part, col, dx, split),
                 // `col` holds this chunk's windows of dy already, gathered for the weight gradient.
                 Direction::Up => self.columns_times_weight(col, dx, Accum::Replace, split),
             }
         }
-        weight_grad
+        (weight_grad, bias_grad)
     }
 
     /// Adds the weight and bias gradients for output gradients `dy` at inputs `x` to `grads` (torch's layout)
-    /// and returns the input gradients when asked for.
-    pub fn backward(&self, x: &[f32], dy: &[f32], images: usize, grads: &mut [Vec<f32>], want_dx: bool) -> Vec<f32> {
+    /// and returns the input gradients when asked for. With `relu_output` (this layer's output, through a
+    /// ReLU), `dy` is the gradient at the ReLU's output and is masked in place, chunk by chunk, first.
+    pub fn backward(
+        &self,
+        x: &[f32],
+        dy: &mut [f32],
+        relu_output: Option<&[f32]>,
+        images: usize,
+        grads: &mut [Vec<f32>],
+        want_dx: bool,
+    ) -> Vec<f32> {
         debug_assert_eq!(x.len(), images * self.input_len());
         debug_assert_eq!(dy.len(), images * self.output_len());
+        debug_assert!(relu_output.is_none_or(|y| y.len() == dy.len()));
         let g = &self.grids;
-        let mut dx = if want_dx { zeros(x.len()) } else { Vec::new() };
-        let (small_grid, big_grid) = match self.direction {
-            Direction::Down => (dy, x),
-            Direction::Up => (x, dy),
-        };
+        let (input_len, output_len) = (self.input_len(), self.output_len());
+        let dx_len = if want_dx { x.len() } else { 0 };
+        let mut dx = unwritten(dx_len);
+        let dx_slots = slots(&mut dx, dx_len);
         let sums = match self.task_images(images) {
-            None => vec![self.backward_chunks(small_grid, big_grid, &mut dx, true)],
+            None => vec![self.backward_chunks(x, dy, relu_output, dx_slots, true)],
             Some(task) => {
                 let tasks = images.div_ceil(task);
-                let dx_parts: Vec<&mut [f32]> = match want_dx {
-                    true => dx.chunks_mut(task * self.input_len()).collect(),
-                    false => (0..tasks).map(|_| <&mut [f32]>::default()).collect(),
+                let dx_parts: Vec<&mut [MaybeUninit<f32>]> = match want_dx {
+                    true => dx_slots.chunks_mut(task * input_len).collect(),
+                    false => (0..tasks).map(|_| <&mut [MaybeUninit<f32>]>::default()).collect(),
+                };
+                let relu_parts: Vec<Option<&[f32]>> = match relu_output {
+                    Some(y) => y.chunks(task * output_len).map(Some).collect(),
+                    None => vec![None; tasks],
                 };
                 dx_parts
                     .into_par_iter()
-                    .zip(small_grid.par_chunks(task * g.small_len()))
-                    .zip(big_grid.par_chunks(task * g.big_len()))
-                    .map(|((dx, small_part), big_part)| self.backward_chunks(small_part, big_part, dx, false))
+                    .zip(x.par_chunks(task * input_len))
+                    .zip(dy.par_chunks_mut(task * output_len))
+                    .zip(relu_parts)
+                    .map(|(((dx, x), dy), relu)| self.backward_chunks(x, dy, relu, dx, false))
                     .collect()
             }
         };
+        // SAFETY: with `want_dx`, each task's chunks wrote the whole of its part of dx, and the parts cover it.
+        unsafe { assume_written(&mut dx, dx_len) };
         let mut sums = sums.into_iter();
-        if let Some(mut weight_grad) = sums.next() {
-            sums.for_each(|sum| add_into(&mut weight_grad, &sum));
+        if let Some((mut weight_grad, mut bias_grad)) = sums.next() {
+            sums.for_each(|(weight, bias)| {
+                add_into(&mut weight_grad, &weight);
+                add_into(&mut bias_grad, &bias);
+            });
             let torch_grad = &mut grads[self.weight_index];
             add_torch_layout(torch_grad, &weight_grad, g.small_channels, g.big_channels, g.kernel * g.kernel);
+            add_into(&mut grads[self.bias_index], &bias_grad);
         }
-        add_column_sums(&mut grads[self.bias_index], dy);
         dx
     }
 }
@@ -453,10 +500,11 @@ pub(crate) mod tests {
         let params = ParamSet::<f32>::from_module(&layer, |n: &str| format!("layer.{n}"));
         let ours = StridedConv::new(&params, "layer", grids, direction).unwrap();
         let x_last = to_channels_last(&x, in_channels, in_side);
-        let y_ours = ours.forward(&x_last, images);
+        let y_ours = ours.forward(&x_last, images, false);
         close(&to_channels_first(&y_ours, out_channels, out_side), &values(&y), "output");
         let mut grads = zero_gradients(&params);
-        let dx = ours.backward(&x_last, &to_channels_last(&r, out_channels, out_side), images, &mut grads, true);
+        let dx =
+            ours.backward(&x_last, &mut to_channels_last(&r, out_channels, out_side), None, images, &mut grads, true);
         close(&to_channels_first(&dx, in_channels, in_side), &values(&xt.grad(&burn_grads).unwrap()), "dx");
         for ((t, g), theirs) in params.tensors.iter().zip(&grads).zip(ParamSet::<f32>::gradients(&layer, &burn_grads)) {
             close(g, &theirs, &t.name);
@@ -509,22 +557,22 @@ pub(crate) mod tests {
             let x: Vec<f32> = (0..images * whole.input_len()).map(|_| rng.random_range(-1.0..1.0)).collect();
             let dy: Vec<f32> = (0..images * whole.output_len()).map(|_| rng.random_range(-1.0..1.0)).collect();
             let (mut whole_grads, mut chunked_grads) = (zero_gradients(&params), zero_gradients(&params));
-            let dx_whole = whole.backward(&x, &dy, images, &mut whole_grads, true);
+            let dx_whole = whole.backward(&x, &mut dy.clone(), None, images, &mut whole_grads, true);
             for (chunk, tasks) in [(2, false), (1, true)] {
                 let mut chunked = StridedConv::new(&params, "layer", grids, direction).unwrap();
                 chunked.chunk = chunk;
                 assert_eq!(chunked.task_images(images).is_some(), tasks);
-                close(&chunked.forward(&x, images), &whole.forward(&x, images), "output");
+                close(&chunked.forward(&x, images, false), &whole.forward(&x, images, false), "output");
                 chunked_grads.iter_mut().for_each(|g| g.fill(0.0));
-                close(&chunked.backward(&x, &dy, images, &mut chunked_grads, true), &dx_whole, "dx");
+                close(&chunked.backward(&x, &mut dy.clone(), None, images, &mut chunked_grads, true), &dx_whole, "dx");
                 for (ours, theirs) in chunked_grads.iter().zip(&whole_grads) {
                     close(ours, theirs, "parameter gradient");
                 }
                 let on_threads = |threads| {
                     on_pool(threads, || {
                         let mut grads = zero_gradients(&params);
-                        let dx = chunked.backward(&x, &dy, images, &mut grads, true);
-                        (chunked.forward(&x, images), dx, grads)
+                        let dx = chunked.backward(&x, &mut dy.clone(), None, images, &mut grads, true);
+                        (chunked.forward(&x, images, false), dx, grads)
                     })
                 };
                 let one = on_threads(1);
@@ -547,11 +595,11 @@ pub(crate) mod tests {
             assert_eq!(chunked.task_images(images), Some(4), "18 chunks in 16 tasks: 2 chunks per task");
             let x: Vec<f32> = (0..images * whole.input_len()).map(|_| rng.random_range(-1.0..1.0)).collect();
             let dy: Vec<f32> = (0..images * whole.output_len()).map(|_| rng.random_range(-1.0..1.0)).collect();
-            close(&chunked.forward(&x, images), &whole.forward(&x, images), "output");
+            close(&chunked.forward(&x, images, false), &whole.forward(&x, images, false), "output");
             for want_dx in [true, false] {
                 let (mut whole_grads, mut chunked_grads) = (zero_gradients(&params), zero_gradients(&params));
-                let dx_whole = whole.backward(&x, &dy, images, &mut whole_grads, want_dx);
-                let dx = chunked.backward(&x, &dy, images, &mut chunked_grads, want_dx);
+                let dx_whole = whole.backward(&x, &mut dy.clone(), None, images, &mut whole_grads, want_dx);
+                let dx = chunked.backward(&x, &mut dy.clone(), None, images, &mut chunked_grads, want_dx);
                 assert_eq!(dx.len(), if want_dx { x.len() } else { 0 });
                 close(&dx, &dx_whole, "dx");
                 for (ours, theirs) in chunked_grads.iter().zip(&whole_grads) {
@@ -560,10 +608,42 @@ pub(crate) mod tests {
                 let on_threads = |threads| {
                     on_pool(threads, || {
                         let mut grads = zero_gradients(&params);
-                        (chunked.backward(&x, &dy, images, &mut grads, want_dx), grads)
+                        (chunked.backward(&x, &mut dy.clone(), None, images, &mut grads, want_dx), grads)
                     })
                 };
                 assert!(on_threads(1) == on_threads(2), "bytes depend on the threads");
+            }
+        }
+    }
+
+    /// The ReLU applied chunk by chunk gives the bits of a pass over the whole output, and the gradient masked
+    /// chunk by chunk gives what masking it first gives, on tasks of several chunks and on chunks in turn.
+    #[test]
+    fn fused_relu_matches_separate_passes() {
+        let mut rng = ChaCha8Rng::seed_from_u64(8);
+        let images = 13;
+        for (params, grids, direction) in small_layers(&mut rng) {
+            for chunk in [2, images] {
+                let mut layer = StridedConv::new(&params, "layer", grids, direction).unwrap();
+                layer.chunk = chunk;
+                let x: Vec<f32> = (0..images * layer.input_len()).map(|_| rng.random_range(-1.0..1.0)).collect();
+                let mut y = layer.forward(&x, images, false);
+                crate::nn::backprop::relu_in_place(&mut y);
+                let fused = layer.forward(&x, images, true);
+                assert!(fused == y, "chunk {chunk}: the fused ReLU changed the output's bits");
+                assert!(fused.contains(&0.0) && fused.iter().any(|&v| v > 0.0));
+                let dy: Vec<f32> = (0..y.len()).map(|_| rng.random_range(-1.0..1.0)).collect();
+                let mut masked = dy.clone();
+                relu_backward(&mut masked, &y);
+                let (mut separate, mut fused_grads) = (zero_gradients(&params), zero_gradients(&params));
+                let dx = layer.backward(&x, &mut masked.clone(), None, images, &mut separate, true);
+                let mut dy_fused = dy.clone();
+                let dx_fused = layer.backward(&x, &mut dy_fused, Some(&y), images, &mut fused_grads, true);
+                assert!(dy_fused == masked, "the gradient is masked in place");
+                close(&dx_fused, &dx, "dx");
+                for (ours, theirs) in fused_grads.iter().zip(&separate) {
+                    close(ours, theirs, "parameter gradient");
+                }
             }
         }
     }

@@ -13,7 +13,7 @@ use super::vae::{FRAME_CHANNELS, FRAME_SIDE, STD_FLOOR, STD_SHIFT};
 use crate::error::{Error, Result};
 use crate::models::gp::GpHypers;
 use crate::nn::activation::{fast_sigmoid, fast_softplus};
-use crate::nn::backprop::{add_into, relu_backward, relu_in_place, zero_gradients, Dense};
+use crate::nn::backprop::{add_into, relu_backward, zero_gradients, Dense};
 use crate::nn::blocked_conv::{BlockedConv, BlockedInput};
 use crate::nn::conv_backprop::{to_channels_first, to_channels_last, Direction, Grids, StridedConv};
 use crate::nn::ParamSet;
@@ -91,12 +91,9 @@ impl<'a> ConvVaeGrad<'a> {
 
     /// Frames regrouped for the first convolution → encoder (mean, std) and the tape.
     fn encode(&self, frames: &BlockedInput, images: usize) -> (Vec<f32>, Vec<f32>, EncoderTape) {
-        let mut first = self.first.forward(frames);
-        relu_in_place(&mut first);
-        let mut grids = vec![first];
+        let mut grids = vec![self.first.forward(frames, true)];
         for layer in &self.encoder {
-            let mut y = layer.forward(grids.last().expect("the first convolution's output at least"), images);
-            relu_in_place(&mut y);
+            let y = layer.forward(grids.last().expect("the first convolution's output at least"), images, true);
             grids.push(y);
         }
         let (channels, side) = self.encoder_out;
@@ -125,11 +122,9 @@ impl<'a> ConvVaeGrad<'a> {
         let (channels, side) = self.encoder_out;
         let mut d = to_channels_last(&d_flat, channels, side);
         for (i, layer) in self.encoder.iter().enumerate().rev() {
-            relu_backward(&mut d, &tape.grids[i + 1]);
-            d = layer.backward(&tape.grids[i], &d, images, grads, true);
+            d = layer.backward(&tape.grids[i], &mut d, Some(&tape.grids[i + 1]), images, grads, true);
         }
-        relu_backward(&mut d, &tape.grids[0]);
-        self.first.backward(frames, &d, grads);
+        self.first.backward(frames, &d, Some(&tape.grids[0]), grads);
     }
 
     /// Latents [rows, L] → pixel logits, channels-last [rows, 64, 64, 6], and the tape.
@@ -137,11 +132,10 @@ impl<'a> ConvVaeGrad<'a> {
         let mut grids = vec![self.fc.forward_relu(latents, rows)];
         let last = self.decoder.len() - 1;
         for (i, layer) in self.decoder.iter().enumerate() {
-            let mut y = layer.forward(grids.last().expect("the dense output at least"), rows);
+            let y = layer.forward(grids.last().expect("the dense output at least"), rows, i != last);
             if i == last {
                 return (y, DecoderTape { grids });
             }
-            relu_in_place(&mut y);
             grids.push(y);
         }
         unreachable!("the decoder has layers")
@@ -158,10 +152,8 @@ impl<'a> ConvVaeGrad<'a> {
     ) -> Vec<f32> {
         let mut d = d_logits;
         for (i, layer) in self.decoder.iter().enumerate().rev() {
-            if i + 1 < self.decoder.len() {
-                relu_backward(&mut d, &tape.grids[i + 1]);
-            }
-            d = layer.backward(&tape.grids[i], &d, rows, grads, true);
+            let relu_output = tape.grids.get(i + 1).map(Vec::as_slice);
+            d = layer.backward(&tape.grids[i], &mut d, relu_output, rows, grads, true);
         }
         relu_backward(&mut d, &tape.grids[0]);
         self.fc.backward(latents, &d, rows, grads, true)
