@@ -225,8 +225,23 @@ impl StridedConv {
         (chunks >= MIN_CHUNKS_FOR_TASKS).then(|| chunks.div_ceil(TASKS) * self.chunk)
     }
 
-    fn scratch(&self, images: usize) -> Vec<f32> {
-        vec![0.0; self.chunk.min(images) * self.grids.positions() * self.grids.window()]
+    /// Runs `work` with an im2col buffer for a run of `images` images: this thread's own, kept from call to call
+    /// (zeroing a fresh one for every task and layer was 2 % of DLGPD's step), or a fresh one where this thread
+    /// already lends its buffer out (a task started while another waits on the pool).
+    fn with_scratch<R>(&self, images: usize, work: impl FnOnce(&mut [f32]) -> R) -> R {
+        thread_local! {
+            static COLUMNS: std::cell::RefCell<Vec<f32>> = const { std::cell::RefCell::new(Vec::new()) };
+        }
+        let len = self.chunk.min(images) * self.grids.positions() * self.grids.window();
+        COLUMNS.with(|columns| match columns.try_borrow_mut() {
+            Ok(mut columns) => {
+                if columns.len() < len {
+                    columns.resize(len, 0.0);
+                }
+                work(&mut columns[..len])
+            }
+            Err(_) => work(&mut vec![0.0; len]),
+        })
     }
 
     /// `x`: `images` inputs (NHWC) → their outputs (NHWC), through a ReLU when `relu`. Each chunk's outputs
@@ -238,17 +253,18 @@ impl StridedConv {
         let len = images * output_len;
         let mut y = unwritten(len);
         let run = |x: &[f32], y: &mut [MaybeUninit<f32>], split: bool| {
-            let mut col = self.scratch(x.len() / input_len.max(1));
-            for (x, y) in x.chunks(self.chunk * input_len).zip(y.chunks_mut(self.chunk * output_len)) {
-                let y = fill_with_row(y, &self.bias);
-                match self.direction {
-                    Direction::Down => self.windows_times_weight(x, &mut col, y, Accum::Add, split),
-                    Direction::Up => self.spread_onto_windows(x, &mut col, y, split),
+            self.with_scratch(x.len() / input_len.max(1), |col| {
+                for (x, y) in x.chunks(self.chunk * input_len).zip(y.chunks_mut(self.chunk * output_len)) {
+                    let y = fill_with_row(y, &self.bias);
+                    match self.direction {
+                        Direction::Down => self.windows_times_weight(x, col, y, Accum::Add, split),
+                        Direction::Up => self.spread_onto_windows(x, col, y, split),
+                    }
+                    if relu {
+                        relu_in_place(y);
+                    }
                 }
-                if relu {
-                    relu_in_place(y);
-                }
-            }
+            })
         };
         let y_slots = slots(&mut y, len);
         match self.task_images(images) {
@@ -314,42 +330,43 @@ impl StridedConv {
         let g = &self.grids;
         let (window, small) = (g.window(), g.small_channels);
         let (input_len, output_len) = (self.input_len(), self.output_len());
-        let mut col = self.scratch(x.len() / input_len.max(1));
         let mut weight_grad = vec![0.0f32; small * window];
         let mut bias_grad = vec![0.0f32; self.bias.len()];
-        let chunks = x.chunks(self.chunk * input_len).zip(dy.chunks_mut(self.chunk * output_len));
-        for (index, (x_part, dy_part)) in chunks.enumerate() {
-            if let Some(y) = relu_output {
-                relu_backward(dy_part, &y[index * self.chunk * output_len..][..dy_part.len()]);
+        self.with_scratch(x.len() / input_len.max(1), |col| {
+            let chunks = x.chunks(self.chunk * input_len).zip(dy.chunks_mut(self.chunk * output_len));
+            for (index, (x_part, dy_part)) in chunks.enumerate() {
+                if let Some(y) = relu_output {
+                    relu_backward(dy_part, &y[index * self.chunk * output_len..][..dy_part.len()]);
+                }
+                add_column_sums(&mut bias_grad, dy_part);
+                let dy_part = &*dy_part;
+                let (small_part, big_part) = match self.direction {
+                    Direction::Down => (dy_part, x_part),
+                    Direction::Up => (x_part, dy_part),
+                };
+                let rows = small_part.len() / small;
+                let col = &mut col[..rows * window];
+                // The small grid's values times the big grid's windows: the weight gradient in both directions.
+                g.gather(big_part, col, split);
+                product(
+                    view_mut(&mut weight_grad, small, window),
+                    Accum::Add,
+                    view(small_part, rows, small).transpose(),
+                    view(col, rows, window),
+                    split,
+                );
+                if dx.is_empty() {
+                    continue;
+                }
+                // Zeroed chunk by chunk, just before it is added to, while it stays in cache.
+                let dx = fill_with_row(&mut dx[index * self.chunk * input_len..][..x_part.len()], &[0.0]);
+                match self.direction {
+                    Direction::Down => self.spread_onto_windows(small_part, col, dx, split),
+                    // `col` holds this chunk's windows of dy already, gathered for the weight gradient.
+                    Direction::Up => self.columns_times_weight(col, dx, Accum::Replace, split),
+                }
             }
-            add_column_sums(&mut bias_grad, dy_part);
-            let dy_part = &*dy_part;
-            let (small_part, big_part) = match self.direction {
-                Direction::Down => (dy_part, x_part),
-                Direction::Up => (x_part, dy_part),
-            };
-            let rows = small_part.len() / small;
-            let col = &mut col[..rows * window];
-            // The small grid's values times the big grid's windows: the weight gradient in both directions.
-            g.gather(big_part, col, split);
-            product(
-                view_mut(&mut weight_grad, small, window),
-                Accum::Add,
-                view(small_part, rows, small).transpose(),
-                view(col, rows, window),
-                split,
-            );
-            if dx.is_empty() {
-                continue;
-            }
-            // Zeroed chunk by chunk, just before it is added to, while it stays in cache.
-            let dx = fill_with_row(&mut dx[index * self.chunk * input_len..][..x_part.len()], &[0.0]);
-            match self.direction {
-                Direction::Down => self.spread_onto_windows(small_part, col, dx, split),
-                // `col` holds this chunk's windows of dy already, gathered for the weight gradient.
-                Direction::Up => self.columns_times_weight(col, dx, Accum::Replace, split),
-            }
-        }
+        });
         (weight_grad, bias_grad)
     }
 
