@@ -12,16 +12,21 @@
 //! output gradient the weight gradient reads. Images are independent and the weight gradient is
 //! summed over fixed groups of images in a fixed order, so the bytes do not depend on the thread count.
 
+use std::mem::MaybeUninit;
+use std::ops::Range;
+
 use faer::{Accum, MatRef, Par};
 use rayon::prelude::*;
 
-use super::backprop::{add_column_sums, add_into, assume_written, slots, tensor_index, unwritten, view, view_mut};
+use super::backprop::{add_into, assume_written, slots, tensor_index, unwritten, view, view_mut};
 use super::params::ParamSet;
 use crate::error::{Error, Result};
 
-/// Images whose weight gradients one task sums; the groups' sums are then added in order. Small groups keep both
-/// threads busy at DLGPD's batches, large ones keep few partial sums.
-const GRADIENT_GROUP: usize = 4;
+/// Images per GEMM, and per task: one image's products (992 × 48 by 48 × 32 for DLGPD's layer) are too short to
+/// run near the kernel's speed. Small groups keep both threads busy at DLGPD's batches and keep each group's
+/// products in cache; each group's weight gradient is summed on its own and the groups' sums are then added in
+/// order.
+const GROUP: usize = 4;
 
 /// A convolution (torch's Conv2d without padding, weight [out, in, k, k]) over channels-first square images.
 pub struct BlockedConv {
@@ -125,9 +130,10 @@ impl BlockedConv {
         self.blocks * self.blocks * self.depth()
     }
 
-    /// Rows of one image's GEMM: every block column of the output's block rows.
-    fn gemm_rows(&self) -> usize {
-        self.out_side * self.blocks
+    /// Rows of one image's GEMM: one per block, so that the images' rows follow one another a block apart and
+    /// a group of images is one GEMM. Rows whose block starts no kernel window are dropped.
+    fn image_rows(&self) -> usize {
+        self.blocks * self.blocks
     }
 
     pub fn input_len(&self) -> usize {
@@ -145,7 +151,8 @@ impl BlockedConv {
 
     /// Regroups channels-first `frames` ([images, channels, side, side], given as consecutive parts) into
     /// blocks: value (channel, y, x) goes to block (y / s, x / s) at ((y % s) · s + x % s) · channels + channel.
-    /// The last image's final GEMM rows read up to `taps` − 1 blocks past its end, so zeros follow it.
+    /// The last image's final GEMM rows read up to `taps` − 1 block rows and blocks past its end, so zeros
+    /// follow it.
     pub fn regroup(&self, parts: &[&[f32]]) -> Result<BlockedInput> {
         if let Some(part) = parts.iter().find(|p| p.len() % self.input_len() != 0) {
             return Err(Error::data(format!(
@@ -157,7 +164,7 @@ impl BlockedConv {
             )));
         }
         let frames: Vec<&[f32]> = parts.iter().flat_map(|p| p.chunks(self.input_len())).collect();
-        let (image_len, padding) = (self.blocked_len(), (self.taps - 1) * self.depth());
+        let (image_len, padding) = (self.blocked_len(), (self.taps - 1) * (self.blocks + 1) * self.depth());
         let len = frames.len() * image_len + padding;
         let mut values = unwritten(len);
         let (image_slots, padding_slots) = slots(&mut values, len).split_at_mut(frames.len() * image_len);
@@ -186,15 +193,16 @@ impl BlockedConv {
         }
     }
 
-    /// The GEMM row of output position `position` (row-major over out side × out side).
+    /// The GEMM row of output position `position` (row-major over out side × out side) within its image.
     fn gemm_row(&self, position: usize) -> usize {
         (position / self.out_side) * self.blocks + position % self.out_side
     }
 
-    /// One image's GEMM rows for kernel row `a`: row (Y, X) is `taps` blocks from block (Y + a, X) on.
-    fn kernel_row_operand<'a>(&self, input: &'a BlockedInput, image: usize, a: usize, rows: usize) -> MatRef<'a, f32> {
-        let depth = self.depth();
-        let start = image * self.blocked_len() + a * self.blocks * depth;
+    /// The GEMM rows of `images` for kernel row `a`: row (image, Y, X) is `taps` blocks from block (Y + a, X) of
+    /// its image on.
+    fn kernel_row_operand<'a>(&self, input: &'a BlockedInput, images: Range<usize>, a: usize) -> MatRef<'a, f32> {
+        let (depth, rows) = (self.depth(), images.len() * self.image_rows());
+        let start = images.start * self.blocked_len() + a * self.blocks * depth;
         let end = start + (rows - 1) * depth + self.row_width();
         assert!(end <= input.values.len(), "a blocked operand past its buffer's padding");
         // SAFETY: every element read, at start + r · depth + j for r < rows and j < row_width, lies below `end`,
@@ -207,33 +215,43 @@ impl BlockedConv {
         view(&self.weight[a * len..][..len], self.row_width(), self.channels_out)
     }
 
+    /// The image ranges of the groups.
+    fn groups(&self, images: usize) -> impl IndexedParallelIterator<Item = Range<usize>> {
+        (0..images.div_ceil(GROUP)).into_par_iter().map(move |group| group * GROUP..((group + 1) * GROUP).min(images))
+    }
+
     /// The layer's outputs, channels-last, bias added, through a ReLU when `relu`.
     pub fn forward(&self, input: &BlockedInput, relu: bool) -> Vec<f32> {
-        let (out, rows) = (self.channels_out, self.gemm_rows());
-        let fill_image = |image: usize, y: &mut [std::mem::MaybeUninit<f32>], product: &mut [f32]| {
-            for a in 0..self.taps {
-                let accum = if a == 0 { Accum::Replace } else { Accum::Add };
-                let operand = self.kernel_row_operand(input, image, a, rows);
-                let product = view_mut(product, rows, out);
-                faer::linalg::matmul::matmul(product, accum, operand, self.kernel_row_weight(a), 1.0f32, Par::Seq);
-            }
-            for (position, slots) in y.chunks_mut(out).enumerate() {
-                let values = &product[self.gemm_row(position) * out..][..out];
-                let activate = |x: f32| if relu { x.max(0.0) } else { x };
-                let pairs = slots.iter_mut().zip(values.iter().zip(&self.bias));
-                pairs.for_each(|(slot, (v, b))| _ = slot.write(activate(v + b)));
-            }
-        };
-        if self.output_len() == 0 {
+        let (out, len) = (self.channels_out, input.images * self.output_len());
+        if len == 0 {
             return Vec::new();
         }
-        let mut y = unwritten(input.images * self.output_len());
-        slots(&mut y, input.images * self.output_len())
-            .par_chunks_mut(self.output_len())
-            .enumerate()
-            .for_each_init(|| vec![0.0f32; rows * out], |product, (image, y)| fill_image(image, y, product));
-        // SAFETY: every image's chunk was written in full above: each of its positions is one row of `out`.
-        unsafe { assume_written(&mut y, input.images * self.output_len()) };
+        let fill_group = |images: Range<usize>, y: &mut [MaybeUninit<f32>], product: &mut Vec<f32>| {
+            let rows = images.len() * self.image_rows();
+            product.resize(rows * out, 0.0);
+            for a in 0..self.taps {
+                let accum = if a == 0 { Accum::Replace } else { Accum::Add };
+                let operand = self.kernel_row_operand(input, images.clone(), a);
+                let product = view_mut(&mut product[..rows * out], rows, out);
+                faer::linalg::matmul::matmul(product, accum, operand, self.kernel_row_weight(a), 1.0f32, Par::Seq);
+            }
+            for (image, y) in y.chunks_mut(self.output_len()).enumerate() {
+                let product = &product[image * self.image_rows() * out..];
+                for (position, slots) in y.chunks_mut(out).enumerate() {
+                    let values = &product[self.gemm_row(position) * out..][..out];
+                    let activate = |x: f32| if relu { x.max(0.0) } else { x };
+                    let pairs = slots.iter_mut().zip(values.iter().zip(&self.bias));
+                    pairs.for_each(|(slot, (v, b))| _ = slot.write(activate(v + b)));
+                }
+            }
+        };
+        let mut y = unwritten(len);
+        slots(&mut y, len)
+            .par_chunks_mut(GROUP * self.output_len())
+            .zip(self.groups(input.images))
+            .for_each_init(Vec::new, |product, (y, images)| fill_group(images, y, product));
+        // SAFETY: every group's chunk was written in full above: each of its images' positions is one row of `out`.
+        unsafe { assume_written(&mut y, len) };
         y
     }
 
@@ -243,45 +261,50 @@ impl BlockedConv {
     pub fn backward(&self, input: &BlockedInput, dy: &[f32], relu_output: Option<&[f32]>, grads: &mut [Vec<f32>]) {
         debug_assert_eq!(dy.len(), input.images * self.output_len());
         debug_assert!(relu_output.is_none_or(|y| y.len() == dy.len()));
-        let (out, rows) = (self.channels_out, self.gemm_rows());
-        let group_sums: Vec<(Vec<f32>, Vec<f32>)> = (0..input.images.div_ceil(GRADIENT_GROUP))
-            .into_par_iter()
-            .map(|group| {
-                let mut sum = vec![0.0f32; self.weight.len()];
-                let mut bias_sum = vec![0.0f32; out];
-                let mut padded = vec![0.0f32; rows * out];
-                let images = group * GRADIENT_GROUP..((group + 1) * GRADIENT_GROUP).min(input.images);
-                for image in images {
-                    let at = image * self.output_len();
-                    let dy = &dy[at..][..self.output_len()];
-                    for (position, values) in dy.chunks(out).enumerate() {
-                        let row = &mut padded[self.gemm_row(position) * out..][..out];
-                        match relu_output {
-                            Some(y) => {
-                                let y = &y[at + position * out..][..out];
-                                let masked = row.iter_mut().zip(values.iter().zip(y));
-                                masked.for_each(|(to, (d, y))| *to = if *y <= 0.0 { 0.0 } else { *d });
+        let out = self.channels_out;
+        // Each thread keeps one buffer for its groups' gradients: the rows whose block starts no window are
+        // never written, so they stay zero and add nothing.
+        let padded_len = GROUP * self.image_rows() * out;
+        let group_sums: Vec<(Vec<f32>, Vec<f32>)> = self
+            .groups(input.images)
+            .map_init(
+                || vec![0.0f32; padded_len],
+                |padded, images| {
+                    let rows = images.len() * self.image_rows();
+                    let padded = &mut padded[..rows * out];
+                    let mut bias_sum = vec![0.0f32; out];
+                    for (image, padded) in images.clone().zip(padded.chunks_mut(self.image_rows() * out)) {
+                        let at = image * self.output_len();
+                        let dy = &dy[at..][..self.output_len()];
+                        for (position, values) in dy.chunks(out).enumerate() {
+                            let row = &mut padded[self.gemm_row(position) * out..][..out];
+                            match relu_output {
+                                Some(y) => {
+                                    let y = &y[at + position * out..][..out];
+                                    let masked = row.iter_mut().zip(values.iter().zip(y));
+                                    masked.for_each(|(to, (d, y))| *to = if *y <= 0.0 { 0.0 } else { *d });
+                                }
+                                None => row.copy_from_slice(values),
                             }
-                            None => row.copy_from_slice(values),
+                            bias_sum.iter_mut().zip(row.iter()).for_each(|(sum, d)| *sum += d);
                         }
                     }
-                    // The rows no kernel window fits stay zero, so they add nothing.
-                    add_column_sums(&mut bias_sum, &padded);
+                    let mut sum = vec![0.0f32; self.weight.len()];
                     for a in 0..self.taps {
-                        let operand = self.kernel_row_operand(input, image, a, rows);
+                        let operand = self.kernel_row_operand(input, images.clone(), a);
                         let sum = &mut sum[a * self.row_width() * out..][..self.row_width() * out];
                         faer::linalg::matmul::matmul(
                             view_mut(sum, self.row_width(), out),
-                            Accum::Add,
+                            Accum::Replace,
                             operand.transpose(),
-                            view(&padded, rows, out),
+                            view(padded, rows, out),
                             1.0f32,
                             Par::Seq,
                         );
                     }
-                }
-                (sum, bias_sum)
-            })
+                    (sum, bias_sum)
+                },
+            )
             .collect();
         let mut group_sums = group_sums.into_iter();
         let Some((mut sum, mut bias_sum)) = group_sums.next() else { return };
