@@ -454,28 +454,36 @@ fn add_torch_layout(dst: &mut [f32], src: &[f32], rows: usize, channels: usize, 
 /// `images` images [channels, side, side] → [side, side, channels].
 pub fn to_channels_last(x: &[f32], channels: usize, side: usize) -> Vec<f32> {
     let plane = side * side;
-    let mut out = vec![0.0; x.len()];
-    out.par_chunks_mut(channels * plane).zip(x.par_chunks(channels * plane)).for_each(|(out, x)| {
-        for c in 0..channels {
-            for p in 0..plane {
-                out[p * channels + c] = x[c * plane + p];
-            }
+    // Each pixel's channels written together, from one place in each channel's plane.
+    permuted(x, channels * plane, |x, out| {
+        for (p, pixel) in out.chunks_exact_mut(channels.max(1)).enumerate() {
+            pixel.iter_mut().zip(x[p..].iter().step_by(plane)).for_each(|(slot, v)| _ = slot.write(*v));
         }
-    });
-    out
+    })
 }
 
 /// The inverse of [`to_channels_last`].
 pub fn to_channels_first(x: &[f32], channels: usize, side: usize) -> Vec<f32> {
     let plane = side * side;
-    let mut out = vec![0.0; x.len()];
-    out.par_chunks_mut(channels * plane).zip(x.par_chunks(channels * plane)).for_each(|(out, x)| {
-        for c in 0..channels {
-            for p in 0..plane {
-                out[c * plane + p] = x[p * channels + c];
-            }
+    permuted(x, channels * plane, |x, out| {
+        for (c, channel) in out.chunks_exact_mut(plane.max(1)).enumerate() {
+            channel.iter_mut().zip(x[c..].iter().step_by(channels)).for_each(|(slot, v)| _ = slot.write(*v));
         }
-    });
+    })
+}
+
+/// A new buffer of `x`'s length whose images (`image_len` values each) `permute` writes in full, one task
+/// per image, without zeroing it first.
+fn permuted(x: &[f32], image_len: usize, permute: impl Fn(&[f32], &mut [MaybeUninit<f32>]) + Sync) -> Vec<f32> {
+    assert!(image_len > 0 && x.len().is_multiple_of(image_len), "permuted: {} values are not whole images", x.len());
+    let mut out = unwritten(x.len());
+    {
+        let images = slots(&mut out, x.len()).par_chunks_mut(image_len).zip(x.par_chunks(image_len));
+        images.for_each(|(out, x)| permute(x, out));
+    }
+    // SAFETY: each image's permutation writes every slot of its image once (a pixel's channels, or a channel's
+    // pixels, cover the image), and the images, all whole, cover the buffer.
+    unsafe { assume_written(&mut out, x.len()) };
     out
 }
 
