@@ -1,16 +1,18 @@
 //! A strided convolution whose kernel is a whole number of strides, run without an im2col matrix. Its input is
 //! regrouped once into stride × stride blocks ("space to depth"); the layer is then a stride-1 convolution with
-//! a (kernel / stride)² kernel over blocks, and one kernel row of it, over every output position of an image, is
-//! a single GEMM whose left operand is the regrouped image itself, read one block apart (its rows overlap).
+//! a (kernel / stride)² kernel over blocks, and one kernel row of it, over every output position of a group of
+//! images, is a single GEMM whose left operand is the regrouped images themselves, read one block apart (its
+//! rows overlap).
 //!
 //! DLGPD's first encoder layer (64 × 64 × 6 frames, kernel 4, stride 2, 32 channels) is why: im2col spends
 //! most of that layer gathering 24-float pieces into a matrix 16 times the frames' size, and its 96 × 32 GEMM is
 //! too thin to hide the gather.
 //!
-//! Each image's GEMM runs over whole block rows, so it also yields the last `taps` − 1 block columns of each
-//! row, where no kernel window fits; those rows are dropped when the output is written, and left zero in the
-//! output gradient the weight gradient reads. Images are independent and the weight gradient is
-//! summed over fixed groups of images in a fixed order, so the bytes do not depend on the thread count.
+//! The GEMM has one row per block, so that one image's rows follow the last one's; it therefore also yields
+//! the blocks where no kernel window fits (the last `taps` − 1 of each block row and block column). Those rows
+//! are dropped when the output is written, and left zero in the output gradient the weight gradient reads.
+//! The groups of images are fixed by the batch, and the weight gradient is summed per group and then over the
+//! groups in order, so the bytes do not depend on the thread count.
 
 use std::mem::MaybeUninit;
 use std::ops::Range;
