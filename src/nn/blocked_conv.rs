@@ -20,7 +20,7 @@ use std::ops::Range;
 use faer::{Accum, MatRef, Par};
 use rayon::prelude::*;
 
-use super::backprop::{add_into, assume_written, slots, tensor_index, unwritten, view, view_mut};
+use super::backprop::{add_into, assume_written, relu_backward, slots, tensor_index, unwritten, view, view_mut};
 use super::params::ParamSet;
 use crate::error::{Error, Result};
 
@@ -237,11 +237,11 @@ impl BlockedConv {
                 let product = view_mut(&mut product[..rows * out], rows, out);
                 faer::linalg::matmul::matmul(product, accum, operand, self.kernel_row_weight(a), 1.0f32, Par::Seq);
             }
+            let activate = |x: f32| if relu { x.max(0.0) } else { x };
             for (image, y) in y.chunks_mut(self.output_len()).enumerate() {
                 let product = &product[image * self.image_rows() * out..];
                 for (position, slots) in y.chunks_mut(out).enumerate() {
                     let values = &product[self.gemm_row(position) * out..][..out];
-                    let activate = |x: f32| if relu { x.max(0.0) } else { x };
                     let pairs = slots.iter_mut().zip(values.iter().zip(&self.bias));
                     pairs.for_each(|(slot, (v, b))| _ = slot.write(activate(v + b)));
                 }
@@ -280,13 +280,9 @@ impl BlockedConv {
                         let dy = &dy[at..][..self.output_len()];
                         for (position, values) in dy.chunks(out).enumerate() {
                             let row = &mut padded[self.gemm_row(position) * out..][..out];
-                            match relu_output {
-                                Some(y) => {
-                                    let y = &y[at + position * out..][..out];
-                                    let masked = row.iter_mut().zip(values.iter().zip(y));
-                                    masked.for_each(|(to, (d, y))| *to = if *y <= 0.0 { 0.0 } else { *d });
-                                }
-                                None => row.copy_from_slice(values),
+                            row.copy_from_slice(values);
+                            if let Some(y) = relu_output {
+                                relu_backward(row, &y[at + position * out..][..out]);
                             }
                             bias_sum.iter_mut().zip(row.iter()).for_each(|(sum, d)| *sum += d);
                         }
@@ -382,13 +378,18 @@ mod tests {
         assert!(error.to_string().contains("multiple of the stride"), "{error}");
     }
 
+    /// A kernel-4, stride-2 layer of random weights over `side`² images.
+    fn random_layer(rng: &mut ChaCha8Rng, side: usize, (cin, cout): (usize, usize)) -> (ParamSet, BlockedConv) {
+        let conv = Conv2dConfig::new(cin, cout, 4, 2).init(&training_device(), rng);
+        let params = ParamSet::<f32>::from_module(&conv, |n: &str| format!("layer.{n}"));
+        let layer = BlockedConv::new(&params, "layer", side, (cin, cout), 4, 2).unwrap();
+        (params, layer)
+    }
+
     #[test]
     fn bytes_do_not_depend_on_the_thread_count() {
-        let device = training_device();
         let mut rng = ChaCha8Rng::seed_from_u64(4);
-        let conv = Conv2dConfig::new(3, 8, 4, 2).init(&device, &mut rng);
-        let params = ParamSet::<f32>::from_module(&conv, |n: &str| format!("layer.{n}"));
-        let layer = BlockedConv::new(&params, "layer", 16, (3, 8), 4, 2).unwrap();
+        let (params, layer) = random_layer(&mut rng, 16, (3, 8));
         let images = 11;
         let x: Vec<f32> = (0..images * layer.input_len()).map(|_| rng.random_range(-1.0..1.0)).collect();
         let dy: Vec<f32> = (0..images * layer.output_len()).map(|_| rng.random_range(-1.0..1.0)).collect();
@@ -438,11 +439,8 @@ mod tests {
     /// The ReLU in the forward pass and the mask in the backward pass give what separate passes give.
     #[test]
     fn fused_relu_matches_separate_passes() {
-        let device = training_device();
         let mut rng = ChaCha8Rng::seed_from_u64(9);
-        let conv = Conv2dConfig::new(3, 5, 4, 2).init(&device, &mut rng);
-        let params = ParamSet::<f32>::from_module(&conv, |n: &str| format!("layer.{n}"));
-        let layer = BlockedConv::new(&params, "layer", 12, (3, 5), 4, 2).unwrap();
+        let (params, layer) = random_layer(&mut rng, 12, (3, 5));
         let images = 9;
         let x: Vec<f32> = (0..images * layer.input_len()).map(|_| rng.random_range(-1.0..1.0)).collect();
         let input = layer.regroup(&[&x]).unwrap();
