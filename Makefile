@@ -68,7 +68,7 @@ bench:
 # machine's load (docs/benchmarks.md). Needs torch: PYTORCH_PYTHON names an interpreter that has it.
 PYTORCH_PYTHON ?= python3
 bench-vs-pytorch:
-	python3 benches/vs_pytorch.py --python $(PYTORCH_PYTHON) $(if $(QUICK),--quick) $(if $(ONLY),--only $(ONLY))
+	python3 benches/vs_pytorch.py --python $(PYTORCH_PYTHON) $(if $(QUICK),--quick) $(if $(ROUNDS),--rounds $(ROUNDS)) $(if $(ONLY),--only $(ONLY))
 
 $(MBRL): build
 

@@ -15,13 +15,20 @@ of the GEMM ceiling without being slower than PyTorch. The other steps' GFLOP/s 
 which can exceed the work mbrl does (the context model shares its action embedding between the single-step and
 multi-step predictions), so their share of the ceiling is not a target.
 
-Usage: python3 benches/vs_pytorch.py [--quick] [--only NAME[,NAME...]] [--python PY] [--markdown FILE]
-(`make bench-vs-pytorch` runs it; PYTORCH_PYTHON names an interpreter that has torch.)
+With --rounds N (N > 1) the two sides take turns N times, mbrl first in odd rounds and PyTorch first in even
+ones, so that a drift in the machine's speed falls on both; each row then shows each side's median time, the
+median of the rounds' ratios and their range. On a shared or virtual machine whose speed moves from minute to
+minute, a single round's ratio can be off by a fifth either way.
+
+Usage: python3 benches/vs_pytorch.py [--quick] [--rounds N] [--only NAME[,NAME...]] [--python PY]
+                                      [--markdown FILE]
+(`make bench-vs-pytorch` runs it, ROUNDS=N for rounds; PYTORCH_PYTHON names an interpreter that has torch.)
 """
 
 import argparse
 import json
 import os
+import statistics
 import subprocess
 import sys
 import time
@@ -112,29 +119,63 @@ def main():
     parser.add_argument("--only", help="comma-separated workloads: " + ", ".join(LABELS))
     parser.add_argument("--python", help="the Python interpreter with torch")
     parser.add_argument("--markdown", help="also write the table to this file")
+    parser.add_argument("--rounds", type=int, default=1, help="turns each side takes, alternating (default 1)")
     args = parser.parse_args()
+    if not 1 <= args.rounds <= 20:
+        sys.exit(f"error: --rounds expects 1 to 20 rounds, got {args.rounds}")
     python = find_python(args.python)
     extra = (["--quick"] if args.quick else []) + (["--only", args.only] if args.only else [])
     if args.only is None or BALL_ROW in args.only.split(","):
         prepare_ball_case(python)
 
-    ours, our_load = run_side("mbrl", ["cargo", "bench", "--quiet", "--bench", "training_steps", "--"] + extra)
-    theirs, their_load = run_side("PyTorch", [python, os.path.join(HERE, "pytorch", "training_steps.py")] + extra)
+    commands = {
+        "mbrl": ["cargo", "bench", "--quiet", "--bench", "training_steps", "--"] + extra,
+        "PyTorch": [python, os.path.join(HERE, "pytorch", "training_steps.py")] + extra,
+    }
+    runs = {"mbrl": [], "PyTorch": []}
+    loads = {"mbrl": [], "PyTorch": []}
+    for round_index in range(args.rounds):
+        order = ["mbrl", "PyTorch"] if round_index % 2 == 0 else ["PyTorch", "mbrl"]
+        for side in order:
+            if args.rounds > 1:
+                print(f"round {round_index + 1} of {args.rounds}: {side}", file=sys.stderr, flush=True)
+            rows, load = run_side(side, commands[side])
+            runs[side].append(rows)
+            loads[side].append(load)
 
-    torch_version = next((r["torch"] for r in theirs if "torch" in r), "?")
-    ceiling = {r["threads"]: r["gflops"] for r in ours if r.get("workload") == "gemm_ceiling"}
-    mbrl = {(r["workload"], r["threads"]): r for r in ours if "seconds" in r}
-    torch_rows = {(r["workload"], r["threads"]): r for r in theirs if "workload" in r}
+    torch_version = next((r["torch"] for rows in runs["PyTorch"] for r in rows if "torch" in r), "?")
+    ceiling = {}
+    for rows in runs["mbrl"]:
+        for r in rows:
+            if r.get("workload") == "gemm_ceiling":
+                ceiling[r["threads"]] = max(ceiling.get(r["threads"], 0.0), r["gflops"])
+    # Per (workload, threads): each round's seconds on each side, in round order.
+    mbrl, torch_seconds, flop_counts = {}, {}, {}
+    for rows in runs["mbrl"]:
+        for r in rows:
+            if "seconds" in r:
+                mbrl.setdefault((r["workload"], r["threads"]), []).append(r["seconds"])
+    for rows in runs["PyTorch"]:
+        for r in rows:
+            if "workload" in r and "seconds" in r:
+                torch_seconds.setdefault((r["workload"], r["threads"]), []).append(r["seconds"])
+                if r.get("flops"):
+                    flop_counts[(r["workload"], r["threads"])] = r["flops"]
 
+    rounds = args.rounds > 1
     lines = [
-        f"| training step | threads | PyTorch {torch_version} | mbrl | mbrl / PyTorch speed | GFLOP per step "
-        "| PyTorch GFLOP/s | mbrl GFLOP/s | mbrl, % of GEMM ceiling | target |",
-        "|---|---|---|---|---|---|---|---|---|---|",
+        f"| training step | threads | PyTorch {torch_version} | mbrl | mbrl / PyTorch speed |"
+        + (f" range over {args.rounds} rounds |" if rounds else "")
+        + " GFLOP per step | PyTorch GFLOP/s | mbrl GFLOP/s | mbrl, % of GEMM ceiling | target |",
+        "|---|---|---|---|---|" + ("---|" if rounds else "") + "---|---|---|---|---|",
     ]
-    for (name, threads), row in mbrl.items():
-        other = torch_rows.get((name, threads), {})
-        ours_s, theirs_s, flops = row["seconds"], other.get("seconds"), other.get("flops")
-        ratio = theirs_s / ours_s if theirs_s else None
+    for (name, threads), our_times in mbrl.items():
+        their_times = torch_seconds.get((name, threads), [])
+        flops = flop_counts.get((name, threads))
+        ours_s = statistics.median(our_times)
+        theirs_s = statistics.median(their_times) if their_times else None
+        paired = [t / o for o, t in zip(our_times, their_times)]
+        ratio = statistics.median(paired) if paired else None
         gflop = flops / 1e9 if flops else None
         our_rate = gflop / ours_s if gflop else None
         their_rate = gflop / theirs_s if gflop and theirs_s else None
@@ -151,6 +192,10 @@ def main():
             fmt_time(theirs_s),
             fmt_time(ours_s),
             f"{ratio:.2f}×" if ratio else "—",
+        ]
+        if rounds:
+            cells.append(f"{min(paired):.2f}–{max(paired):.2f}×" if paired else "—")
+        cells += [
             f"{gflop:.3g}" if gflop else "—",
             f"{their_rate:.1f}" if their_rate else "—",
             f"{our_rate:.1f}" if our_rate else "—",
@@ -161,10 +206,19 @@ def main():
     ceilings = ", ".join(f"{ceiling[t]:.1f} GFLOP/s at {t} thread{'s' if t > 1 else ''}" for t in sorted(ceiling))
     lines.append("")
     lines.append(f"f32 GEMM ceiling (faer, 1024³, best of the run): {ceilings}.")
-    for side, load in (("mbrl", our_load), ("PyTorch", their_load)):
+    for side in ("mbrl", "PyTorch"):
+        side_loads = loads[side]
+        turns = f"{len(side_loads)} turns, " if rounds else ""
+        busiest = max(load["other_cores"] for load in side_loads)
         lines.append(
-            f"{side} side: {load['wall']:.0f} s, load average {load['load_before']} → {load['load_after']}, "
-            f"other processes kept {load['other_cores']:.2f} cores busy."
+            f"{side} side: {turns}{sum(load['wall'] for load in side_loads):.0f} s, load average "
+            f"{side_loads[0]['load_before']} → {side_loads[-1]['load_after']}, other processes kept "
+            f"{busiest:.2f} cores busy{' at most' if rounds else ''}."
+        )
+    if rounds:
+        lines.append(
+            "Times are each side's median over the rounds; the ratio is the median of the rounds' ratios (each "
+            "round's PyTorch time over its mbrl time), and the target is judged on it."
         )
     lines.append(
         "FLOPs: matmul and convolution FLOPs of forward and backward, counted by torch's FlopCounterMode on "
