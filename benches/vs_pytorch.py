@@ -149,16 +149,17 @@ def main():
         for r in rows:
             if r.get("workload") == "gemm_ceiling":
                 ceiling[r["threads"]] = max(ceiling.get(r["threads"], 0.0), r["gflops"])
-    # Per (workload, threads): each round's seconds on each side, in round order.
+    # Per (workload, threads): {round: seconds} on each side, so that a row one side lacks in a round leaves
+    # that round unpaired instead of pairing the rounds after it wrongly.
     mbrl, torch_seconds, flop_counts = {}, {}, {}
-    for rows in runs["mbrl"]:
+    for index, rows in enumerate(runs["mbrl"]):
         for r in rows:
             if "seconds" in r:
-                mbrl.setdefault((r["workload"], r["threads"]), []).append(r["seconds"])
-    for rows in runs["PyTorch"]:
+                mbrl.setdefault((r["workload"], r["threads"]), {})[index] = r["seconds"]
+    for index, rows in enumerate(runs["PyTorch"]):
         for r in rows:
             if "workload" in r and "seconds" in r:
-                torch_seconds.setdefault((r["workload"], r["threads"]), []).append(r["seconds"])
+                torch_seconds.setdefault((r["workload"], r["threads"]), {})[index] = r["seconds"]
                 if r.get("flops"):
                     flop_counts[(r["workload"], r["threads"])] = r["flops"]
 
@@ -170,11 +171,11 @@ def main():
         "|---|---|---|---|---|" + ("---|" if rounds else "") + "---|---|---|---|---|",
     ]
     for (name, threads), our_times in mbrl.items():
-        their_times = torch_seconds.get((name, threads), [])
+        their_times = torch_seconds.get((name, threads), {})
         flops = flop_counts.get((name, threads))
-        ours_s = statistics.median(our_times)
-        theirs_s = statistics.median(their_times) if their_times else None
-        paired = [t / o for o, t in zip(our_times, their_times)]
+        ours_s = statistics.median(our_times.values())
+        theirs_s = statistics.median(their_times.values()) if their_times else None
+        paired = [their_times[i] / our_times[i] for i in sorted(our_times) if i in their_times]
         ratio = statistics.median(paired) if paired else None
         gflop = flops / 1e9 if flops else None
         our_rate = gflop / ours_s if gflop else None
@@ -194,7 +195,8 @@ def main():
             f"{ratio:.2f}×" if ratio else "—",
         ]
         if rounds:
-            cells.append(f"{min(paired):.2f}–{max(paired):.2f}×" if paired else "—")
+            short = f" ({len(paired)} rounds)" if len(paired) < args.rounds else ""
+            cells.append(f"{min(paired):.2f}–{max(paired):.2f}×{short}" if paired else "—")
         cells += [
             f"{gflop:.3g}" if gflop else "—",
             f"{their_rate:.1f}" if their_rate else "—",

@@ -654,9 +654,9 @@ pub(crate) mod tests {
         }
     }
 
-    /// Windows of 1024 values (64 channels, kernel 4) in tasks of one-image chunks, whose weight gradients go
-    /// to the AVX-512 kernel where there is one: the values of one chunk on faer's path, in both directions,
-    /// and the same bytes on one thread and two.
+    /// Windows of 1024 values (64 channels, kernel 4) in tasks of two one-image chunks of 289 rows (two blocks
+    /// of the kernel's inner dimension), whose weight gradients go to the AVX-512 kernel where there is one: the
+    /// values of one chunk split over the pool, in both directions, and the same bytes on one thread and two.
     #[test]
     fn wide_weight_gradients_in_tasks_match_one_chunk() {
         let device = training_device();
@@ -666,17 +666,29 @@ pub(crate) mod tests {
         let up =
             ParamSet::<f32>::from_module(&Conv2dConfig::new(64, 64, 4, 2).init_transposed(&device, &mut rng), named);
         let layers = [
-            (down, Grids::conv(6, 64, 64, 4, 2), Direction::Down),
-            (up, Grids::conv_transpose(2, 64, 64, 4, 2), Direction::Up),
+            (down, Grids::conv(36, 64, 64, 4, 2), Direction::Down),
+            (up, Grids::conv_transpose(17, 64, 64, 4, 2), Direction::Up),
         ];
-        let images = 6;
+        let images = 20;
         for (params, grids, direction) in layers {
             assert_eq!(grids.window(), 1024);
             let mut whole = StridedConv::new(&params, "layer", grids, direction).unwrap();
             whole.chunk = images;
             let mut tasks = StridedConv::new(&params, "layer", grids, direction).unwrap();
             tasks.chunk = 1;
-            assert!(tasks.task_images(images).is_some() && whole.task_images(images).is_none());
+            // Two chunks per task, so that each task's weight gradient sums two products.
+            assert!(tasks.task_images(images) == Some(2) && whole.task_images(images).is_none());
+            // The weight gradient's operands as a task lays them out: the kernel reads them where there is one.
+            let rows = grids.small_side * grids.small_side;
+            let mut weight_grad = vec![0.0f32; 64 * 1024];
+            let (small_part, col) = (vec![0.0f32; rows * 64], vec![0.0f32; rows * 1024]);
+            let dst = view_mut(&mut weight_grad, 64, 1024);
+            let (a, b) = (view(&small_part, rows, 64).transpose(), view(&col, rows, 1024));
+            #[cfg(target_arch = "x86_64")]
+            if is_x86_feature_detected!("avx512f") {
+                assert!(widest_kernel(&dst, &a, &b).is_some(), "the AVX-512 kernel reads a task's weight gradient");
+            }
+            let _ = (dst, a, b);
             let x: Vec<f32> = (0..images * whole.input_len()).map(|_| rng.random_range(-1.0..1.0)).collect();
             let dy: Vec<f32> = (0..images * whole.output_len()).map(|_| rng.random_range(-1.0..1.0)).collect();
             let (mut whole_grads, mut task_grads) = (zero_gradients(&params), zero_gradients(&params));

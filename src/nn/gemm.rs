@@ -112,7 +112,7 @@ impl Kernel {
     }
 
     /// dst (m × n) = [dst +] a (m × k) · b (k × n), sequentially. `self` must be `for_product` of this product
-    /// or of one it is a block of (rows or columns).
+    /// or of one it is a block of (rows or columns), or `widest_kernel` of it (a caller's choice by shape).
     pub fn product(self, dst: MatMut<'_, f32>, accum: Accum, a: MatRef<'_, f32>, b: MatRef<'_, f32>) {
         self.fused(dst, Start::of(accum), a, b, Finish::Store);
     }
@@ -326,7 +326,7 @@ mod avx512 {
         let (ars, aks) = (a.row_stride(), a.col_stride());
         let panels = n.div_ceil(NR);
         // Each thread keeps its packing buffers from product to product (zeroing a fresh 0.1-0.8 MiB one for
-        // every conv chunk cost DLGPD's step 1 %); a product nested in another's use of them takes new ones.
+        // every conv chunk cost DLGPD's step 3 %); a product nested in another's use of them takes new ones.
         // Lanes of the last panel past the output's last column hold zeros or values of an earlier block or
         // product: they feed only accumulator lanes that the masked stores leave out.
         let (mut packed, mut a_block) = SCRATCH.take();
@@ -724,10 +724,17 @@ mod tests {
     fn matches_an_f64_product_for_every_layout_and_ragged_edge() {
         let mut rng = ChaCha8Rng::seed_from_u64(3);
         // Operands past MIN_VALUES with a ragged last row block, columns with one- and two-vector tails, inner
-        // sizes across the 256 block, and a weight gradient's shape (few rows, a long inner dimension).
-        for &(m, n, k) in
-            &[(2031, 300, 9), (1024, 600, 200), (1100, 257, 300), (1037, 280, 513), (2000, 270, 1), (40, 600, 9000)]
-        {
+        // sizes across the 256 block, a weight gradient's shape (few rows, a long inner dimension), and an
+        // output wide enough to be cut into column blocks.
+        for &(m, n, k) in &[
+            (2031, 300, 9),
+            (1024, 600, 200),
+            (1100, 257, 300),
+            (1037, 280, 513),
+            (2000, 270, 1),
+            (40, 600, 9000),
+            (100, 1601, 270),
+        ] {
             for accum in [Accum::Replace, Accum::Add] {
                 for (a_rows, b_rows) in [(true, true), (false, true), (true, false), (false, false)] {
                     let (a, b, c0) = (random(m, k, &mut rng), random(k, n, &mut rng), random(m, n, &mut rng));
@@ -761,7 +768,8 @@ mod tests {
     #[test]
     fn a_bias_start_and_a_relu_finish_are_applied_in_place() {
         let mut rng = ChaCha8Rng::seed_from_u64(5);
-        for &(m, n, k) in &[(1031, 300, 9), (1030, 45, 600), (1100, 17, 260)] {
+        // The last is cut into column blocks by the AVX-512 kernel.
+        for &(m, n, k) in &[(1031, 300, 9), (1030, 45, 600), (1100, 17, 260), (40, 1601, 300)] {
             let (a, b) = (random(m, k, &mut rng), random(k, n, &mut rng));
             let bias: Vec<f32> = (0..n).map(|_| rng.random_range(-1.0..1.0)).collect();
             // A ReLU output with zeros, positives and a NaN, which keeps its gradient as relu_backward does.
