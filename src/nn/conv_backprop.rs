@@ -20,8 +20,6 @@
 //! image is gathered and scattered by one thread: the bytes do not depend on the thread count.
 
 use faer::{Accum, MatMut, MatRef, Par};
-
-use super::gemm::widest_kernel;
 use rayon::prelude::*;
 
 use std::mem::MaybeUninit;
@@ -30,6 +28,7 @@ use super::backprop::{
     add_column_sums, add_into, assume_written, fill_with_row, matmul, relu_backward, relu_in_place, slots,
     tensor_index, unwritten, view, view_mut,
 };
+use super::gemm::widest_kernel;
 use super::params::ParamSet;
 use crate::error::{Error, Result};
 use crate::util::wide::widest_fn;
@@ -175,9 +174,9 @@ fn product(dst: MatMut<'_, f32>, accum: Accum, a: MatRef<'_, f32>, b: MatRef<'_,
 /// batch-256 step 3 % faster. The choice depends on the layer's shape alone, not on the threads.
 fn weight_gradient_product(dst: MatMut<'_, f32>, a: MatRef<'_, f32>, b: MatRef<'_, f32>, split: bool) {
     let wide = dst.ncols() >= 1024 && dst.nrows() >= 64;
-    match widest_kernel(&dst, &a, &b) {
-        Some(kernel) if wide && !split => kernel.product(dst, Accum::Add, a, b),
-        _ => product(dst, Accum::Add, a, b, split),
+    match (wide && !split).then(|| widest_kernel(&dst, &a, &b)).flatten() {
+        Some(kernel) => kernel.product(dst, Accum::Add, a, b),
+        None => product(dst, Accum::Add, a, b, split),
     }
 }
 
@@ -564,6 +563,32 @@ pub(crate) mod tests {
         }
     }
 
+    /// Random inputs and output gradients for `images` images of `layer`, drawn in that order.
+    fn random_batch(layer: &StridedConv, images: usize, rng: &mut ChaCha8Rng) -> (Vec<f32>, Vec<f32>) {
+        let x = (0..images * layer.input_len()).map(|_| rng.random_range(-1.0..1.0)).collect();
+        let dy = (0..images * layer.output_len()).map(|_| rng.random_range(-1.0..1.0)).collect();
+        (x, dy)
+    }
+
+    /// Asserts `layer` gives `reference`'s input gradient (empty without `want_dx`) and parameter gradients.
+    fn assert_same_gradients(
+        layer: &StridedConv,
+        reference: &StridedConv,
+        params: &ParamSet,
+        batch: (&[f32], &[f32], usize),
+        want_dx: bool,
+    ) {
+        let (x, dy, images) = batch;
+        let (mut reference_grads, mut grads) = (zero_gradients(params), zero_gradients(params));
+        let dx_reference = reference.backward(x, &mut dy.to_vec(), None, images, &mut reference_grads, want_dx);
+        let dx = layer.backward(x, &mut dy.to_vec(), None, images, &mut grads, want_dx);
+        assert_eq!(dx.len(), if want_dx { x.len() } else { 0 });
+        close(&dx, &dx_reference, "dx");
+        for (ours, theirs) in grads.iter().zip(&reference_grads) {
+            close(ours, theirs, "parameter gradient");
+        }
+    }
+
     /// `work` run on a pool of `threads` threads.
     fn on_pool<R: Send>(threads: usize, work: impl FnOnce() -> R + Send) -> R {
         rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(work)
@@ -592,8 +617,7 @@ pub(crate) mod tests {
         for (params, grids, direction) in small_layers(&mut rng) {
             let whole = StridedConv::new(&params, "layer", grids, direction).unwrap();
             assert!(whole.chunk >= images && whole.task_images(images).is_none());
-            let x: Vec<f32> = (0..images * whole.input_len()).map(|_| rng.random_range(-1.0..1.0)).collect();
-            let dy: Vec<f32> = (0..images * whole.output_len()).map(|_| rng.random_range(-1.0..1.0)).collect();
+            let (x, dy) = random_batch(&whole, images, &mut rng);
             let (mut whole_grads, mut chunked_grads) = (zero_gradients(&params), zero_gradients(&params));
             let dx_whole = whole.backward(&x, &mut dy.clone(), None, images, &mut whole_grads, true);
             for (chunk, tasks) in [(2, false), (1, true)] {
@@ -631,18 +655,10 @@ pub(crate) mod tests {
             let mut chunked = StridedConv::new(&params, "layer", grids, direction).unwrap();
             chunked.chunk = 2;
             assert_eq!(chunked.task_images(images), Some(4), "18 chunks in 16 tasks: 2 chunks per task");
-            let x: Vec<f32> = (0..images * whole.input_len()).map(|_| rng.random_range(-1.0..1.0)).collect();
-            let dy: Vec<f32> = (0..images * whole.output_len()).map(|_| rng.random_range(-1.0..1.0)).collect();
+            let (x, dy) = random_batch(&whole, images, &mut rng);
             close(&chunked.forward(&x, images, false), &whole.forward(&x, images, false), "output");
             for want_dx in [true, false] {
-                let (mut whole_grads, mut chunked_grads) = (zero_gradients(&params), zero_gradients(&params));
-                let dx_whole = whole.backward(&x, &mut dy.clone(), None, images, &mut whole_grads, want_dx);
-                let dx = chunked.backward(&x, &mut dy.clone(), None, images, &mut chunked_grads, want_dx);
-                assert_eq!(dx.len(), if want_dx { x.len() } else { 0 });
-                close(&dx, &dx_whole, "dx");
-                for (ours, theirs) in chunked_grads.iter().zip(&whole_grads) {
-                    close(ours, theirs, "parameter gradient");
-                }
+                assert_same_gradients(&chunked, &whole, &params, (&x, &dy, images), want_dx);
                 let on_threads = |threads| {
                     on_pool(threads, || {
                         let mut grads = zero_gradients(&params);
@@ -689,14 +705,8 @@ pub(crate) mod tests {
                 assert!(widest_kernel(&dst, &a, &b).is_some(), "the AVX-512 kernel reads a task's weight gradient");
             }
             let _ = (dst, a, b);
-            let x: Vec<f32> = (0..images * whole.input_len()).map(|_| rng.random_range(-1.0..1.0)).collect();
-            let dy: Vec<f32> = (0..images * whole.output_len()).map(|_| rng.random_range(-1.0..1.0)).collect();
-            let (mut whole_grads, mut task_grads) = (zero_gradients(&params), zero_gradients(&params));
-            let dx_whole = whole.backward(&x, &mut dy.clone(), None, images, &mut whole_grads, true);
-            close(&tasks.backward(&x, &mut dy.clone(), None, images, &mut task_grads, true), &dx_whole, "dx");
-            for (ours, theirs) in task_grads.iter().zip(&whole_grads) {
-                close(ours, theirs, "parameter gradient");
-            }
+            let (x, dy) = random_batch(&whole, images, &mut rng);
+            assert_same_gradients(&tasks, &whole, &params, (&x, &dy, images), true);
             let on_threads = |threads| {
                 on_pool(threads, || {
                     let mut grads = zero_gradients(&params);

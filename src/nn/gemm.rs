@@ -329,7 +329,7 @@ mod avx512 {
         // every conv chunk cost DLGPD's step 3 %); a product nested in another's use of them takes new ones.
         // Lanes of the last panel past the output's last column hold zeros or values of an earlier block or
         // product: they feed only accumulator lanes that the masked stores leave out.
-        let (mut packed, mut a_block) = SCRATCH.take();
+        let (mut packed, mut a_block) = PACKING_BUFFERS.take();
         grow(&mut packed, panels * KC.min(k) * NR);
         // `a` stored by rows is read in place, its 12 rows' values consecutive along k. Stored by columns (a
         // weight gradient's dYᵀ), its row block is packed as [k][row]: read in place, each k's 12 values sit
@@ -421,11 +421,11 @@ mod avx512 {
                 }
             }
         }
-        SCRATCH.set((packed, a_block));
+        PACKING_BUFFERS.set((packed, a_block));
     }
 
     thread_local! {
-        static SCRATCH: std::cell::Cell<(Vec<f32>, Vec<f32>)> = const { std::cell::Cell::new((Vec::new(), Vec::new())) };
+        static PACKING_BUFFERS: std::cell::Cell<(Vec<f32>, Vec<f32>)> = const { std::cell::Cell::new((Vec::new(), Vec::new())) };
     }
 
     fn grow(buffer: &mut Vec<f32>, len: usize) {
