@@ -408,13 +408,6 @@ widest_fn! {
     }
 }
 
-widest_fn! {
-    /// d[i] *= s[i].
-    pub fn mul_into(d: &mut [f32], s: &[f32]) {
-        d.iter_mut().zip(s).for_each(|(d, s)| *d *= s)
-    }
-}
-
 /// A new buffer of `n` values, each written by `fill` from its block's offset, in parallel blocks when large:
 /// a fresh multi-megabyte buffer written by one thread (memset, memcpy) leaves the other core idle.
 fn filled(n: usize, block: usize, fill: impl Fn(usize, &mut [std::mem::MaybeUninit<f32>]) + Sync) -> Vec<f32> {

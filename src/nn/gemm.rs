@@ -45,6 +45,9 @@ pub enum Finish<'a> {
     /// Zero where the matrix of the output's shape is not positive: the gradient through a ReLU whose output
     /// that matrix is.
     ReluGrad(MatRef<'a, f32>),
+    /// Times the matrix of the output's shape, element by element: the gradient through an activation whose
+    /// slopes that matrix holds.
+    Scale(MatRef<'a, f32>),
 }
 
 impl<'a> Start<'a> {
@@ -78,6 +81,7 @@ impl<'a> Finish<'a> {
     pub fn rows(self, from: usize, count: usize) -> Finish<'a> {
         match self {
             Finish::ReluGrad(y) => Finish::ReluGrad(y.subrows(from, count)),
+            Finish::Scale(y) => Finish::Scale(y.subrows(from, count)),
             other => other,
         }
     }
@@ -86,6 +90,7 @@ impl<'a> Finish<'a> {
     pub fn cols(self, from: usize, count: usize) -> Finish<'a> {
         match self {
             Finish::ReluGrad(y) => Finish::ReluGrad(y.subcols(from, count)),
+            Finish::Scale(y) => Finish::Scale(y.subcols(from, count)),
             other => other,
         }
     }
@@ -154,8 +159,8 @@ impl Kernel {
             }
             Start::Zero | Start::Dst => {}
         }
-        if let Finish::ReluGrad(y) = finish {
-            assert!(y.nrows() == m && y.ncols() == n, "gemm: the ReLU output must have the output's shape");
+        if let Finish::ReluGrad(y) | Finish::Scale(y) = finish {
+            assert!(y.nrows() == m && y.ncols() == n, "gemm: a finish matrix must have the output's shape");
         }
         match self {
             Kernel::Faer => {
@@ -183,7 +188,7 @@ impl Kernel {
             Kernel::Avx512 => {
                 assert!(avx512::fits(&dst, &a, &b), "gemm: the AVX-512 kernel was chosen for a layout it cannot read");
                 let mask_by_rows = match finish {
-                    Finish::ReluGrad(y) => y.col_stride() == 1 && y.row_stride() >= n as isize,
+                    Finish::ReluGrad(y) | Finish::Scale(y) => y.col_stride() == 1 && y.row_stride() >= n as isize,
                     _ => true,
                 };
                 if let Start::Matrix(source) = start {
@@ -231,14 +236,20 @@ fn finish_pass(mut dst: MatMut<'_, f32>, finish: Finish<'_>) {
                 zip.for_each(|(x, y)| *x = if *y <= 0.0 { 0.0 } else { *x });
             }
         }
+        Finish::Scale(y) => {
+            for i in 0..dst.nrows() {
+                dst.as_mut().row_mut(i).iter_mut().zip(y.row(i).iter()).for_each(|(x, y)| *x *= *y);
+            }
+        }
     }
 }
 
-/// The AVX-512 kernel where this machine has it and it reads these layouts, whatever the product's size:
-/// for callers that know a shape it runs faster than faer.
+/// The AVX-512 kernel where this machine has it, it reads these layouts and the output is at least a vector
+/// wide, whatever the product's size: for callers that know a shape it runs faster than faer, or whose start
+/// and finish would be passes of their own on faer.
 pub fn widest_kernel(dst: &MatMut<'_, f32>, a: &MatRef<'_, f32>, b: &MatRef<'_, f32>) -> Option<Kernel> {
     #[cfg(target_arch = "x86_64")]
-    if avx512::fits(dst, a, b) {
+    if dst.ncols() >= MIN_COLS && avx512::fits(dst, a, b) {
         return Some(Kernel::Avx512);
     }
     let _ = (dst, a, b);
@@ -352,11 +363,12 @@ mod avx512 {
                 Start::Row(row) => (Begin::Row, row.as_ptr(), c.cast_const(), ldc),
                 Start::Matrix(source) => (Begin::Load, std::ptr::null(), source.as_ptr(), source.row_stride() as usize),
             };
-            let (end, relu_out, ldy) = match finish {
+            let (end, finish_from, ldf) = match finish {
                 _ if k0 + kc < k => (End::Store, std::ptr::null(), 0),
                 Finish::Store => (End::Store, std::ptr::null(), 0),
                 Finish::Relu => (End::Relu, std::ptr::null(), 0),
                 Finish::ReluGrad(y) => (End::ReluGrad, y.as_ptr(), y.row_stride() as usize),
+                Finish::Scale(y) => (End::Scale, y.as_ptr(), y.row_stride() as usize),
             };
             for i0 in (0..m).step_by(MR) {
                 let rows = (m - i0).min(MR);
@@ -408,8 +420,12 @@ mod avx512 {
                         // SAFETY: column j0 < n of the start row and (i0, j0) of the ReLU output exist.
                         row: if row.is_null() { row } else { unsafe { row.add(j0) } },
                         end,
-                        relu_out: if relu_out.is_null() { relu_out } else { unsafe { relu_out.add(i0 * ldy + j0) } },
-                        ldy,
+                        finish_from: if finish_from.is_null() {
+                            finish_from
+                        } else {
+                            unsafe { finish_from.add(i0 * ldf + j0) }
+                        },
+                        ldf,
                         next_c: next_tile,
                         next_a,
                         next_a_stride: ars,
@@ -466,6 +482,18 @@ mod avx512 {
         [lanes(cols), lanes(cols.saturating_sub(16))]
     }
 
+    /// The offsets of 16 consecutive columns of `b` from the first, where `b` is stored by columns and they fit
+    /// a gather's 32-bit indices.
+    fn gather_offsets(b: MatRef<'_, f32>) -> Option<__m512i> {
+        let stride = i32::try_from(b.col_stride()).ok()?;
+        if b.row_stride() != 1 || stride.checked_mul(15).is_none() {
+            return None;
+        }
+        let offsets: [i32; 16] = std::array::from_fn(|j| j as i32 * stride);
+        // SAFETY: an unaligned load of 16 i32 from an array of 16.
+        Some(unsafe { _mm512_loadu_si512(offsets.as_ptr().cast()) })
+    }
+
     /// Rows k0..k0 + kc of `b` as panels of 32 columns, [panel][k][32].
     #[target_feature(enable = "avx512f")]
     unsafe fn pack(b: MatRef<'_, f32>, k0: usize, kc: usize, packed: &mut [f32]) {
@@ -484,6 +512,22 @@ mod avx512 {
                         let src = b.as_ptr().offset((k0 + kk) as isize * b.row_stride() + (p * NR) as isize);
                         for (v, &mask) in masks.iter().enumerate() {
                             let values = _mm512_maskz_loadu_ps(mask, src.wrapping_add(16 * v));
+                            _mm512_storeu_ps(row.as_mut_ptr().add(16 * v), values);
+                        }
+                    }
+                }
+            } else if let Some(offsets) = gather_offsets(b) {
+                // `b` by columns (a weight's transpose): each row of the panel is gathered, 16 columns at a
+                // time; element by element it cost PETS' step 3 %.
+                let masks = masks(cols);
+                for (kk, row) in panel.chunks_exact_mut(NR).enumerate() {
+                    for (v, &mask) in masks.iter().enumerate() {
+                        // SAFETY: row k0 + kk < k of `b` exists, and so do the columns the mask covers, whose
+                        // offsets from column p·NR + 16v fit in i32 (`gather_offsets`); `row` holds NR values.
+                        unsafe {
+                            let first = (k0 + kk) as isize + (p * NR + 16 * v) as isize * b.col_stride();
+                            let base = b.as_ptr().wrapping_offset(first);
+                            let values = _mm512_mask_i32gather_ps::<4>(_mm512_setzero_ps(), mask, offsets, base.cast());
                             _mm512_storeu_ps(row.as_mut_ptr().add(16 * v), values);
                         }
                     }
@@ -511,6 +555,7 @@ mod avx512 {
         Store,
         Relu,
         ReluGrad,
+        Scale,
     }
 
     struct Call {
@@ -530,9 +575,10 @@ mod avx512 {
         /// The start row at the tile's first column.
         row: *const f32,
         end: End,
-        /// The ReLU output at the tile's first element, and its row stride.
-        relu_out: *const f32,
-        ldy: usize,
+        /// The finish's matrix (a ReLU output, or slopes to scale by) at the tile's first element, and its row
+        /// stride.
+        finish_from: *const f32,
+        ldf: usize,
         next_c: *const f32,
         next_a: *const f32,
         next_a_stride: isize,
@@ -584,6 +630,8 @@ mod avx512 {
             lds,
             row,
             end,
+            finish_from,
+            ldf,
             next_c,
             next_a,
             next_a_stride,
@@ -651,40 +699,41 @@ mod avx512 {
                 step!(kk);
                 kk += 1;
             }
+            match end {
+                End::Store => {}
+                // In registers once the sums are done, where the old values still are: a pass of its own over
+                // the stored tile waited on each masked store (which does not forward to a later load).
+                // max_ps gives its second operand where the first is NaN: 0, as f32::max does.
+                End::Relu => {
+                    let zero = _mm512_setzero_ps();
+                    for values in acc.iter_mut() {
+                        for lane in values.iter_mut() {
+                            *lane = _mm512_max_ps(*lane, zero);
+                        }
+                    }
+                }
+                // Zero where y ≤ 0 (a NaN y keeps the gradient, as relu_backward does).
+                End::ReluGrad => {
+                    let zero = _mm512_setzero_ps();
+                    for (r, values) in acc.iter_mut().enumerate() {
+                        for (v, lane) in values.iter_mut().enumerate() {
+                            let y = _mm512_maskz_loadu_ps(masks[v], finish_from.wrapping_add(r * ldf + 16 * v));
+                            *lane = _mm512_mask_mov_ps(*lane, _mm512_cmp_ps_mask::<_CMP_LE_OQ>(y, zero), zero);
+                        }
+                    }
+                }
+                End::Scale => {
+                    for (r, values) in acc.iter_mut().enumerate() {
+                        for (v, lane) in values.iter_mut().enumerate() {
+                            let y = _mm512_maskz_loadu_ps(masks[v], finish_from.wrapping_add(r * ldf + 16 * v));
+                            *lane = _mm512_mul_ps(*lane, y);
+                        }
+                    }
+                }
+            }
             for (r, values) in acc.iter().enumerate() {
                 for (v, lane) in values.iter().enumerate() {
                     _mm512_mask_storeu_ps(c.wrapping_add(r * ldc + 16 * v), masks[v], *lane);
-                }
-            }
-            if end != End::Store {
-                finish_tile::<R, V>(call);
-            }
-        }
-    }
-
-    /// The finish applied to a tile the kernel just stored (still in L1). A pass of its own: inside the kernel
-    /// it took registers the accumulators need, and they spilled.
-    #[inline(never)]
-    #[target_feature(enable = "avx512f")]
-    unsafe fn finish_tile<const R: usize, const V: usize>(call: &Call) {
-        let &Call { c, ldc, masks, end, relu_out, ldy, .. } = call;
-        let zero = _mm512_setzero_ps();
-        for r in 0..R {
-            for (v, &mask) in masks.iter().enumerate().take(V) {
-                unsafe {
-                    let at = c.wrapping_add(r * ldc + 16 * v);
-                    let value = _mm512_maskz_loadu_ps(mask, at);
-                    let value = match end {
-                        End::Store => value,
-                        // max_ps gives its second operand where the first is NaN: 0, as f32::max does.
-                        End::Relu => _mm512_max_ps(value, zero),
-                        End::ReluGrad => {
-                            let y = _mm512_maskz_loadu_ps(mask, relu_out.wrapping_add(r * ldy + 16 * v));
-                            // Zero where y ≤ 0 (a NaN y keeps the gradient, as relu_backward does).
-                            _mm512_mask_mov_ps(value, _mm512_cmp_ps_mask::<_CMP_LE_OQ>(y, zero), zero)
-                        }
-                    };
-                    _mm512_mask_storeu_ps(at, mask, value);
                 }
             }
         }
@@ -766,7 +815,7 @@ mod tests {
     }
 
     #[test]
-    fn a_bias_start_and_a_relu_finish_are_applied_in_place() {
+    fn starts_and_finishes_are_applied_in_place() {
         let mut rng = ChaCha8Rng::seed_from_u64(5);
         // The last is cut into column blocks by the AVX-512 kernel.
         for &(m, n, k) in &[(1031, 300, 9), (1030, 45, 600), (1100, 17, 260), (40, 1601, 300)] {
@@ -776,6 +825,7 @@ mod tests {
             let mut relu_out: Vec<f32> = (0..m * n).map(|_| rng.random_range(-1.0f32..1.0).max(0.0)).collect();
             relu_out[7] = f32::NAN;
             let y = MatRef::from_row_major_slice(&relu_out, m, n);
+            let slopes = random(m, n, &mut rng);
             let plain = reference(&Mat::zeros(m, n), Accum::Replace, a.as_ref(), b.as_ref());
             for kernel in available_kernels() {
                 let mut with_bias = vec![0.0f32; m * n];
@@ -784,6 +834,10 @@ mod tests {
                 let mut masked = vec![1.0f32; m * n];
                 let dst = MatMut::from_row_major_slice_mut(&mut masked, m, n);
                 kernel.fused(dst, Start::Zero, a.as_ref(), b.as_ref(), Finish::ReluGrad(y));
+                // Slopes to scale by, on a start of the output's own values.
+                let mut scaled = vec![0.5f32; m * n];
+                let dst = MatMut::from_row_major_slice_mut(&mut scaled, m, n);
+                kernel.fused(dst, Start::Dst, a.as_ref(), b.as_ref(), Finish::Scale(slopes.as_ref()));
                 // A start matrix read by rows, and one read by columns (the kernel copies it first).
                 let mut from_rows = vec![f32::NAN; m * n];
                 let dst = MatMut::from_row_major_slice_mut(&mut from_rows, m, n);
@@ -808,6 +862,8 @@ mod tests {
                     let want_grad = if relu_out[x] <= 0.0 { 0.0 } else { plain[(i, j)] };
                     assert!((with_bias[x] as f64 - want_relu).abs() <= tol, "{kernel:?} relu {m}×{n}×{k} at {x}");
                     assert!((masked[x] as f64 - want_grad).abs() <= tol, "{kernel:?} relu grad {m}×{n}×{k} at {x}");
+                    let want_scaled = (0.5 + plain[(i, j)]) * slopes[(i, j)] as f64;
+                    assert!((scaled[x] as f64 - want_scaled).abs() <= tol, "{kernel:?} scale {m}×{n}×{k} at {x}");
                     if x != 7 {
                         let want = plain[(i, j)] + relu_out[x] as f64;
                         assert!((from_rows[x] as f64 - want).abs() <= tol, "{kernel:?} start {m}×{n}×{k} at {x}");

@@ -19,7 +19,8 @@ use super::config::PetsConfig;
 use crate::error::Result;
 use crate::nn::activation::{fast_exp, fast_sigmoid as sigmoid, fast_softplus as softplus, Activation};
 use crate::nn::adam::AdamStep;
-use crate::nn::backprop::{add_column_sums, mul_into, tensor_index, view, view_mut, zero_gradients};
+use crate::nn::backprop::{add_column_sums, tensor_index, view, view_mut, zero_gradients};
+use crate::nn::gemm::{widest_kernel, Finish, Kernel, Start};
 use crate::nn::{Adam, ParamSet};
 use crate::util::wide::widest_fn;
 
@@ -29,6 +30,21 @@ const BOUNDS_PENALTY: f32 = 0.01;
 /// dst = [dst +] a · b on the calling thread: the first phase's tasks already fill the pool.
 fn matmul_here(dst: faer::MatMut<'_, f32>, accum: Accum, a: faer::MatRef<'_, f32>, b: faer::MatRef<'_, f32>) {
     faer_matmul(dst, accum, a, b, 1.0f32, Par::Seq);
+}
+
+/// dst = finish(start + a · b) on the calling thread. Where the AVX-512 kernel reads the layouts it takes
+/// the bias rows and the activation's slopes into its tiles (as fast as faer on these cache-sized products,
+/// and it spares the passes that copied the bias into every row and scaled every input gradient); the
+/// kernel is chosen by the layer's shape alone, so the bytes do not depend on the thread count.
+fn fused_here(
+    dst: faer::MatMut<'_, f32>,
+    start: Start<'_>,
+    a: faer::MatRef<'_, f32>,
+    b: faer::MatRef<'_, f32>,
+    finish: Finish<'_>,
+) {
+    let kernel = widest_kernel(&dst, &a, &b).unwrap_or(Kernel::Faer);
+    kernel.fused(dst, start, a, b, finish);
 }
 
 /// One ensemble layer's weights, [members, in, out] and [members, 1, out], as views of a parameter set.
@@ -57,16 +73,18 @@ impl<'a> Layer<'a> {
     /// Member `member`'s `rows` inputs `x` → `y` (rows × out).
     fn forward(&self, member: usize, x: &[f32], rows: usize, y: &mut [f32]) {
         let (i, o) = (self.shape.d_in, self.shape.d_out);
-        let bias = &self.bias[member * o..(member + 1) * o];
-        y.chunks_mut(o).for_each(|row| row.copy_from_slice(bias));
-        matmul_here(view_mut(y, rows, o), Accum::Add, view(x, rows, i), view(self.member_weight(member), i, o));
+        let bias = Start::Row(&self.bias[member * o..(member + 1) * o]);
+        let w = view(self.member_weight(member), i, o);
+        fused_here(view_mut(y, rows, o), bias, view(x, rows, i), w, Finish::Store);
     }
 
-    /// The input gradients `dx` (rows × in) of member `member` for output gradients `dy`.
-    fn backward_input(&self, member: usize, dy: &[f32], rows: usize, dx: &mut [f32]) {
+    /// The input gradients `dx` (rows × in) of member `member` for output gradients `dy`, times the slopes of
+    /// the activation below (rows × in): the gradient before that activation.
+    fn backward_input(&self, member: usize, dy: &[f32], rows: usize, slopes: &[f32], dx: &mut [f32]) {
         let (i, o) = (self.shape.d_in, self.shape.d_out);
         let w = view(self.member_weight(member), i, o);
-        matmul_here(view_mut(dx, rows, i), Accum::Replace, view(dy, rows, o), w.transpose());
+        let scale = Finish::Scale(view(slopes, rows, i));
+        fused_here(view_mut(dx, rows, i), Start::Zero, view(dy, rows, o), w.transpose(), scale);
     }
 }
 
@@ -294,8 +312,7 @@ impl<'a> EnsembleNet<'a> {
         for k in (1..layers.len()).rev() {
             let (below, above) = buffers.d_outputs.split_at_mut(k);
             let dx = &mut *below[k - 1];
-            layers[k].backward_input(part.member, above[0], part.rows(), dx);
-            mul_into(dx, buffers.slopes[k - 1]);
+            layers[k].backward_input(part.member, above[0], part.rows(), buffers.slopes[k - 1], dx);
         }
     }
 
