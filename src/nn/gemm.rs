@@ -825,7 +825,8 @@ mod tests {
             let mut relu_out: Vec<f32> = (0..m * n).map(|_| rng.random_range(-1.0f32..1.0).max(0.0)).collect();
             relu_out[7] = f32::NAN;
             let y = MatRef::from_row_major_slice(&relu_out, m, n);
-            let slopes = random(m, n, &mut rng);
+            let slope_values: Vec<f32> = (0..m * n).map(|_| rng.random_range(-1.0..1.0)).collect();
+            let slopes = MatRef::from_row_major_slice(&slope_values, m, n);
             let plain = reference(&Mat::zeros(m, n), Accum::Replace, a.as_ref(), b.as_ref());
             for kernel in available_kernels() {
                 let mut with_bias = vec![0.0f32; m * n];
@@ -834,10 +835,17 @@ mod tests {
                 let mut masked = vec![1.0f32; m * n];
                 let dst = MatMut::from_row_major_slice_mut(&mut masked, m, n);
                 kernel.fused(dst, Start::Zero, a.as_ref(), b.as_ref(), Finish::ReluGrad(y));
-                // Slopes to scale by, on a start of the output's own values.
+                // Slopes to scale by, on a start of the output's own values: read by rows (in the AVX-512
+                // kernel's tiles), and by columns (a pass of its own), to the same bytes.
                 let mut scaled = vec![0.5f32; m * n];
                 let dst = MatMut::from_row_major_slice_mut(&mut scaled, m, n);
-                kernel.fused(dst, Start::Dst, a.as_ref(), b.as_ref(), Finish::Scale(slopes.as_ref()));
+                kernel.fused(dst, Start::Dst, a.as_ref(), b.as_ref(), Finish::Scale(slopes));
+                let slopes_by_columns = slopes.to_owned();
+                let mut scaled_by_columns = vec![0.5f32; m * n];
+                let dst = MatMut::from_row_major_slice_mut(&mut scaled_by_columns, m, n);
+                kernel.fused(dst, Start::Dst, a.as_ref(), b.as_ref(), Finish::Scale(slopes_by_columns.as_ref()));
+                let same_bits = scaled.iter().zip(&scaled_by_columns).all(|(r, c)| r.to_bits() == c.to_bits());
+                assert!(same_bits, "{kernel:?}: slopes by columns give the bytes of slopes by rows");
                 // A start matrix read by rows, and one read by columns (the kernel copies it first).
                 let mut from_rows = vec![f32::NAN; m * n];
                 let dst = MatMut::from_row_major_slice_mut(&mut from_rows, m, n);
@@ -862,7 +870,7 @@ mod tests {
                     let want_grad = if relu_out[x] <= 0.0 { 0.0 } else { plain[(i, j)] };
                     assert!((with_bias[x] as f64 - want_relu).abs() <= tol, "{kernel:?} relu {m}×{n}×{k} at {x}");
                     assert!((masked[x] as f64 - want_grad).abs() <= tol, "{kernel:?} relu grad {m}×{n}×{k} at {x}");
-                    let want_scaled = (0.5 + plain[(i, j)]) * slopes[(i, j)] as f64;
+                    let want_scaled = (0.5 + plain[(i, j)]) * slope_values[x] as f64;
                     assert!((scaled[x] as f64 - want_scaled).abs() <= tol, "{kernel:?} scale {m}×{n}×{k} at {x}");
                     if x != 7 {
                         let want = plain[(i, j)] + relu_out[x] as f64;
