@@ -122,8 +122,8 @@ impl Kernel {
         self.fused(dst, Start::of(accum), a, b, Finish::Store);
     }
 
-    /// dst = finish(start + a · b), sequentially; a `Row` start has `n` values and a `ReluGrad` matrix is
-    /// m × n. On faer the start and the finish are passes of their own; the AVX-512 kernel applies them to
+    /// dst = finish(start + a · b), sequentially; a `Row` start has `n` values and a `ReluGrad` or `Scale`
+    /// matrix is m × n. On faer the start and the finish are passes of their own; the AVX-512 kernel applies them to
     /// each tile in registers, which spares the training paths a pass over every layer's output.
     pub fn fused(
         self,
@@ -304,7 +304,7 @@ mod avx512 {
 
     /// # Safety
     /// The CPU supports AVX-512F and `fits(&dst, &a, &b)` holds; a `Row` start has n values, a `Matrix` start
-    /// and a `ReluGrad` matrix are m × n with unit column stride (the start also with a row stride ≥ 0),
+    /// and a `ReluGrad` or `Scale` matrix are m × n with unit column stride (the start also with a row stride ≥ 0),
     /// `row_sums` has m values. A tile's second vector may lie past a buffer's end where its mask is empty:
     /// masked loads and stores never touch those lanes, and its address is computed with wrapping arithmetic.
     pub(super) unsafe fn product(
@@ -417,7 +417,7 @@ mod avx512 {
                         // SAFETY: (i0, j0) lies inside the start matrix, which has the output's shape.
                         load_from: unsafe { start_at.add(i0 * lds + j0) },
                         lds,
-                        // SAFETY: column j0 < n of the start row and (i0, j0) of the ReLU output exist.
+                        // SAFETY: column j0 < n of the start row and (i0, j0) of the finish matrix exist.
                         row: if row.is_null() { row } else { unsafe { row.add(j0) } },
                         end,
                         finish_from: if finish_from.is_null() {
@@ -701,8 +701,8 @@ mod avx512 {
             }
             match end {
                 End::Store => {}
-                // In registers once the sums are done, where the old values still are: a pass of its own over
-                // the stored tile waited on each masked store (which does not forward to a later load).
+                // Applied in registers before the store: as a pass over the stored tile, each read waited on a
+                // masked store (which does not forward to a later load), 3.6 % of the context step.
                 // max_ps gives its second operand where the first is NaN: 0, as f32::max does.
                 End::Relu => {
                     let zero = _mm512_setzero_ps();
