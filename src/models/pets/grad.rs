@@ -4,10 +4,11 @@
 //! bookkeeping, copies and reloading the weights into the module each step cost more than the arithmetic.
 //! `net.rs` stays the reference: a test holds the loss and every gradient here to burn's.
 //!
-//! A step runs in two parallel phases. First each member's batch, cut into one row range per thread, goes
-//! forward, through the loss and back to every layer's output gradient as one task per range: a small preset's
-//! layers are a few microseconds of GEMM each, so tasks per layer would spend the step waking threads. Then
-//! every (layer, member) weight gradient is one GEMM over all of the member's rows. Rows of a product do not
+//! A step runs in two parallel phases. First the members' batches, cut into one equal run of rows per thread
+//! (see [`parts`]), go forward, through the loss and back to every layer's output gradient, one task per
+//! member within a run: a small preset's layers are a few microseconds of GEMM each, so tasks per layer would
+//! spend the step waking threads. Then every (layer, member) weight gradient is one GEMM over all of the
+//! member's rows. Rows of a product do not
 //! depend on which other rows it computes, and the sums over rows (the loss, the bounds' gradients) are taken
 //! after the first phase in row order, so the bytes do not depend on the threads.
 
@@ -105,20 +106,26 @@ impl Part {
     }
 }
 
-/// Every member's rows in one range per thread, in memory order: with the presets' five members on two
-/// threads, ten equal tasks share the pool evenly where five would leave a thread idle for a fifth of the
-/// phase; on one thread, halves would only repack each weight twice.
+/// The ensemble's member-rows (member by member, in memory order) cut into one equal run per thread, each run
+/// cut again where it crosses from one member to the next. With the presets' five members on two threads
+/// that is two whole members and half of the third per thread: cutting every member in half instead cost each
+/// half-member part a quarter more than half a whole one (its weights packed twice, its tiles half as tall),
+/// and held the phase to 1.6× one thread's speed. On one thread every part is a whole member.
 fn parts(members: usize, rows: usize) -> Vec<Part> {
-    let per_member = rayon::current_num_threads().clamp(1, rows.max(1));
-    (0..members)
-        .flat_map(|member| {
-            (0..per_member).map(move |p| Part {
-                member,
-                start: rows * p / per_member,
-                end: rows * (p + 1) / per_member,
-            })
-        })
-        .collect()
+    let total = members * rows;
+    let threads = rayon::current_num_threads().clamp(1, total.max(1));
+    let mut parts = Vec::new();
+    for run in 0..threads {
+        let (begin, end) = (total * run / threads, total * (run + 1) / threads);
+        let mut at = begin;
+        while at < end {
+            let (member, start) = (at / rows, at % rows);
+            let stop = end.min((member + 1) * rows);
+            parts.push(Part { member, start, end: stop - member * rows });
+            at = stop;
+        }
+    }
+    parts
 }
 
 /// A [members, rows, width] buffer cut into the parts' pieces, which cover it in order.
@@ -571,12 +578,18 @@ fn weight_gradients(
         };
         let grads = weight_grad.chunks_mut(i * o).zip(bias_grad.chunks_mut(o));
         let data = x.chunks(rows * i).zip(ws.d_outputs[k].chunks(rows * o));
-        for (((weight_grad, bias_grad), (x, dy)), update) in grads.zip(data).zip(updates.iter_mut()) {
-            tasks.push(WeightTask { shape: *shape, x, dy, weight_grad, bias_grad, update: update.take() });
+        let members = grads.zip(data).zip(updates.iter_mut()).enumerate();
+        for (member, (((weight_grad, bias_grad), (x, dy)), update)) in members {
+            let task = WeightTask { shape: *shape, x, dy, weight_grad, bias_grad, update: update.take() };
+            tasks.push((member, task));
         }
     }
+    // Member by member, so that rayon's halving hands each thread the members whose rows it ran in the first
+    // phase (see `parts`), still in its cache: layer by layer, most of the phase read what the other core had
+    // written, and the next step wrote over what this one had read, 20 % slower on two threads.
+    tasks.sort_by_key(|(member, _)| *member);
     let optimizer_step = optimizer.map(|blocks| blocks.step);
-    tasks.into_par_iter().for_each(|task| {
+    tasks.into_par_iter().for_each(|(_, task)| {
         let WeightTask { shape, x, dy, weight_grad, bias_grad, update } = task;
         backward_weights(shape, x, dy, rows, weight_grad, bias_grad);
         if let (Some([[p, m, v], [bp, bm, bv]]), Some(step)) = (update, optimizer_step) {
@@ -699,6 +712,31 @@ mod tests {
         let one = run(1);
         assert_eq!(one, run(2));
         assert_eq!(one, run(3));
+        assert_eq!(one, run(7));
+    }
+
+    /// Each thread's run of member-rows is within one row of the others', and the parts cover every member's
+    /// rows once, in memory order, without crossing a member's end.
+    #[test]
+    fn parts_share_the_rows_evenly_in_memory_order() {
+        for threads in 1..=6 {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            for (members, rows) in [(5, 256), (3, 7), (1, 1), (2, 5)] {
+                let parts = pool.install(|| parts(members, rows));
+                let mut next = 0;
+                for part in &parts {
+                    assert!(part.start < part.end && part.end <= rows, "{threads} threads: a part within a member");
+                    assert_eq!(part.member * rows + part.start, next, "{threads} threads: parts in order");
+                    next = part.member * rows + part.end;
+                }
+                assert_eq!(next, members * rows);
+                let runs = threads.min(members * rows);
+                assert!(parts.len() < runs + members, "{threads} threads: at most one cut per run and member");
+                if threads == 1 {
+                    assert_eq!(parts.len(), members, "one thread: whole members");
+                }
+            }
+        }
     }
 
     /// The fused step (Adam applied block by block inside the gradient tasks) against the gradients followed by

@@ -4,6 +4,7 @@
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
 
 use super::config::PetsConfig;
 use super::data::Transitions;
@@ -32,6 +33,8 @@ pub struct PetsTrainer {
     /// Per member: the training rows it draws its batches from.
     members_rows: Vec<Vec<u32>>,
     workspace: Workspace,
+    /// The training rows of this step's batch, member by member.
+    batch_rows: Vec<u32>,
     batch_inputs: Vec<f32>,
     batch_targets: Vec<f32>,
 }
@@ -78,6 +81,7 @@ impl PetsTrainer {
             valid,
             members_rows,
             workspace: Workspace::default(),
+            batch_rows: Vec::new(),
             batch_inputs: Vec::new(),
             batch_targets: Vec::new(),
         })
@@ -88,21 +92,36 @@ impl PetsTrainer {
     }
 }
 
+/// Copies the rows `picks` of `train` into the batch buffers, one contiguous run of rows per thread: serial,
+/// the copies of 1280 short rows were 25-45 µs of a 380 µs step of the small preset on two threads. The runs
+/// match the training step's (`grad::parts`), so each thread writes the rows it then reads.
+fn gather_batch(train: &Transitions, picks: &[u32], inputs: &mut Vec<f32>, targets: &mut Vec<f32>) {
+    let (din, dout) = (train.input_dim, train.target_dim);
+    inputs.resize(picks.len() * din, 0.0);
+    targets.resize(picks.len() * dout, 0.0);
+    let run = picks.len().div_ceil(rayon::current_num_threads()).max(1);
+    let runs = inputs.par_chunks_mut(run * din).zip(targets.par_chunks_mut(run * dout)).zip(picks.par_chunks(run));
+    runs.for_each(|((inputs, targets), picks)| {
+        let rows = inputs.chunks_exact_mut(din).zip(targets.chunks_exact_mut(dout)).zip(picks);
+        for ((input, target), &row) in rows {
+            let row = row as usize;
+            input.copy_from_slice(&train.inputs[row * din..(row + 1) * din]);
+            target.copy_from_slice(&train.targets[row * dout..(row + 1) * dout]);
+        }
+    });
+}
+
 impl TrainingMethod for PetsTrainer {
     fn step(&mut self, step: u64) -> Result<f64> {
         let b = self.config.batch_size;
         let (din, dout) = (self.train.input_dim, self.train.target_dim);
         let mut rng = rng_for(self.seed, &[BATCH_STREAM, step]);
-        let (inputs, targets) = (&mut self.batch_inputs, &mut self.batch_targets);
-        inputs.clear();
-        targets.clear();
+        self.batch_rows.clear();
         for rows in &self.members_rows {
-            for _ in 0..b {
-                let row = rows[rng.random_range(0..rows.len())] as usize;
-                inputs.extend_from_slice(&self.train.inputs[row * din..(row + 1) * din]);
-                targets.extend_from_slice(&self.train.targets[row * dout..(row + 1) * dout]);
-            }
+            self.batch_rows.extend((0..b).map(|_| rows[rng.random_range(0..rows.len())]));
         }
+        gather_batch(&self.train, &self.batch_rows, &mut self.batch_inputs, &mut self.batch_targets);
+        let (inputs, targets) = (&self.batch_inputs, &self.batch_targets);
         if self.adam.config.clip_grad_norm.is_none() {
             let ws = &mut self.workspace;
             return train_step(&mut self.params, &mut self.adam, &self.config, (din, dout), ws, inputs, targets, b);
