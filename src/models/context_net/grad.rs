@@ -146,23 +146,38 @@ fn kl(pm: f32, ps: f32, qm: f32, qs: f32) -> f32 {
     (ratio + shift - 1.0) * 0.5 + (qs / ps).ln()
 }
 
-/// Σ_d log N(x_d | m_d, v_d) per row, and its derivatives with respect to m and v.
-fn gaussian_log_likelihood(x: &[f32], m: &[f32], v: &[f32], d: usize) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
+/// Σ_d log N(x_d | m_d, v_d) per row, and its derivatives with respect to m and v, each row's times
+/// `weight(row)` (the row's weight in the loss). Rows go in parallel blocks (serially, this was 4 % of the
+/// batch-64 step on two threads); each row is summed in order, so the bytes do not depend on the threads.
+fn gaussian_log_likelihood(
+    x: &[f32],
+    m: &[f32],
+    v: &[f32],
+    d: usize,
+    weight: impl Fn(usize) -> f32 + Sync,
+) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
     let log_2pi = (2.0 * std::f32::consts::PI).ln();
     let rows = x.len() / d;
     let mut ll = vec![0.0; rows];
     let mut dm = vec![0.0; x.len()];
     let mut dv = vec![0.0; x.len()];
-    for (row, out) in ll.iter_mut().enumerate() {
-        let mut sum = 0.0;
-        for k in row * d..(row + 1) * d {
-            let diff = x[k] - m[k];
-            sum += diff * diff / v[k] + v[k].ln() + log_2pi;
-            dm[k] = diff / v[k];
-            dv[k] = 0.5 * (diff * diff / (v[k] * v[k]) - 1.0 / v[k]);
+    let per_task = rows.div_ceil(rayon::current_num_threads()).max(1024);
+    let blocks = ll.par_chunks_mut(per_task).zip(dm.par_chunks_mut(per_task * d).zip(dv.par_chunks_mut(per_task * d)));
+    blocks.enumerate().for_each(|(block, (ll, (dm, dv)))| {
+        for (r, out) in ll.iter_mut().enumerate() {
+            let row = block * per_task + r;
+            let w = weight(row);
+            let mut sum = 0.0;
+            for j in 0..d {
+                let (k, local) = (row * d + j, r * d + j);
+                let diff = x[k] - m[k];
+                sum += diff * diff / v[k] + v[k].ln() + log_2pi;
+                dm[local] = diff / v[k] * w;
+                dv[local] = 0.5 * (diff * diff / (v[k] * v[k]) - 1.0 / v[k]) * w;
+            }
+            *out = -0.5 * sum;
         }
-        *out = -0.5 * sum;
-    }
+    });
     (ll, dm, dv)
 }
 
@@ -310,7 +325,16 @@ pub fn loss_and_gradients(
             (row.iter().cycle().take(rows * p).copied().collect(), None)
         }
     };
-    let (ll, dm, dv) = gaussian_log_likelihood(&targets, &mean, &variance, p);
+    // ∂loss/∂(row log-likelihood): the reconstruction and single-step terms are means over their B·T rows, the
+    // multi-step one a mean over chunks of a sum over steps.
+    let row_weight = |row: usize| -> f32 {
+        if row < 2 * b * t {
+            -1.0 / (b * t) as f32
+        } else {
+            -1.0 / b as f32
+        }
+    };
+    let (ll, d_mean, d_var) = gaussian_log_likelihood(&targets, &mean, &variance, p, row_weight);
     let sum = |range: std::ops::Range<usize>| ll[range].iter().map(|x| *x as f64).sum::<f64>();
     let reconstruction = sum(0..b * t) / (b * t) as f64;
     let single_step = sum(b * t..2 * b * t) / (b * t) as f64;
@@ -331,22 +355,6 @@ pub fn loss_and_gradients(
     }
 
     let mut grads = zero_gradients(params);
-    // ∂loss/∂(row log-likelihood): the reconstruction and single-step terms are means over their B·T rows, the
-    // multi-step one a mean over chunks of a sum over steps.
-    let row_weight = |row: usize| -> f32 {
-        if row < 2 * b * t {
-            -1.0 / (b * t) as f32
-        } else {
-            -1.0 / b as f32
-        }
-    };
-    let mut d_mean = dm;
-    let mut d_var = dv;
-    for row in 0..rows {
-        let w = row_weight(row);
-        d_mean[row * p..(row + 1) * p].iter_mut().for_each(|x| *x *= w);
-        d_var[row * p..(row + 1) * p].iter_mut().for_each(|x| *x *= w);
-    }
     let mut d_decoded = net.mean_decoder.backward(&decoded, &mean_tape, &d_mean, rows, &mut grads, true);
     match (&net.variance, variance_tape) {
         (Variance::Decoder(decoder), Some((raw, tape))) => {
