@@ -8,9 +8,9 @@
 //! (see [`parts`]), go forward, through the loss and back to every layer's output gradient, one task per
 //! member within a run: a small preset's layers are a few microseconds of GEMM each, so tasks per layer would
 //! spend the step waking threads. Then every (layer, member) weight gradient is one GEMM over all of the
-//! member's rows. Rows of a product do not
-//! depend on which other rows it computes, and the sums over rows (the loss, the bounds' gradients) are taken
-//! after the first phase in row order, so the bytes do not depend on the threads.
+//! member's rows. Rows of a product do not depend on which other rows it computes, and the sums over rows (the
+//! loss, the bounds' gradients) are taken after the first phase in row order, so the bytes do not depend on the
+//! threads.
 
 use faer::linalg::matmul::matmul as faer_matmul;
 use faer::{Accum, Par};

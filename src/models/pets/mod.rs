@@ -328,4 +328,13 @@ mod tests {
         let none = ModelSpec { state_names: vec![], angular: vec![], ..spec };
         assert!(none.validate(RewardSource::Known).is_err());
     }
+
+    #[test]
+    fn a_trainer_needs_targets_as_well_as_inputs() {
+        use data::Transitions;
+        let train = Transitions { inputs: vec![0.5; 8], targets: vec![], input_dim: 4, target_dim: 0 };
+        let config = PetsConfig::preset(Preset::Small);
+        let error = train::PetsTrainer::new(config, 0, train, Transitions::default()).err().expect("refused");
+        assert!(error.to_string().contains("4 inputs and 0 targets"), "{error}");
+    }
 }

@@ -46,6 +46,10 @@ impl PetsTrainer {
         if train.is_empty() {
             return Err(Error::data("no training transitions"));
         }
+        if train.input_dim == 0 || train.target_dim == 0 {
+            let dims = format!("{} inputs and {} targets", train.input_dim, train.target_dim);
+            return Err(Error::data(format!("training transitions of {dims} per row; a dynamics model needs both")));
+        }
         if train.len() > u32::MAX as usize {
             let message = format!("{} training transitions; at most {} supported", train.len(), u32::MAX);
             return Err(Error::budget("--data", train.len() as f64, f64::from(u32::MAX), message));
