@@ -98,7 +98,8 @@ impl PetsTrainer {
 
 /// Copies the rows `picks` of `train` into the batch buffers, one contiguous run of rows per thread: serial,
 /// the copies of 1280 short rows were 25-45 µs of a 380 µs step of the small preset on two threads. The runs
-/// match the training step's (`grad::parts`), so each thread writes the rows it then reads.
+/// are the training step's (`grad::parts`) to within a row where the rows do not divide evenly, so each thread
+/// mostly writes the rows it then reads.
 fn gather_batch(train: &Transitions, picks: &[u32], inputs: &mut Vec<f32>, targets: &mut Vec<f32>) {
     let (din, dout) = (train.input_dim, train.target_dim);
     inputs.resize(picks.len() * din, 0.0);
