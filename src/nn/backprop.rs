@@ -596,7 +596,7 @@ mod tests {
         let mut probe = start.clone();
         assert!(is_tall_weight_gradient(&view_mut(&mut probe, o, i), &a, &b));
         let mut direct = start.clone();
-        faer::linalg::matmul::matmul(view_mut(&mut direct, o, i), Accum::Add, a, b, 1.0, faer::Par::Seq);
+        crate::nn::gemm::faer_product(view_mut(&mut direct, o, i), Accum::Add, a, b);
         let run = |threads: usize, accum: Accum| {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             let mut out = start.clone();

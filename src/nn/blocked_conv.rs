@@ -17,7 +17,9 @@
 use std::mem::MaybeUninit;
 use std::ops::Range;
 
-use faer::{Accum, MatRef, Par};
+use faer::{Accum, MatRef};
+
+use super::gemm::faer_product;
 use rayon::prelude::*;
 
 use super::backprop::{add_into, assume_written, relu_backward, slots, tensor_index, unwritten, view, view_mut};
@@ -235,7 +237,7 @@ impl BlockedConv {
                 let accum = if a == 0 { Accum::Replace } else { Accum::Add };
                 let operand = self.kernel_row_operand(input, images.clone(), a);
                 let product = view_mut(&mut product[..rows * out], rows, out);
-                faer::linalg::matmul::matmul(product, accum, operand, self.kernel_row_weight(a), 1.0f32, Par::Seq);
+                faer_product(product, accum, operand, self.kernel_row_weight(a));
             }
             let activate = |x: f32| if relu { x.max(0.0) } else { x };
             for (image, y) in y.chunks_mut(self.output_len()).enumerate() {
@@ -291,13 +293,11 @@ impl BlockedConv {
                     for a in 0..self.taps {
                         let operand = self.kernel_row_operand(input, images.clone(), a);
                         let sum = &mut sum[a * self.row_width() * out..][..self.row_width() * out];
-                        faer::linalg::matmul::matmul(
+                        faer_product(
                             view_mut(sum, self.row_width(), out),
                             Accum::Replace,
                             operand.transpose(),
                             view(padded, rows, out),
-                            1.0f32,
-                            Par::Seq,
                         );
                     }
                     (sum, bias_sum)

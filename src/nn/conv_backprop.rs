@@ -19,7 +19,7 @@
 //! its GEMMs over the pool. Which of the two, and the chunk size, depend on the layer and the batch alone, and each
 //! image is gathered and scattered by one thread: the bytes do not depend on the thread count.
 
-use faer::{Accum, MatMut, MatRef, Par};
+use faer::{Accum, MatMut, MatRef};
 use rayon::prelude::*;
 
 use std::mem::MaybeUninit;
@@ -28,7 +28,7 @@ use super::backprop::{
     add_column_sums, add_into, assume_written, fill_with_row, matmul, relu_backward, relu_in_place, slots,
     tensor_index, unwritten, view, view_mut,
 };
-use super::gemm::widest_kernel;
+use super::gemm::{faer_product, widest_kernel};
 use super::params::ParamSet;
 use crate::error::{Error, Result};
 use crate::util::wide::widest_fn;
@@ -164,7 +164,7 @@ fn product(dst: MatMut<'_, f32>, accum: Accum, a: MatRef<'_, f32>, b: MatRef<'_,
     if split {
         matmul(dst, accum, a, b);
     } else {
-        faer::linalg::matmul::matmul(dst, accum, a, b, 1.0f32, Par::Seq);
+        faer_product(dst, accum, a, b);
     }
 }
 

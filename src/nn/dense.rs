@@ -2,7 +2,9 @@
 //! over plain f32 buffers, one faer GEMM per layer. Calibration by information gain pushes 10⁵–10⁶ rows per
 //! decision through the context model; this path is held to the burn forward pass by tests.
 
-use faer::{Accum, MatMut, MatRef, Par};
+use faer::{Accum, MatMut, MatRef};
+
+use super::gemm::faer_product;
 
 use super::activation::{fast_sigmoid as sigmoid, fast_tanh as tanh, Activation};
 use super::params::{NamedTensor, ParamSet};
@@ -36,13 +38,11 @@ fn affine(src: &[f32], rows: usize, d_in: usize, w: &[f32], bias: &[f32], dst: &
     for row in dst.chunks_mut(d_out) {
         row.copy_from_slice(bias);
     }
-    faer::linalg::matmul::matmul(
+    faer_product(
         MatMut::from_row_major_slice_mut(dst, rows, d_out),
         Accum::Add,
         MatRef::from_row_major_slice(src, rows, d_in),
         MatRef::from_row_major_slice(w, d_in, d_out),
-        1.0f32,
-        Par::Seq,
     );
 }
 
@@ -197,13 +197,11 @@ impl DenseGru {
     /// Adds x·W_ih[cols] to `gates` (`rows × 3H`).
     pub fn add_input_gates(&self, x: &[f32], rows: usize, cols: std::ops::Range<usize>, gates: &mut [f32]) {
         let g = 3 * self.d_hidden;
-        faer::linalg::matmul::matmul(
+        faer_product(
             MatMut::from_row_major_slice_mut(gates, rows, g),
             Accum::Add,
             MatRef::from_row_major_slice(x, rows, cols.len()),
             MatRef::from_row_major_slice(&self.weight_ih[cols.start * g..cols.end * g], cols.len(), g),
-            1.0f32,
-            Par::Seq,
         );
     }
 

@@ -3,7 +3,9 @@
 //! information-gain planners push hundreds of thousands of rows through a trained model per decision; this path
 //! is held to the burn forward pass by a test.
 
-use faer::{Accum, MatMut, MatRef, Par};
+use faer::{Accum, MatMut, MatRef};
+
+use super::gemm::faer_product;
 
 use super::activation::Activation;
 use super::params::NamedTensor;
@@ -112,13 +114,11 @@ impl FastEnsembleMlp {
                 row.copy_from_slice(bias);
             }
             let w = &layer.weight[member * layer.d_in * layer.d_out..(member + 1) * layer.d_in * layer.d_out];
-            faer::linalg::matmul::matmul(
+            faer_product(
                 MatMut::from_row_major_slice_mut(dst, rows, layer.d_out),
                 Accum::Add,
                 MatRef::from_row_major_slice(src, rows, layer.d_in),
                 MatRef::from_row_major_slice(w, layer.d_in, layer.d_out),
-                1.0f32,
-                Par::Seq,
             );
             if k != last {
                 self.activation.apply_in_place(dst);

@@ -16,6 +16,8 @@
 
 use faer::{Accum, MatMut, MatRef, Par};
 
+use crate::util::wide::clean_upper_state;
+
 /// Products whose three operands hold fewer values than this (2 MiB, a core's L2) are left to faer: they sit
 /// in cache, where faer's kernels are at least as fast.
 const MIN_VALUES: usize = 1 << 19;
@@ -178,7 +180,7 @@ impl Kernel {
                         Accum::Add
                     }
                 };
-                faer::linalg::matmul::matmul(dst.as_mut(), accum, a, b, 1.0f32, Par::Seq);
+                faer_product(dst.as_mut(), accum, a, b);
                 finish_pass(dst, finish);
                 if let Some(sums) = row_sums {
                     add_row_sums(sums, a);
@@ -215,6 +217,15 @@ impl Kernel {
 }
 
 /// sums[i] += Σ_k a[i, k], in order of k.
+/// dst = [dst +] a · b on faer's kernels, on the calling thread, with the vector registers cleared after them
+/// for the baseline code that follows (see [`clean_upper_state`]). Every f32 product that goes to faer goes
+/// through here (clippy.toml disallows calling faer's `matmul` directly).
+#[allow(clippy::disallowed_methods)]
+pub fn faer_product(dst: MatMut<'_, f32>, accum: Accum, a: MatRef<'_, f32>, b: MatRef<'_, f32>) {
+    faer::linalg::matmul::matmul(dst, accum, a, b, 1.0f32, Par::Seq);
+    clean_upper_state();
+}
+
 fn add_row_sums(sums: &mut [f32], a: MatRef<'_, f32>) {
     for (i, sum) in sums.iter_mut().enumerate() {
         *sum = a.row(i).iter().fold(*sum, |total, x| total + x);

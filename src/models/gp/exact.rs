@@ -9,7 +9,7 @@ use faer::{Mat, Side};
 use super::kernel::SeArd;
 use crate::error::{Error, Result};
 use crate::util::fast_exp::scaled_exp_in_place;
-use crate::util::wide::widest_fn;
+use crate::util::wide::{clean_upper_state, widest_fn};
 
 const LN_2PI: f64 = 1.837_877_066_409_345_5;
 /// Jitter added to the diagonal when the factorization fails, relative to the mean diagonal, tried in turn.
@@ -132,6 +132,8 @@ impl ConditionedGp {
         let residual: Vec<f64> = targets.iter().zip(prior_mean).map(|(y, m)| y - m).collect();
         let mut alpha = Mat::from_fn(n, 1, |i, _| residual[i]);
         factor.solve_in_place_with_conj(faer::Conj::No, alpha.as_mut());
+        // faer's factorization and solve leave the vector registers dirty for the scalar loops below.
+        clean_upper_state();
         let alpha = (0..n).map(|i| alpha[(i, 0)]).collect();
         let scaled_columns =
             (0..d).map(|c| (0..n).map(|j| inputs[j * d + c] / kernel.lengthscales[c]).collect()).collect();
@@ -173,6 +175,7 @@ impl ConditionedGp {
     pub fn gradients(&self) -> NllGradients {
         let (n, d) = (self.len(), self.kernel.dims());
         let inverse = self.factor.inverse();
+        clean_upper_state();
         let w = Mat::from_fn(n, n, |i, j| 0.5 * (inverse[(i, j)] - self.alpha[i] * self.alpha[j]));
         let k = self.kernel.matrix(&self.inputs, &self.inputs);
         let inv_sq: Vec<f64> = self.kernel.lengthscales.iter().map(|l| 1.0 / (l * l)).collect();
@@ -234,6 +237,7 @@ impl ConditionedGp {
         let variance = if with_variance && n > 0 {
             let mut v = faer::MatMut::from_column_major_slice_mut(&mut cross, n, q);
             self.factor.L().solve_lower_triangular_in_place(v.as_mut());
+            clean_upper_state();
             (0..q)
                 .map(|i| {
                     let explained: f64 = (0..n).map(|j| v[(j, i)] * v[(j, i)]).sum();

@@ -12,8 +12,7 @@
 //! loss, the bounds' gradients) are taken after the first phase in row order, so the bytes do not depend on the
 //! threads.
 
-use faer::linalg::matmul::matmul as faer_matmul;
-use faer::{Accum, Par};
+use faer::Accum;
 use rayon::prelude::*;
 
 use super::config::PetsConfig;
@@ -21,7 +20,7 @@ use crate::error::Result;
 use crate::nn::activation::{fast_exp, fast_sigmoid as sigmoid, fast_softplus as softplus, Activation};
 use crate::nn::adam::AdamStep;
 use crate::nn::backprop::{add_column_sums, tensor_index, view, view_mut, zero_gradients};
-use crate::nn::gemm::{widest_kernel, Finish, Kernel, Start};
+use crate::nn::gemm::{faer_product, widest_kernel, Finish, Kernel, Start};
 use crate::nn::{Adam, ParamSet};
 use crate::util::wide::widest_fn;
 
@@ -30,7 +29,7 @@ const BOUNDS_PENALTY: f32 = 0.01;
 
 /// dst = [dst +] a · b on the calling thread: the first phase's tasks already fill the pool.
 fn matmul_here(dst: faer::MatMut<'_, f32>, accum: Accum, a: faer::MatRef<'_, f32>, b: faer::MatRef<'_, f32>) {
-    faer_matmul(dst, accum, a, b, 1.0f32, Par::Seq);
+    faer_product(dst, accum, a, b);
 }
 
 /// Layers at least this wide take their weight gradients from mbrl's kernel, narrower ones from faer's.

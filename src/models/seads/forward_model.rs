@@ -5,7 +5,9 @@
 use burn::module::Module;
 use burn::tensor::activation::{relu, softplus};
 use burn::tensor::{Device, Tensor};
-use faer::{Accum, MatMut, MatRef, Par};
+use faer::{Accum, MatMut, MatRef};
+
+use crate::nn::gemm::faer_product;
 use rand::Rng;
 
 use crate::error::{Error, Result};
@@ -136,13 +138,11 @@ impl FlipModel {
         let (h, k) = (self.hidden, self.skills);
         scratch.board_part.clear();
         scratch.board_part.resize(n * h, 0.0);
-        faer::linalg::matmul::matmul(
+        faer_product(
             MatMut::from_row_major_slice_mut(&mut scratch.board_part, n, h),
             Accum::Replace,
             MatRef::from_row_major_slice(boards, n, self.bits),
             MatRef::from_row_major_slice(&self.board_weight, self.bits, h),
-            1.0f32,
-            Par::Seq,
         );
         scratch.hidden.clear();
         scratch.hidden.reserve(n * k * h);
@@ -213,13 +213,11 @@ impl FlipModel {
         let n = skills.len();
         scratch.board_part.clear();
         scratch.board_part.resize(n * h, 0.0);
-        faer::linalg::matmul::matmul(
+        faer_product(
             MatMut::from_row_major_slice_mut(&mut scratch.board_part, n, h),
             Accum::Replace,
             MatRef::from_row_major_slice(boards, n, bits),
             MatRef::from_row_major_slice(&self.board_weight, bits, h),
-            1.0f32,
-            Par::Seq,
         );
         scratch.hidden.clear();
         scratch.hidden.reserve(n * h);
