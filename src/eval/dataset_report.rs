@@ -5,7 +5,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use super::num;
-use super::plot::{histogram, line_panels, Panel, Series};
+use super::plot::{histogram, line_panels, wrapped_angle_trace, Panel, Series};
 use super::stats::{mean, quantile};
 use super::summary::{publish, write_config};
 use crate::data::{read_dataset, Rollout};
@@ -201,21 +201,14 @@ fn state_panels(path: &Path, meta: &DatasetHeader, plotted: &[PlottedRollout], r
     line_panels(path, &title, "time [s]", &panels)
 }
 
-/// (t, x_d) of a rollout; an angle is wrapped and a NaN breaks the line where it jumps across ±π.
+/// (t, x_d) of a rollout; an angle is wrapped, its line broken where it crosses ±π.
 fn state_trace(states: &[Vec<f64>], d: usize, dt: f64, is_angle: bool) -> Vec<(f64, f64)> {
-    let wrap = |x: f64| (x + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
-    let mut points = Vec::with_capacity(states.len());
-    let mut previous: Option<f64> = None;
-    for (t, state) in states.iter().enumerate() {
-        let Some(&raw) = state.get(d) else { continue };
-        let value = if is_angle { wrap(raw) } else { raw };
-        if is_angle && previous.is_some_and(|p| (value - p).abs() > std::f64::consts::PI) {
-            points.push((t as f64 * dt, f64::NAN));
-        }
-        points.push((t as f64 * dt, value));
-        previous = Some(value);
+    let samples = states.iter().enumerate().filter_map(|(t, state)| state.get(d).map(|x| (t as f64 * dt, *x)));
+    if is_angle {
+        wrapped_angle_trace(samples)
+    } else {
+        samples.collect()
     }
-    points
 }
 
 fn markdown(input: &str, meta: &DatasetHeader, s: &DatasetSummary, returns: &[f64]) -> String {

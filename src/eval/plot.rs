@@ -7,6 +7,7 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use crate::envs::pendulum::angle_normalize;
 use crate::error::{Error, Result};
 
 const FONT: &[u8] = include_bytes!("fonts/DejaVuSans.ttf");
@@ -154,6 +155,28 @@ fn draw_axes(chart: &mut XyChart<'_, '_>, path: &Path, x_label: &str, y_label: &
         .y_desc(y_label)
         .draw()
         .map_err(|e| plot_err(path, e))
+}
+
+/// (t, angle wrapped to [−π, π)) for samples (t, unwrapped angle), with the line broken by a NaN wherever the
+/// angle wraps. Each side of a break runs to the edge it crosses, at the time the straight line between the
+/// two samples reaches it: cut at the samples instead, a trace that starts on the wrap (a pendulum hanging
+/// down, θ = ±π) began with a segment of one point, drawn as a lone dot.
+pub fn wrapped_angle_trace(samples: impl IntoIterator<Item = (f64, f64)>) -> Vec<(f64, f64)> {
+    use std::f64::consts::{PI, TAU};
+    let mut points = Vec::new();
+    let mut previous: Option<(f64, f64)> = None;
+    for (t, raw) in samples {
+        let angle = angle_normalize(raw);
+        if let Some((t0, a0)) = previous.filter(|(_, a0)| (angle - a0).abs() > PI) {
+            // Falling from near +π to near −π means the angle rose through +π, and the other way round.
+            let (edge, step) = if a0 > angle { (PI, angle + TAU - a0) } else { (-PI, angle - TAU - a0) };
+            let at = t0 + ((edge - a0) / step).clamp(0.0, 1.0) * (t - t0);
+            points.extend([(at, edge), (at, f64::NAN), (at, -edge)]);
+        }
+        points.push((t, angle));
+        previous = Some((t, angle));
+    }
+    points
 }
 
 pub fn line_plot(path: &Path, title: &str, x_label: &str, y_label: &str, series: &[Series]) -> Result<()> {
@@ -680,6 +703,29 @@ mod tests {
         assert_eq!(tick(&-1e-17), "0.0");
         assert_eq!(tick(&-0.25), "-0.25");
         assert_eq!(tick(&2.0), "2.0");
+    }
+
+    #[test]
+    fn wrapped_angles_run_to_the_edge_they_cross() {
+        use std::f64::consts::{PI, TAU};
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-12;
+        // Up through +π between t = 0 and 1: the line from 3.0 reaches π at t = (π − 3) / 0.3.
+        let up = wrapped_angle_trace([(0.0, 3.0), (1.0, 3.3), (2.0, 3.4)]);
+        let at = (PI - 3.0) / 0.3;
+        assert_eq!(up.len(), 6);
+        assert_eq!(up[0], (0.0, 3.0));
+        assert!(close(up[1].0, at) && up[1].1 == PI);
+        assert!(close(up[2].0, at) && up[2].1.is_nan());
+        assert!(close(up[3].0, at) && up[3].1 == -PI);
+        assert!(up[4].0 == 1.0 && close(up[4].1, 3.3 - TAU));
+        // Down through −π: the first side ends at −π and the second starts at +π.
+        let down = wrapped_angle_trace([(0.0, -3.0), (1.0, -3.3)]);
+        assert!(down[1].1 == -PI && down[3].1 == PI && close(down[1].0, (PI - 3.0) / 0.3));
+        // A trace that starts on the wrap opens with a segment of two points, not a lone one.
+        let hanging = wrapped_angle_trace([(0.0, PI - 0.01), (0.05, PI + 0.02)]);
+        assert_eq!(hanging.split(|p| p.1.is_nan()).next().unwrap().len(), 2);
+        // Without a wrap, only the wrapped samples.
+        assert_eq!(wrapped_angle_trace([(0.0, 0.5), (1.0, 7.0)]).len(), 2);
     }
 
     #[test]

@@ -6,7 +6,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use super::num;
-use super::plot::{histogram, line_plot, Series};
+use super::plot::{histogram, line_plot, wrapped_angle_trace, Series};
 use super::stats::{mean, quantile};
 use super::summary::{publish, write_config};
 use crate::control::BatchDynamics;
@@ -350,25 +350,15 @@ pub fn render(summary: &SwingupSummary, dir: &Path) -> Result<()> {
     let dt = Pendulum::new(settings.variant.clone()).spec().dt;
     let series: Vec<Series> = results
         .iter()
-        .map(|e| Series { name: format!("episode {}", e.episode + 1), points: wrapped_angle_points(&e.angles, dt) })
+        .map(|e| Series {
+            name: format!("episode {}", e.episode + 1),
+            points: wrapped_angle_trace(e.angles.iter().enumerate().map(|(t, a)| (t as f64 * dt, *a))),
+        })
         .collect();
     line_plot(&file("angle.png"), "Pendulum angle during swing-up (0 = upright)", "time [s]", "angle [rad]", &series)?;
     histogram(&file("returns.png"), "Episode returns", "return", &summary.returns(), 10)?;
     let report = report_markdown(settings, &summary.model, &summary.provenance, results);
     write_text(&file("report.md"), &report)
-}
-
-/// (time, wrapped angle) with a NaN break wherever the angle wraps around ±π.
-fn wrapped_angle_points(angles: &[f64], dt: f64) -> Vec<(f64, f64)> {
-    let mut points: Vec<(f64, f64)> = Vec::with_capacity(angles.len() + 8);
-    for (t, a) in angles.iter().enumerate() {
-        let point = (t as f64 * dt, angle_normalize(*a));
-        if points.last().is_some_and(|last| (last.1 - point.1).abs() > std::f64::consts::PI) {
-            points.push((point.0, f64::NAN));
-        }
-        points.push(point);
-    }
-    points
 }
 
 fn report_markdown(
