@@ -216,7 +216,6 @@ impl Kernel {
     }
 }
 
-/// sums[i] += Σ_k a[i, k], in order of k.
 /// dst = [dst +] a · b on faer's kernels, on the calling thread, with the vector registers cleared after them
 /// for the baseline code that follows (see [`clean_upper_state`]). Every f32 product that goes to faer goes
 /// through here (clippy.toml disallows calling faer's `matmul` directly).
@@ -226,6 +225,7 @@ pub fn faer_product(dst: MatMut<'_, f32>, accum: Accum, a: MatRef<'_, f32>, b: M
     clean_upper_state();
 }
 
+/// sums[i] += Σ_k a[i, k], in order of k.
 fn add_row_sums(sums: &mut [f32], a: MatRef<'_, f32>) {
     for (i, sum) in sums.iter_mut().enumerate() {
         *sum = a.row(i).iter().fold(*sum, |total, x| total + x);
