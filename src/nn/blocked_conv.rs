@@ -18,11 +18,10 @@ use std::mem::MaybeUninit;
 use std::ops::Range;
 
 use faer::{Accum, MatRef};
-
-use super::gemm::faer_product;
 use rayon::prelude::*;
 
 use super::backprop::{add_into, assume_written, relu_backward, slots, tensor_index, unwritten, view, view_mut};
+use super::gemm::faer_product;
 use super::params::ParamSet;
 use crate::error::{Error, Result};
 

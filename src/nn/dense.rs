@@ -4,9 +4,8 @@
 
 use faer::{Accum, MatMut, MatRef};
 
-use super::gemm::faer_product;
-
 use super::activation::{fast_sigmoid as sigmoid, fast_tanh as tanh, Activation};
+use super::gemm::faer_product;
 use super::params::{NamedTensor, ParamSet};
 use crate::error::{Error, Result};
 

@@ -5,9 +5,8 @@
 
 use faer::{Accum, MatMut, MatRef};
 
-use super::gemm::faer_product;
-
 use super::activation::Activation;
+use super::gemm::faer_product;
 use super::params::NamedTensor;
 use crate::error::{Error, Result};
 

@@ -27,11 +27,6 @@ use crate::util::wide::widest_fn;
 /// mbrl-lib's weight on Σ max_logvar − Σ min_logvar.
 const BOUNDS_PENALTY: f32 = 0.01;
 
-/// dst = [dst +] a · b on the calling thread: the first phase's tasks already fill the pool.
-fn matmul_here(dst: faer::MatMut<'_, f32>, accum: Accum, a: faer::MatRef<'_, f32>, b: faer::MatRef<'_, f32>) {
-    faer_product(dst, accum, a, b);
-}
-
 /// Layers at least this wide take their weight gradients from mbrl's kernel, narrower ones from faer's.
 const WIDE_LAYER: usize = 128;
 
@@ -618,7 +613,8 @@ fn backward_weights(
     if i >= WIDE_LAYER {
         fused_here(dst, Start::Zero, xt, dy_view, Finish::Store);
     } else {
-        matmul_here(dst, Accum::Replace, xt, dy_view);
+        // On the calling thread: the first phase's tasks already fill the pool.
+        faer_product(dst, Accum::Replace, xt, dy_view);
     }
     bias_grad.fill(0.0);
     add_column_sums(bias_grad, dy);

@@ -6,12 +6,11 @@ use burn::module::Module;
 use burn::tensor::activation::{relu, softplus};
 use burn::tensor::{Device, Tensor};
 use faer::{Accum, MatMut, MatRef};
-
-use crate::nn::gemm::faer_product;
 use rand::Rng;
 
 use crate::error::{Error, Result};
 use crate::nn::dense::{DenseLayer, DenseStack, StackScratch};
+use crate::nn::gemm::faer_product;
 use crate::nn::{Activation, Linear, LinearConfig, ParamSet};
 
 /// torch.distributions.Bernoulli clamps probabilities to [ε, 1 − ε] (ε = f32 machine epsilon) before taking
