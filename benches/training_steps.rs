@@ -16,7 +16,8 @@ use mbrl::models::ball::learn::{train as train_ball, TrainSettings};
 use mbrl::models::context::config::{ContextConfig, EnvFamily, Preset as ContextPreset};
 use mbrl::models::context::ContextTrainer;
 use mbrl::models::dlgpd::data::ObservationKind;
-use mbrl::models::dlgpd::model::{loss_and_gradients, sample_noise, Batch, Gradients};
+use mbrl::models::dlgpd::grad::images_loss_and_gradients;
+use mbrl::models::dlgpd::model::{sample_noise, Batch, Gradients};
 use mbrl::models::dlgpd::vae::VaeNet;
 use mbrl::models::gp::{GpHypers, HyperInit};
 use mbrl::models::pets::data::Transitions;
@@ -89,7 +90,8 @@ fn sac() -> Step {
 fn dlgpd(rows: usize) -> Step {
     let mut rng = ChaCha8Rng::seed_from_u64(0);
     let device = training_device();
-    let vae = VaeNet::init(ObservationKind::Images { side: 64 }, 3, 0, &device, &mut rng).unwrap();
+    // The weights as `train` holds them between steps: outside the module, read in place.
+    let params = VaeNet::init(ObservationKind::Images { side: 64 }, 3, 0, &device, &mut rng).unwrap().params();
     let transition: Vec<GpHypers> = (0..3).map(|_| GpHypers::new(&HyperInit::dlgpd(4, 1.0)).unwrap()).collect();
     let reward = GpHypers::new(&HyperInit::dlgpd(4, 4.0)).unwrap();
     let pixels = rows * 6 * 64 * 64;
@@ -99,7 +101,7 @@ fn dlgpd(rows: usize) -> Step {
     let batch = Batch { rows, obs: frames.clone(), next_obs: frames, actions, rewards };
     let noise = sample_noise(rows, 3, &mut rng);
     Box::new(move || {
-        loss_and_gradients(&vae, &transition, &reward, &batch, (&noise.0, &noise.1), Gradients::Wanted, &device)
+        images_loss_and_gradients(&params, &transition, &reward, &batch, (&noise.0, &noise.1), Gradients::Wanted)
             .unwrap();
         None
     })

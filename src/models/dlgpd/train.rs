@@ -4,6 +4,8 @@
 //! latents. A checkpoint's weights carry the latent standardization that planning freezes: the statistics of
 //! the encoder's samples on (at most) 1024 training transitions, as the authors' planning code takes them.
 
+use std::cell::{Cell, Ref, RefCell};
+
 use burn::tensor::Device;
 use rand::seq::index::sample;
 use rand::Rng;
@@ -13,8 +15,9 @@ use super::config::DlgpdConfig;
 use super::data::{ObservationKind, Windows};
 use super::evidence::{condition_on_rows, encoded_means};
 use super::latent_gp::LatentScale;
+use super::grad::images_loss_and_gradients;
 use super::model::{
-    init_hypers, loss_and_gradients, raw_gradient, raw_vector, sample_noise, set_raw_vector, Batch, Gradients, StepLoss,
+    burn_loss_and_gradients, init_hypers, raw_gradient, raw_vector, sample_noise, set_raw_vector, Batch, Gradients, StepLoss,
 };
 use super::prediction::reward_errors;
 use super::vae::{encode_rows, VaeNet};
@@ -129,7 +132,12 @@ pub struct DlgpdTrainer {
     config: DlgpdConfig,
     seed: u64,
     device: Device,
-    vae: Option<VaeNet>,
+    /// The burn module encodes (validation, the frozen scale, the planner's check) and trains the angle VAE;
+    /// `params` are the weights. The image VAE trains on `params` alone, so after each update the module is
+    /// only marked stale and reloaded when next used: copying its 17 MB out and back in at every step was
+    /// serial work of 4 % of a two-thread step at batch 256.
+    vae: RefCell<Option<VaeNet>>,
+    vae_is_stale: Cell<bool>,
     params: ParamSet<f32>,
     vae_adam: Adam<f32>,
     gps: Option<Gps>,
@@ -139,7 +147,7 @@ pub struct DlgpdTrainer {
     last: Option<StepLoss>,
     /// The frozen standardization of the current weights: an improving validation needs it twice (the
     /// prediction check and the saved weights), and at image size it costs a thousand encodings.
-    frozen_scale_of_weights: std::cell::RefCell<Option<LatentScale>>,
+    frozen_scale_of_weights: RefCell<Option<LatentScale>>,
 }
 
 impl DlgpdTrainer {
@@ -173,7 +181,8 @@ impl DlgpdTrainer {
             config,
             seed,
             device,
-            vae: Some(vae),
+            vae: RefCell::new(Some(vae)),
+            vae_is_stale: Cell::new(false),
             params,
             vae_adam,
             gps: None,
@@ -181,7 +190,7 @@ impl DlgpdTrainer {
             train_rows,
             valid_rows,
             last: None,
-            frozen_scale_of_weights: std::cell::RefCell::new(None),
+            frozen_scale_of_weights: RefCell::new(None),
         })
     }
 
@@ -189,8 +198,29 @@ impl DlgpdTrainer {
         self.params.count()
     }
 
-    fn vae(&self) -> &VaeNet {
-        self.vae.as_ref().expect("the VAE is only taken out while loading new weights")
+    /// The burn module with the current weights.
+    fn vae(&self) -> Result<Ref<'_, VaeNet>> {
+        const PRESENT: &str = "the VAE is only taken out while loading new weights";
+        if self.vae_is_stale.get() {
+            let mut slot = self.vae.borrow_mut();
+            let vae = slot.take().expect(PRESENT);
+            *slot = Some(vae.with_params(&self.params, &self.device)?);
+            self.vae_is_stale.set(false);
+        }
+        Ok(Ref::map(self.vae.borrow(), |vae| vae.as_ref().expect(PRESENT)))
+    }
+
+    /// The loss of `batch` (and its gradients when wanted) at the current weights.
+    fn loss(&self, gps: &Gps, batch: &Batch, noise: (&[f32], &[f32]), gradients: Gradients) -> Result<StepLoss> {
+        match self.windows.kind {
+            ObservationKind::Images { .. } => {
+                images_loss_and_gradients(&self.params, &gps.transition, &gps.reward, batch, noise, gradients)
+            }
+            ObservationKind::Angles => {
+                let vae = self.vae()?;
+                burn_loss_and_gradients(&vae, &gps.transition, &gps.reward, batch, noise, gradients, &self.device)
+            }
+        }
     }
 
     fn batch(&self, rows: &[usize]) -> Batch {
@@ -200,15 +230,15 @@ impl DlgpdTrainer {
     }
 
     /// Reparameterized samples of the encoder at `obs` with standard-normal `noise`.
-    fn samples(&self, obs: &[f32], noise: &[f32]) -> Vec<f64> {
-        let (mean, std) = encode_rows(self.vae(), obs, self.windows.kind.input_len(), &self.device);
-        mean.iter().zip(&std).zip(noise).map(|((m, s), e)| (m + s * e) as f64).collect()
+    fn samples(&self, obs: &[f32], noise: &[f32]) -> Result<Vec<f64>> {
+        let (mean, std) = encode_rows(&*self.vae()?, obs, self.windows.kind.input_len(), &self.device);
+        Ok(mean.iter().zip(&std).zip(noise).map(|((m, s), e)| (m + s * e) as f64).collect())
     }
 
     /// The GPs' starting point from the first batch, as the authors' first `set_train_data` does.
     fn init_gps(&self, batch: &Batch, noise: (&[f32], &[f32])) -> Result<Gps> {
-        let latents = self.samples(&batch.obs, noise.0);
-        let next = self.samples(&batch.next_obs, noise.1);
+        let latents = self.samples(&batch.obs, noise.0)?;
+        let next = self.samples(&batch.next_obs, noise.1)?;
         let (transition, reward) = init_hypers(&latents, &next, &batch.rewards, self.windows.action_dim)?;
         let sizes: Vec<usize> = transition.iter().chain([&reward]).map(|h| raw_vector(h).len()).collect();
         Ok(Gps { transition, reward, adam: gp_adam(&self.config, &sizes) })
@@ -232,7 +262,7 @@ impl DlgpdTrainer {
         let (obs, _) = self.windows.observations(&rows);
         let noise: Vec<f32> =
             (0..count * self.config.latent_dim).map(|_| rng.sample::<f32, _>(StandardNormal)).collect();
-        LatentScale::of(&self.samples(&obs, &noise), self.config.latent_dim)
+        LatentScale::of(&self.samples(&obs, &noise)?, self.config.latent_dim)
     }
 }
 
@@ -247,22 +277,13 @@ impl TrainingMethod for DlgpdTrainer {
         if self.gps.is_none() {
             self.gps = Some(self.init_gps(&batch, (&noise.0, &noise.1))?);
         }
-        let gps = self.gps.as_mut().expect("initialized above");
-        let vae = self.vae.as_ref().expect("present between steps");
-        let mut loss = loss_and_gradients(
-            vae,
-            &gps.transition,
-            &gps.reward,
-            &batch,
-            (&noise.0, &noise.1),
-            Gradients::Wanted,
-            &self.device,
-        )?;
+        let gps = self.gps.as_ref().expect("initialized above");
+        let mut loss = self.loss(gps, &batch, (&noise.0, &noise.1), Gradients::Wanted)?;
         let mut vae_grads = std::mem::take(&mut loss.vae_gradients);
         *self.frozen_scale_of_weights.get_mut() = None;
         self.vae_adam.update(&mut self.params.values_mut(), &mut vae_grads)?;
-        let vae = self.vae.take().expect("present between steps");
-        self.vae = Some(vae.with_params(&self.params, &self.device)?);
+        self.vae_is_stale.set(true);
+        let gps = self.gps.as_mut().expect("initialized above");
         let mut raw: Vec<Vec<f64>> = gps.all().map(raw_vector).collect();
         let mut grads: Vec<Vec<f64>> = loss.gp.d_hypers.iter().map(raw_gradient).collect();
         gps.adam.update(&mut raw.iter_mut().collect::<Vec<_>>(), &mut grads)?;
@@ -283,15 +304,7 @@ impl TrainingMethod for DlgpdTrainer {
         };
         let batch = self.batch(&self.valid_rows[..count]);
         let noise = sample_noise(count, self.config.latent_dim, &mut rng_for(self.seed, &[VALID_STREAM]));
-        let loss = loss_and_gradients(
-            self.vae(),
-            &gps.transition,
-            &gps.reward,
-            &batch,
-            (&noise.0, &noise.1),
-            Gradients::NotWanted,
-            &self.device,
-        )?;
+        let loss = self.loss(gps, &batch, (&noise.0, &noise.1), Gradients::NotWanted)?;
         Ok(Some(loss.total))
     }
 
@@ -306,9 +319,9 @@ impl TrainingMethod for DlgpdTrainer {
             return Ok(Vec::new());
         };
         let scale = self.frozen_scale()?;
-        let vae = self.vae.as_ref().expect("present between steps");
-        let dynamics = condition_on_rows(vae, (&gps.transition, &gps.reward), scale, &self.windows, &evidence_rows)?;
-        let latents = encoded_means(vae, &self.windows, &scored_rows)?;
+        let vae = self.vae()?;
+        let dynamics = condition_on_rows(&vae, (&gps.transition, &gps.reward), scale, &self.windows, &evidence_rows)?;
+        let latents = encoded_means(&vae, &self.windows, &scored_rows)?;
         let errors = reward_errors(&dynamics, &self.windows, &scored_rows, &latents)?;
         let at = |h: usize| errors.open_loop_rmse.get(h).copied().unwrap_or(f64::NAN);
         Ok(vec![
@@ -348,8 +361,7 @@ impl TrainingMethod for DlgpdTrainer {
     fn restore(&mut self, saved: &[StoredTensor]) -> Result<()> {
         state::restore(saved, &mut self.params, &mut self.vae_adam)?;
         *self.frozen_scale_of_weights.get_mut() = None;
-        let vae = self.vae.take().expect("present between steps");
-        self.vae = Some(vae.with_params(&self.params, &self.device)?);
+        self.vae_is_stale.set(true);
         let has_gps = saved.iter().any(|t| t.name.starts_with(&format!("live.{REWARD_GP}.")));
         self.gps = if has_gps {
             let (transition, reward) =
