@@ -6,6 +6,7 @@ use std::sync::Once;
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use crate::envs::pendulum::angle_normalize;
 use crate::error::{Error, Result};
@@ -260,16 +261,24 @@ pub struct Panel {
 }
 
 /// Line charts stacked on one x axis, each with its own y range and label (one per state dimension): the
-/// series keep their colour across panels, and the first panel carries the legend when it stays readable.
+/// series keep their colour across panels, and a legend of the first panel's series, when it stays readable
+/// (2 to 10 of them), sits in a column of its own to the right: drawn inside a panel, ten rollouts' box
+/// covered lines wherever it went.
 pub fn line_panels(path: &Path, title: &str, x_label: &str, panels: &[Panel]) -> Result<()> {
     let (x0, x1) = bounds(panels.iter().flat_map(|p| p.series.iter().flat_map(|s| s.points.iter().map(|p| p.0))));
     let rows = panels.len().max(1);
-    let size = (900, 50 + 230 * rows as u32);
+    let legend: &[Series] = match panels.first() {
+        Some(first) if (2..=10).contains(&first.series.len()) => &first.series,
+        _ => &[],
+    };
+    let legend_width = legend_column_width(legend);
+    let size = (900 + legend_width, 50 + 230 * rows as u32);
     render_atomic(path, |tmp| {
         let root = BitMapBackend::new(tmp, size).into_drawing_area();
         root.fill(&WHITE).map_err(|e| plot_err(path, e))?;
         let root = root.titled(title, ("sans-serif", 22)).map_err(|e| plot_err(path, e))?;
-        for (k, (area, panel)) in root.split_evenly((rows, 1)).iter().zip(panels).enumerate() {
+        let (charts, legend_area) = root.split_horizontally(900);
+        for (k, (area, panel)) in charts.split_evenly((rows, 1)).iter().zip(panels).enumerate() {
             let (y_label, series) = (&panel.y_label, &panel.series);
             let (y0, y1) =
                 panel.y_range.unwrap_or_else(|| bounds(series.iter().flat_map(|s| s.points.iter().map(|p| p.1))));
@@ -288,16 +297,38 @@ pub fn line_panels(path: &Path, title: &str, x_label: &str, panels: &[Panel]) ->
             }
             mesh.draw().map_err(|e| plot_err(path, e))?;
             for (i, s) in series.iter().enumerate() {
-                let look = LineLook { width: 2, mark_lone_points: false, labelled: k == 0 };
+                let look = LineLook { width: 2, mark_lone_points: false, labelled: false };
                 draw_line(&mut chart, path, s, series_color(i), look)?;
             }
-            if k == 0 && (2..=10).contains(&series.len()) {
-                draw_legend(&mut chart, path, SeriesLabelPosition::UpperRight, Some(12))?;
-            }
         }
+        draw_legend_column(&legend_area, path, legend)?;
         root.present().map_err(|e| plot_err(path, e))?;
         Ok(())
     })
+}
+
+/// Legend text size in `line_panels`' column, and the width of one of its characters at most.
+const LEGEND_FONT: u32 = 13;
+const LEGEND_CHAR_WIDTH: u32 = 8;
+
+/// The width of a legend column for `series`' names (none without series): a line sample, the longest name,
+/// margins; long names are cut to 24 characters.
+fn legend_column_width(series: &[Series]) -> u32 {
+    let longest = series.iter().map(|s| s.name.chars().count().min(24) as u32).max();
+    longest.map_or(0, |chars| 44 + LEGEND_CHAR_WIDTH * chars)
+}
+
+/// One row per series from the top of `area`: a short line of its colour and its name.
+fn draw_legend_column(area: &DrawingArea<BitMapBackend<'_>, Shift>, path: &Path, series: &[Series]) -> Result<()> {
+    for (i, s) in series.iter().enumerate() {
+        let y = 16 + 20 * i as i32;
+        let color = series_color(i);
+        area.draw(&PathElement::new(vec![(6, y), (26, y)], color.stroke_width(2))).map_err(|e| plot_err(path, e))?;
+        let name: String = s.name.chars().take(24).collect();
+        let style = TextStyle::from(("sans-serif", LEGEND_FONT).into_font()).pos(Pos::new(HPos::Left, VPos::Center));
+        area.draw(&Text::new(name, (32, y), style)).map_err(|e| plot_err(path, e))?;
+    }
+    Ok(())
 }
 
 /// A median line with a shaded band between a lower and an upper quantile.
@@ -726,6 +757,47 @@ mod tests {
         assert_eq!(hanging.split(|p| p.1.is_nan()).next().unwrap().len(), 2);
         // Without a wrap, only the wrapped samples.
         assert_eq!(wrapped_angle_trace([(0.0, 0.5), (1.0, 7.0)]).len(), 2);
+    }
+
+    /// (width, RGB rows) of a PNG this module drew.
+    fn decoded(path: &Path) -> (usize, Vec<Vec<[u8; 3]>>) {
+        let mut reader =
+            png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap())).read_info().unwrap();
+        let mut buffer = vec![0; reader.output_buffer_size().unwrap()];
+        let info = reader.next_frame(&mut buffer).unwrap();
+        assert_eq!(info.color_type, png::ColorType::Rgb);
+        let width = info.width as usize;
+        let rows = buffer[..info.buffer_size()]
+            .chunks(info.line_size)
+            .map(|row| row.chunks(3).take(width).map(|p| [p[0], p[1], p[2]]).collect())
+            .collect();
+        (width, rows)
+    }
+
+    #[test]
+    fn stacked_panels_keep_their_legend_beside_the_charts() {
+        let dir = tempfile::tempdir().unwrap();
+        let series = |count: usize| -> Vec<Series> {
+            (0..count)
+                .map(|k| Series {
+                    name: format!("rollout {k}"),
+                    points: (0..40).map(|i| (i as f64, (i as f64 * 0.2 + k as f64).sin())).collect(),
+                })
+                .collect()
+        };
+        let panel = |count| Panel { y_label: "theta".into(), series: series(count), y_range: None };
+        let (three, one) = (dir.path().join("three.png"), dir.path().join("one.png"));
+        line_panels(&three, "t", "time [s]", &[panel(3), panel(3)]).unwrap();
+        line_panels(&one, "t", "time [s]", &[panel(1)]).unwrap();
+        assert_eq!(decoded(&one).0, 900, "no legend, no column");
+        let (width, rows) = decoded(&three);
+        assert_eq!(width as u32, 900 + legend_column_width(&series(3)));
+        for k in 0..3 {
+            let c = series_color(k);
+            let colour = [c.0, c.1, c.2];
+            let in_column = rows.iter().any(|row| row[900..].contains(&colour));
+            assert!(in_column, "series {k}'s sample line is in the legend column");
+        }
     }
 
     #[test]

@@ -14,10 +14,11 @@ use rand_distr::StandardNormal;
 use super::config::DlgpdConfig;
 use super::data::{ObservationKind, Windows};
 use super::evidence::{condition_on_rows, encoded_means};
-use super::latent_gp::LatentScale;
 use super::grad::images_loss_and_gradients;
+use super::latent_gp::LatentScale;
 use super::model::{
-    burn_loss_and_gradients, init_hypers, raw_gradient, raw_vector, sample_noise, set_raw_vector, Batch, Gradients, StepLoss,
+    burn_loss_and_gradients, init_hypers, raw_gradient, raw_vector, sample_noise, set_raw_vector, Batch, Gradients,
+    StepLoss,
 };
 use super::prediction::reward_errors;
 use super::vae::{encode_rows, VaeNet};
