@@ -186,33 +186,17 @@ pub fn line_plot(path: &Path, title: &str, x_label: &str, y_label: &str, series:
 }
 
 /// A line plot of curves that rise from the lower left and level off (errors against the prediction horizon):
-/// the legend goes to whichever corner the curves cross least, instead of over their right ends.
+/// the legend goes to whichever upper or lower-right corner the curves cross least, instead of over their
+/// right ends.
 pub fn rising_line_plot(path: &Path, title: &str, x_label: &str, y_label: &str, series: &[Series]) -> Result<()> {
     let y = bounds(series.iter().flat_map(|s| s.points.iter().map(|p| p.1)));
-    let x = bounds(series.iter().flat_map(|s| s.points.iter().map(|p| p.0)));
-    // The legend box covers roughly the outer 40 % of the width and 25 % of the height of its corner.
-    let inside = |(px, py): (f64, f64), right: bool, top: bool| {
-        let fx = (px - x.0) / (x.1 - x.0).max(f64::MIN_POSITIVE);
-        let fy = (py - y.0) / (y.1 - y.0).max(f64::MIN_POSITIVE);
-        (if right { fx > 0.6 } else { fx < 0.4 }) && (if top { fy > 0.75 } else { fy < 0.25 })
-    };
-    let corners = [
-        (SeriesLabelPosition::UpperLeft, false, true),
-        (SeriesLabelPosition::UpperRight, true, true),
-        (SeriesLabelPosition::LowerRight, true, false),
-    ];
-    let crossings = |right: bool, top: bool| {
-        series.iter().flat_map(|s| s.points.iter()).filter(|p| inside(**p, right, top)).count()
-    };
-    let legend = corners
-        .into_iter()
-        .min_by_key(|(_, right, top)| crossings(*right, *top))
-        .map(|(position, _, _)| position)
-        .unwrap_or(SeriesLabelPosition::UpperLeft);
+    use SeriesLabelPosition::{LowerRight, UpperLeft, UpperRight};
+    let legend = emptiest_legend_place(series, y, &[UpperLeft, UpperRight, LowerRight]);
     line_plot_legend_at(path, title, (x_label, y_label), series, y, legend)
 }
 
-/// A line plot on a fixed y range: rates in percent read wrong when the axis zooms in on 95-100.
+/// A line plot on a fixed y range: rates in percent read wrong when the axis zooms in on 95-100. The legend
+/// sits middle right unless the curves pass there (a swing-up settling at 0 rad), then where they pass least.
 pub fn line_plot_in(
     path: &Path,
     title: &str,
@@ -221,7 +205,35 @@ pub fn line_plot_in(
     series: &[Series],
     y: (f64, f64),
 ) -> Result<()> {
-    line_plot_legend_at(path, title, (x_label, y_label), series, y, SeriesLabelPosition::MiddleRight)
+    use SeriesLabelPosition::{LowerLeft, LowerRight, MiddleLeft, MiddleRight, UpperLeft, UpperRight};
+    let places = [MiddleRight, UpperRight, LowerRight, UpperLeft, LowerLeft, MiddleLeft];
+    let legend = emptiest_legend_place(series, y, &places);
+    line_plot_legend_at(path, title, (x_label, y_label), series, y, legend)
+}
+
+/// Of `places` (corners and middles of the chart), the first where the fewest points of `series` fall under
+/// the legend box, taken to cover the outer 40 % of the width and a quarter of the height at its place.
+fn emptiest_legend_place(series: &[Series], y: (f64, f64), places: &[SeriesLabelPosition]) -> SeriesLabelPosition {
+    use SeriesLabelPosition::{LowerLeft, LowerRight, MiddleLeft, MiddleRight, UpperLeft, UpperRight};
+    let x = bounds(series.iter().flat_map(|s| s.points.iter().map(|p| p.0)));
+    let fraction = |v: f64, (lo, hi): (f64, f64)| (v - lo) / (hi - lo).max(f64::MIN_POSITIVE);
+    let covered = |place: &SeriesLabelPosition, (px, py): (f64, f64)| {
+        let (fx, fy) = (fraction(px, x), fraction(py, y));
+        let (right, height) = match place {
+            UpperLeft => (false, 0.75..=1.0),
+            UpperRight => (true, 0.75..=1.0),
+            MiddleLeft => (false, 0.375..=0.625),
+            MiddleRight => (true, 0.375..=0.625),
+            LowerLeft => (false, 0.0..=0.25),
+            _ => (true, 0.0..=0.25),
+        };
+        (if right { fx > 0.6 } else { fx < 0.4 }) && height.contains(&fy)
+    };
+    let crossings = |place: &SeriesLabelPosition| {
+        series.iter().flat_map(|s| s.points.iter()).filter(|p| covered(place, **p)).count()
+    };
+    // min_by_key keeps the first of equal counts: the caller's order breaks ties.
+    places.iter().min_by_key(|place| crossings(place)).cloned().unwrap_or(LowerRight)
 }
 
 fn line_plot_legend_at(
@@ -798,6 +810,20 @@ mod tests {
             let in_column = rows.iter().any(|row| row[900..].contains(&colour));
             assert!(in_column, "series {k}'s sample line is in the legend column");
         }
+    }
+
+    #[test]
+    fn the_legend_goes_where_the_curves_are_not() {
+        use SeriesLabelPosition::{MiddleRight, UpperRight};
+        let series = |points: Vec<(f64, f64)>| vec![Series { name: "a".into(), points }];
+        let places = [MiddleRight, UpperRight];
+        let place = |points| format!("{:?}", emptiest_legend_place(&series(points), (-1.0, 1.0), &places));
+        // A swing-up settling at 0 on the right: the middle right is taken, the upper right is free.
+        let settling: Vec<(f64, f64)> = (0..50).map(|i| (i as f64, (-0.2 * i as f64).exp())).collect();
+        assert_eq!(place(settling), format!("{UpperRight:?}"));
+        // Curves that keep out of the middle right leave the legend at the first place.
+        let high: Vec<(f64, f64)> = (0..50).map(|i| (i as f64, 0.9)).collect();
+        assert_eq!(place(high), format!("{MiddleRight:?}"));
     }
 
     #[test]
