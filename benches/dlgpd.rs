@@ -6,9 +6,8 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use mbrl::models::dlgpd::data::ObservationKind;
-use mbrl::models::dlgpd::grad::images_loss_and_gradients;
 use mbrl::models::dlgpd::latent_gp::gp_terms;
-use mbrl::models::dlgpd::model::{sample_noise, Batch, Gradients};
+use mbrl::models::dlgpd::model::{loss_and_gradients, sample_noise, Batch, Gradients, Weights};
 use mbrl::models::dlgpd::vae::VaeNet;
 use mbrl::models::gp::{GpHypers, HyperInit};
 use mbrl::nn::tensor::training_device;
@@ -44,8 +43,16 @@ fn gp(c: &mut Criterion) {
     let noise = sample_noise(BATCH, 3, &mut rng);
     group.bench_function("whole_step_gradients_without_optimizer", |b| {
         b.iter(|| {
-            images_loss_and_gradients(&params, &transition, &reward, &batch, (&noise.0, &noise.1), Gradients::Wanted)
-                .unwrap()
+            loss_and_gradients(
+                Weights::Images(&params),
+                &transition,
+                &reward,
+                &batch,
+                (&noise.0, &noise.1),
+                Gradients::Wanted,
+                &device,
+            )
+            .unwrap()
         })
     });
     group.finish();

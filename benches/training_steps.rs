@@ -16,8 +16,7 @@ use mbrl::models::ball::learn::{train as train_ball, TrainSettings};
 use mbrl::models::context::config::{ContextConfig, EnvFamily, Preset as ContextPreset};
 use mbrl::models::context::ContextTrainer;
 use mbrl::models::dlgpd::data::ObservationKind;
-use mbrl::models::dlgpd::grad::images_loss_and_gradients;
-use mbrl::models::dlgpd::model::{sample_noise, Batch, Gradients};
+use mbrl::models::dlgpd::model::{loss_and_gradients, sample_noise, Batch, Gradients, Weights};
 use mbrl::models::dlgpd::vae::VaeNet;
 use mbrl::models::gp::{GpHypers, HyperInit};
 use mbrl::models::pets::data::Transitions;
@@ -101,8 +100,16 @@ fn dlgpd(rows: usize) -> Step {
     let batch = Batch { rows, obs: frames.clone(), next_obs: frames, actions, rewards };
     let noise = sample_noise(rows, 3, &mut rng);
     Box::new(move || {
-        images_loss_and_gradients(&params, &transition, &reward, &batch, (&noise.0, &noise.1), Gradients::Wanted)
-            .unwrap();
+        loss_and_gradients(
+            Weights::Images(&params),
+            &transition,
+            &reward,
+            &batch,
+            (&noise.0, &noise.1),
+            Gradients::Wanted,
+            &device,
+        )
+        .unwrap();
         None
     })
 }

@@ -13,6 +13,7 @@ use super::vae::VaeNet;
 use crate::error::{Error, Result};
 use crate::models::gp::{GpHypers, HyperInit, ObjectiveGradients};
 use crate::nn::tensor::{scalar, tensor, values};
+use crate::nn::ParamSet;
 
 /// A batch of transitions: observations and next observations as rows of the VAE's input (for images
 /// [rows, 6, side, side] flattened), actions [rows, A], rewards [rows].
@@ -75,10 +76,19 @@ pub enum Gradients {
     NotWanted,
 }
 
+/// The VAE a loss is taken with, as each path reads it.
+pub enum Weights<'a> {
+    /// The image VAE's parameters, which its hand-written path (`grad.rs`) reads in place: a trainer keeps
+    /// them outside the burn module, which need not be reloaded after every update.
+    Images(&'a ParamSet<f32>),
+    /// The angle VAE's burn module, which trains through burn's autodiff.
+    Angles(&'a VaeNet),
+}
+
 /// Loss (and, when wanted, gradients) of one batch. `noise` = the standard-normal draws of the current and
-/// next latents. The image VAE runs on its hand-written path (`grad.rs`); the angle VAE through burn.
+/// next latents.
 pub fn loss_and_gradients(
-    vae: &VaeNet,
+    weights: Weights<'_>,
     transition: &[GpHypers],
     reward: &GpHypers,
     batch: &Batch,
@@ -86,9 +96,9 @@ pub fn loss_and_gradients(
     gradients: Gradients,
     device: &Device,
 ) -> Result<StepLoss> {
-    match vae {
-        VaeNet::Images { .. } => images_loss_and_gradients(&vae.params(), transition, reward, batch, noise, gradients),
-        VaeNet::Angles(_) => burn_loss_and_gradients(vae, transition, reward, batch, noise, gradients, device),
+    match weights {
+        Weights::Images(params) => images_loss_and_gradients(params, transition, reward, batch, noise, gradients),
+        Weights::Angles(vae) => burn_loss_and_gradients(vae, transition, reward, batch, noise, gradients, device),
     }
 }
 
@@ -178,7 +188,7 @@ mod tests {
         let batch = Batch { rows: rows.len(), obs, next_obs, actions, rewards };
         let device = training_device();
         let mut rng = ChaCha8Rng::seed_from_u64(5);
-        let mut vae = VaeNet::init(kind, 3, 0, &device, &mut rng).unwrap();
+        let vae = VaeNet::init(kind, 3, 0, &device, &mut rng).unwrap();
         let mut params = vae.params();
         let sizes: Vec<usize> = params.tensors.iter().map(|t| t.values.len()).collect();
         let adam_config = |lr| AdamConfig {
@@ -205,7 +215,7 @@ mod tests {
         let mut losses = Vec::new();
         for _ in 0..8 {
             let step = loss_and_gradients(
-                &vae,
+                Weights::Images(&params),
                 &transition,
                 &reward,
                 &batch,
@@ -217,7 +227,6 @@ mod tests {
             losses.push(step.total);
             let mut grads = step.vae_gradients;
             vae_adam.update(&mut params.values_mut(), &mut grads).unwrap();
-            vae = vae.with_params(&params, &device).unwrap();
             for (k, g) in step.gp.d_hypers.iter().enumerate() {
                 let h = if k < 3 { &mut transition[k] } else { &mut reward };
                 let mut v = raw_vector(h);
