@@ -37,22 +37,15 @@ fn gp(c: &mut Criterion) {
     let device = training_device();
     // The weights as `train` holds them between steps: outside the module, read in place.
     let params = VaeNet::init(ObservationKind::Images { side: 64 }, 3, 0, &device, &mut rng).unwrap().params();
+    let weights = Weights::Images(&params);
     let pixels = BATCH * 6 * 64 * 64;
     let frames: Vec<f32> = (0..pixels).map(|i| ((i % 251) as f32) / 251.0).collect();
     let batch = Batch { rows: BATCH, obs: frames.clone(), next_obs: frames, actions, rewards: rewards.clone() };
     let noise = sample_noise(BATCH, 3, &mut rng);
     group.bench_function("whole_step_gradients_without_optimizer", |b| {
         b.iter(|| {
-            loss_and_gradients(
-                Weights::Images(&params),
-                &transition,
-                &reward,
-                &batch,
-                (&noise.0, &noise.1),
-                Gradients::Wanted,
-                &device,
-            )
-            .unwrap()
+            loss_and_gradients(weights, &transition, &reward, &batch, (&noise.0, &noise.1), Gradients::Wanted, &device)
+                .unwrap()
         })
     });
     group.finish();

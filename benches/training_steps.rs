@@ -100,16 +100,9 @@ fn dlgpd(rows: usize) -> Step {
     let batch = Batch { rows, obs: frames.clone(), next_obs: frames, actions, rewards };
     let noise = sample_noise(rows, 3, &mut rng);
     Box::new(move || {
-        loss_and_gradients(
-            Weights::Images(&params),
-            &transition,
-            &reward,
-            &batch,
-            (&noise.0, &noise.1),
-            Gradients::Wanted,
-            &device,
-        )
-        .unwrap();
+        let weights = Weights::Images(&params);
+        loss_and_gradients(weights, &transition, &reward, &batch, (&noise.0, &noise.1), Gradients::Wanted, &device)
+            .unwrap();
         None
     })
 }

@@ -77,6 +77,7 @@ pub enum Gradients {
 }
 
 /// The VAE a loss is taken with, as each path reads it.
+#[derive(Clone, Copy)]
 pub enum Weights<'a> {
     /// The image VAE's parameters, which its hand-written path (`grad.rs`) reads in place: a trainer keeps
     /// them outside the burn module, which need not be reloaded after every update.
