@@ -284,12 +284,12 @@ pub fn line_panels(path: &Path, title: &str, x_label: &str, panels: &[Panel]) ->
         _ => &[],
     };
     let legend_width = legend_column_width(legend);
-    let size = (900 + legend_width, 50 + 230 * rows as u32);
+    let size = (SIZE.0 + legend_width, 50 + 230 * rows as u32);
     render_atomic(path, |tmp| {
         let root = BitMapBackend::new(tmp, size).into_drawing_area();
         root.fill(&WHITE).map_err(|e| plot_err(path, e))?;
         let root = root.titled(title, ("sans-serif", 22)).map_err(|e| plot_err(path, e))?;
-        let (charts, legend_area) = root.split_horizontally(900);
+        let (charts, legend_area) = root.split_horizontally(SIZE.0);
         for (k, (area, panel)) in charts.split_evenly((rows, 1)).iter().zip(panels).enumerate() {
             let (y_label, series) = (&panel.y_label, &panel.series);
             let (y0, y1) =
@@ -319,14 +319,16 @@ pub fn line_panels(path: &Path, title: &str, x_label: &str, panels: &[Panel]) ->
     })
 }
 
-/// Legend text size in `line_panels`' column, and the width of one of its characters at most.
+/// Legend text size in `line_panels`' column, the width of one of its characters at most, and the longest
+/// name it shows (longer ones are cut).
 const LEGEND_FONT: u32 = 13;
 const LEGEND_CHAR_WIDTH: u32 = 8;
+const LEGEND_NAME_CHARS: usize = 24;
 
 /// The width of a legend column for `series`' names (none without series): a line sample, the longest name,
-/// margins; long names are cut to 24 characters.
+/// margins.
 fn legend_column_width(series: &[Series]) -> u32 {
-    let longest = series.iter().map(|s| s.name.chars().count().min(24) as u32).max();
+    let longest = series.iter().map(|s| s.name.chars().count().min(LEGEND_NAME_CHARS) as u32).max();
     longest.map_or(0, |chars| 44 + LEGEND_CHAR_WIDTH * chars)
 }
 
@@ -336,7 +338,7 @@ fn draw_legend_column(area: &DrawingArea<BitMapBackend<'_>, Shift>, path: &Path,
         let y = 16 + 20 * i as i32;
         let color = series_color(i);
         area.draw(&PathElement::new(vec![(6, y), (26, y)], color.stroke_width(2))).map_err(|e| plot_err(path, e))?;
-        let name: String = s.name.chars().take(24).collect();
+        let name: String = s.name.chars().take(LEGEND_NAME_CHARS).collect();
         let style = TextStyle::from(("sans-serif", LEGEND_FONT).into_font()).pos(Pos::new(HPos::Left, VPos::Center));
         area.draw(&Text::new(name, (32, y), style)).map_err(|e| plot_err(path, e))?;
     }
@@ -771,23 +773,9 @@ mod tests {
         assert_eq!(wrapped_angle_trace([(0.0, 0.5), (1.0, 7.0)]).len(), 2);
     }
 
-    /// (width, RGB rows) of a PNG this module drew.
-    fn decoded(path: &Path) -> (usize, Vec<Vec<[u8; 3]>>) {
-        let mut reader =
-            png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap())).read_info().unwrap();
-        let mut buffer = vec![0; reader.output_buffer_size().unwrap()];
-        let info = reader.next_frame(&mut buffer).unwrap();
-        assert_eq!(info.color_type, png::ColorType::Rgb);
-        let width = info.width as usize;
-        let rows = buffer[..info.buffer_size()]
-            .chunks(info.line_size)
-            .map(|row| row.chunks(3).take(width).map(|p| [p[0], p[1], p[2]]).collect())
-            .collect();
-        (width, rows)
-    }
-
     #[test]
     fn stacked_panels_keep_their_legend_beside_the_charts() {
+        use crate::util::png::decode_rgb;
         let dir = tempfile::tempdir().unwrap();
         let series = |count: usize| -> Vec<Series> {
             (0..count)
@@ -801,13 +789,14 @@ mod tests {
         let (three, one) = (dir.path().join("three.png"), dir.path().join("one.png"));
         line_panels(&three, "t", "time [s]", &[panel(3), panel(3)]).unwrap();
         line_panels(&one, "t", "time [s]", &[panel(1)]).unwrap();
-        assert_eq!(decoded(&one).0, 900, "no legend, no column");
-        let (width, rows) = decoded(&three);
-        assert_eq!(width as u32, 900 + legend_column_width(&series(3)));
+        let bytes = |path: &Path| std::fs::read(path).unwrap();
+        decode_rgb(&bytes(&one), SIZE.0, 50 + 230).expect("no legend, no column");
+        let width = SIZE.0 + legend_column_width(&series(3));
+        let pixels = decode_rgb(&bytes(&three), width, 50 + 2 * 230).unwrap();
+        let rows: Vec<&[u8]> = pixels.chunks(3 * width as usize).collect();
         for k in 0..3 {
             let c = series_color(k);
-            let colour = [c.0, c.1, c.2];
-            let in_column = rows.iter().any(|row| row[900..].contains(&colour));
+            let in_column = rows.iter().any(|row| row[3 * SIZE.0 as usize..].chunks(3).any(|p| p == [c.0, c.1, c.2]));
             assert!(in_column, "series {k}'s sample line is in the legend column");
         }
     }

@@ -212,16 +212,15 @@ impl DlgpdTrainer {
 
     /// The loss of `batch` (and its gradients when wanted) at the current weights.
     fn loss(&self, gps: &Gps, batch: &Batch, noise: (&[f32], &[f32]), gradients: Gradients) -> Result<StepLoss> {
-        let (transition, reward, device) = (&gps.transition, &gps.reward, &self.device);
-        match self.windows.kind {
-            ObservationKind::Images { .. } => {
-                loss_and_gradients(Weights::Images(&self.params), transition, reward, batch, noise, gradients, device)
-            }
+        let module;
+        let weights = match self.windows.kind {
+            ObservationKind::Images { .. } => Weights::Images(&self.params),
             ObservationKind::Angles => {
-                let vae = self.vae()?;
-                loss_and_gradients(Weights::Angles(&vae), transition, reward, batch, noise, gradients, device)
+                module = self.vae()?;
+                Weights::Angles(&module)
             }
-        }
+        };
+        loss_and_gradients(weights, &gps.transition, &gps.reward, batch, noise, gradients, &self.device)
     }
 
     fn batch(&self, rows: &[usize]) -> Batch {
