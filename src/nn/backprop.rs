@@ -10,6 +10,7 @@ use rayon::prelude::*;
 
 use super::gemm::{Finish, Kernel, Start};
 use super::params::ParamSet;
+use super::sparse::SparseColumns;
 use crate::error::{Error, Result};
 use crate::util::wide::widest_fn;
 
@@ -268,6 +269,26 @@ impl<'a> Dense<'a> {
             return Vec::new();
         }
         self.backward_input(dy, rows)
+    }
+
+    /// [`Dense::backward_through_relu`] for output gradients that are zero but at `dy`'s entries.
+    pub fn sparse_backward_through_relu(&self, x: &[f32], dy: &SparseColumns, grads: &mut [Vec<f32>]) -> Vec<f32> {
+        let (o, i) = (self.d_out, self.d_in);
+        assert_eq!((dy.rows() * i, dy.width()), (x.len(), o), "sparse backward: the gradients do not fit the layer");
+        let (weight_grad, bias_grad) = two_mut(grads, self.weight_index, self.bias_index);
+        if self.non_negative {
+            let mut acting = vec![0.0; o * i];
+            dy.add_transposed_product(x, i, &mut acting);
+            for ((g, a), w) in weight_grad.iter_mut().zip(&acting).zip(self.weight.iter()) {
+                if *w > 0.0 {
+                    *g += a;
+                }
+            }
+        } else {
+            dy.add_transposed_product(x, i, weight_grad);
+        }
+        dy.add_column_sums(bias_grad);
+        dy.product(&self.weight, i, Some(x))
     }
 
     /// [`Dense::backward`] with the input gradients taken on through the ReLU whose output `x` is: zero
@@ -558,6 +579,21 @@ impl<'a> TwoLayer<'a> {
     ) -> Vec<f32> {
         let d_hidden = self.second.backward_through_relu(&tape.hidden, d_out, rows, grads);
         self.first.backward(x, &d_hidden, rows, grads, want_dx)
+    }
+}
+
+impl TwoLayer<'_> {
+    /// [`TwoLayer::backward`] for output gradients that are zero but at `d_out`'s entries (a max pool's).
+    pub fn sparse_backward(
+        &self,
+        x: &[f32],
+        tape: &TwoLayerTape,
+        d_out: &SparseColumns,
+        grads: &mut [Vec<f32>],
+        want_dx: bool,
+    ) -> Vec<f32> {
+        let d_hidden = self.second.sparse_backward_through_relu(&tape.hidden, d_out, grads);
+        self.first.backward(x, &d_hidden, d_out.rows(), grads, want_dx)
     }
 }
 

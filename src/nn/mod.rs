@@ -24,6 +24,7 @@ pub mod linear;
 pub mod normalizer;
 pub mod params;
 pub mod pool;
+pub mod sparse;
 pub mod tensor;
 
 pub use activation::Activation;

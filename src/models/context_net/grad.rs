@@ -11,10 +11,11 @@ use super::net::{STD_FLOOR, STD_SCALE, STD_SHIFT, VARIANCE_FLOOR};
 use crate::error::{Error, Result};
 use crate::nn::activation::{fast_sigmoid as sigmoid, fast_softplus as softplus, fast_tanh as tanh};
 use crate::nn::backprop::{
-    add_column_sums, add_into, assume_written, block_rows, concat, copy_of, for_each_value, relu_backward, slots,
-    tensor_index, unwritten, zero_gradients, zip_values, TwoLayer, TwoLayerTape,
+    add_column_sums, add_into, assume_written, block_rows, concat, copy_of, for_each_value, slots, tensor_index,
+    unwritten, zero_gradients, zip_values, TwoLayer, TwoLayerTape,
 };
 use crate::nn::gru_backprop::Gru;
+use crate::nn::sparse::SparseColumns;
 use crate::nn::ParamSet;
 
 /// The loss and its parts (batch means), as [`super::net::LossParts`] reports them.
@@ -498,19 +499,17 @@ pub fn loss_and_gradients(
         }
     }
 
-    // Back through the pools to the transition features' maximizing rows.
-    let mut d_features = vec![0.0; enc_rows * f];
-    for k in 0..b * f {
-        let j = k % f;
-        if let Some(row) = chunk_arg[k] {
-            d_features[row * f + j] += d_chunk_pool[k];
-        }
-        if let Some(row) = context_arg[k] {
-            d_features[(b * t + row) * f + j] += d_context_pool[k];
+    // Back through the pools to the transition features' maximizing rows, the only ones with a gradient. A
+    // pooled maximum is positive, so the features' ReLU passes it. The chunks' rows come before the contexts'.
+    let mut d_features = SparseColumns::new(enc_rows, f);
+    for (args, d_pool, offset) in [(&chunk_arg, &d_chunk_pool, 0), (&context_arg, &d_context_pool, b * t)] {
+        for (k, (arg, d)) in args.iter().zip(d_pool.iter()).enumerate() {
+            if let Some(row) = arg {
+                d_features.push(offset + row, k % f, *d);
+            }
         }
     }
-    relu_backward(&mut d_features, &features);
-    net.transition_encoder.backward(&transitions, &enc_tape, &d_features, enc_rows, &mut grads, false);
+    net.transition_encoder.sparse_backward(&transitions, &enc_tape, &d_features, &mut grads, false);
 
     Ok((values, Some(grads)))
 }
