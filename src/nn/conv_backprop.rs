@@ -28,7 +28,7 @@ use super::backprop::{
     add_column_sums, add_into, assume_written, fill_with_row, matmul, relu_backward, relu_in_place, slots,
     tensor_index, unwritten, view, view_mut,
 };
-use super::gemm::{faer_product, widest_kernel};
+use super::gemm::Kernel;
 use super::params::ParamSet;
 use crate::error::{Error, Result};
 use crate::util::wide::widest_fn;
@@ -164,19 +164,7 @@ fn product(dst: MatMut<'_, f32>, accum: Accum, a: MatRef<'_, f32>, b: MatRef<'_,
     if split {
         matmul(dst, accum, a, b);
     } else {
-        faer_product(dst, accum, a, b);
-    }
-}
-
-/// dst += a · b for a weight gradient (small channels × window). A task's chunk on this thread gives windows
-/// of 1024 values or more to the AVX-512 kernel where there is one: on DLGPD's wide layers (64-1024 channels
-/// by 1024-3200 window values over a chunk's 200-400 rows) it ran 10-40 % faster than faer alone, and the
-/// batch-256 step 3 % faster. The choice depends on the layer's shape alone, not on the threads.
-fn weight_gradient_product(dst: MatMut<'_, f32>, a: MatRef<'_, f32>, b: MatRef<'_, f32>, split: bool) {
-    let wide = dst.ncols() >= 1024 && dst.nrows() >= 64;
-    match (wide && !split).then(|| widest_kernel(&dst, &a, &b)).flatten() {
-        Some(kernel) => kernel.product(dst, Accum::Add, a, b),
-        None => product(dst, Accum::Add, a, b, split),
+        Kernel::for_product(&dst, &a, &b).product(dst, accum, a, b);
     }
 }
 
@@ -361,8 +349,9 @@ impl StridedConv {
                 let col = &mut col[..rows * window];
                 // The small grid's values times the big grid's windows: the weight gradient in both directions.
                 g.gather(big_part, col, split);
-                weight_gradient_product(
+                product(
                     view_mut(&mut weight_grad, small, window),
+                    Accum::Add,
                     view(small_part, rows, small).transpose(),
                     view(col, rows, window),
                     split,
@@ -702,7 +691,11 @@ pub(crate) mod tests {
             let (a, b) = (view(&small_part, rows, 64).transpose(), view(&col, rows, 1024));
             #[cfg(target_arch = "x86_64")]
             if is_x86_feature_detected!("avx512f") {
-                assert!(widest_kernel(&dst, &a, &b).is_some(), "the AVX-512 kernel reads a task's weight gradient");
+                assert_ne!(
+                    Kernel::for_product(&dst, &a, &b),
+                    Kernel::Faer,
+                    "the AVX-512 kernel reads a task's weight gradient"
+                );
             }
             let _ = (dst, a, b);
             let (x, dy) = random_batch(&whole, images, &mut rng);

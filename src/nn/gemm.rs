@@ -7,8 +7,13 @@
 //! prefetches the next output tile and the next rows of the left operand while it works on the current ones,
 //! and which starts each tile from a bias row (or from a matrix the caller keeps) and ends it with a ReLU (or a
 //! ReLU's gradient mask) in cache: the passes that wrote the bias rows and applied the activation over every
-//! layer's output cost the context model's step as much again as the kernel saves. Elsewhere, and for products
-//! small enough to stay in cache, faer does the work, with the start and the finish as passes of their own.
+//! layer's output cost the context model's step as much again as the kernel saves.
+//!
+//! Products small enough to stay in cache went to faer until 2026-11-29: timed alone, with their operands hot,
+//! faer's kernels match this one or beat it by up to 10 %, but inside the training steps this one ran SAC's
+//! update 9-12 % faster and DLGPD's convolutions 1-7 % faster (interleaved A/B runs of the training-step
+//! bench). So every product this kernel reads goes to it; faer does the rest (outputs narrower than a vector,
+//! other layouts, machines without AVX-512), with the start and the finish as passes of their own.
 //!
 //! On either kernel every output element is one thread's sum in one order (on this one: its start, then
 //! k = 0, 1, … by fused multiply-adds), whatever the split of rows or columns around it, and the kernel is
@@ -17,10 +22,6 @@
 use faer::{Accum, MatMut, MatRef, Par};
 
 use crate::util::wide::clean_upper_state;
-
-/// Products whose three operands hold fewer values than this (2 MiB, a core's L2) are left to faer: they sit
-/// in cache, where faer's kernels are at least as fast.
-const MIN_VALUES: usize = 1 << 19;
 
 /// Outputs narrower than one vector are left to faer: the kernel would spend a 16-lane multiply-add on each
 /// of them (a VAE's 3-wide latent head).
@@ -109,17 +110,16 @@ pub enum Kernel {
 
 impl Kernel {
     pub fn for_product(dst: &MatMut<'_, f32>, a: &MatRef<'_, f32>, b: &MatRef<'_, f32>) -> Kernel {
-        let (m, n, k) = (dst.nrows(), dst.ncols(), a.ncols());
         #[cfg(target_arch = "x86_64")]
-        if n >= MIN_COLS && m * k + k * n + m * n >= MIN_VALUES && avx512::fits(dst, a, b) {
+        if dst.ncols() >= MIN_COLS && avx512::fits(dst, a, b) {
             return Kernel::Avx512;
         }
-        let _ = (m, n, k);
+        let _ = (dst, a, b);
         Kernel::Faer
     }
 
     /// dst (m × n) = [dst +] a (m × k) · b (k × n), sequentially. `self` must be `for_product` of this product
-    /// or of one it is a block of (rows or columns), or `widest_kernel` of it (a caller's choice by shape).
+    /// or of one it is a block of (rows or columns).
     pub fn product(self, dst: MatMut<'_, f32>, accum: Accum, a: MatRef<'_, f32>, b: MatRef<'_, f32>) {
         self.fused(dst, Start::of(accum), a, b, Finish::Store);
     }
@@ -253,18 +253,6 @@ fn finish_pass(mut dst: MatMut<'_, f32>, finish: Finish<'_>) {
             }
         }
     }
-}
-
-/// The AVX-512 kernel where this machine has it, it reads these layouts and the output is at least a vector
-/// wide, whatever the product's size: for callers that know a shape it runs faster than faer, or whose start
-/// and finish would be passes of their own on faer.
-pub fn widest_kernel(dst: &MatMut<'_, f32>, a: &MatRef<'_, f32>, b: &MatRef<'_, f32>) -> Option<Kernel> {
-    #[cfg(target_arch = "x86_64")]
-    if dst.ncols() >= MIN_COLS && avx512::fits(dst, a, b) {
-        return Some(Kernel::Avx512);
-    }
-    let _ = (dst, a, b);
-    None
 }
 
 /// Every kernel this machine runs, faer first: for tests that hold each of them to the same contract.
@@ -783,7 +771,7 @@ mod tests {
     #[test]
     fn matches_an_f64_product_for_every_layout_and_ragged_edge() {
         let mut rng = ChaCha8Rng::seed_from_u64(3);
-        // Operands past MIN_VALUES with a ragged last row block, columns with one- and two-vector tails, inner
+        // Operands with a ragged last row block, columns with one- and two-vector tails, inner
         // sizes across the 256 block, a weight gradient's shape (few rows, a long inner dimension), and an
         // output wide enough to be cut into column blocks.
         for &(m, n, k) in &[
@@ -940,8 +928,7 @@ mod tests {
         let (a, b) = (random(m, k, &mut rng), random(k, n, &mut rng));
         let mut whole = vec![0.0f32; m * n];
         let dst = MatMut::from_row_major_slice_mut(&mut whole, m, n);
-        // Chosen once for the whole product, as backprop::matmul chooses; the pieces are too small to be
-        // given the AVX-512 kernel on their own.
+        // Chosen once for the whole product, as backprop::matmul chooses.
         let kernel = Kernel::for_product(&dst, &a.as_ref(), &b.as_ref());
         assert_eq!(available_kernels().last(), Some(&kernel));
         kernel.product(dst, Accum::Replace, a.as_ref(), b.as_ref());

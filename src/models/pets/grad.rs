@@ -20,7 +20,7 @@ use crate::error::Result;
 use crate::nn::activation::{fast_exp, fast_sigmoid as sigmoid, fast_softplus as softplus, Activation};
 use crate::nn::adam::AdamStep;
 use crate::nn::backprop::{add_column_sums, tensor_index, view, view_mut, zero_gradients};
-use crate::nn::gemm::{faer_product, widest_kernel, Finish, Kernel, Start};
+use crate::nn::gemm::{faer_product, Finish, Kernel, Start};
 use crate::nn::{Adam, ParamSet};
 use crate::util::wide::widest_fn;
 
@@ -41,7 +41,7 @@ fn fused_here(
     b: faer::MatRef<'_, f32>,
     finish: Finish<'_>,
 ) {
-    let kernel = widest_kernel(&dst, &a, &b).unwrap_or(Kernel::Faer);
+    let kernel = Kernel::for_product(&dst, &a, &b);
     kernel.fused(dst, start, a, b, finish);
 }
 
