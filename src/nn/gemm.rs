@@ -10,8 +10,8 @@
 //! layer's output cost the context model's step as much again as the kernel saves.
 //!
 //! Products small enough to stay in cache went to faer until 2026-11-29: timed alone, with their operands hot,
-//! faer's kernels match this one or beat it by up to 10 %, but inside the training steps this one ran SAC's
-//! update 9-12 % faster and DLGPD's convolutions 1-7 % faster (interleaved A/B runs of the training-step
+//! the two kernels came within about 15 % of each other on SAC's and DLGPD's shapes, faer ahead on most, but
+//! inside the training steps this one ran SAC's update 9-12 % faster and DLGPD's convolutions 1-7 % faster (interleaved A/B runs of the training-step
 //! bench). So every product this kernel reads goes to it; faer does the rest (outputs narrower than a vector,
 //! other layouts, machines without AVX-512), with the start and the finish as passes of their own.
 //!

@@ -1,10 +1,10 @@
 //! Output gradients that are zero but at a few entries, and the two products a layer's backward pass takes of
 //! them. A max pool passes each set's gradient to the one row that won each feature: the context model's
 //! transition encoder sees about 2 % of its 50 000 × 128 output gradients nonzero at batch 512, and its dense
-//! backward (two 2.6-GFLOP products over those zeros) cost its training step 3 %.
+//! backward (two 2.6-GFLOP products over those zeros) was 3 % of its training step's FLOPs.
 //!
-//! Every sum runs in a fixed order (a column's entries by row, a row's by column) by fused multiply-adds, so the
-//! bytes do not depend on the thread count.
+//! Every sum runs in a fixed order (a column's entries by row, a row's by column), so the bytes do not depend
+//! on the thread count.
 
 use rayon::prelude::*;
 
