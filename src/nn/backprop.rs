@@ -245,14 +245,9 @@ impl<'a> Dense<'a> {
         let (o, i) = (self.d_out, self.d_in);
         let (weight_grad, bias_grad) = two_mut(grads, self.weight_index, self.bias_index);
         if self.non_negative {
-            // Only the positive raw weights act, so only they receive gradient (burn's ReLU backward).
             let mut acting = vec![0.0; o * i];
             matmul(view_mut(&mut acting, o, i), Accum::Replace, view(dy, rows, o).transpose(), view(x, rows, i));
-            for ((g, a), w) in weight_grad.iter_mut().zip(&acting).zip(self.weight.iter()) {
-                if *w > 0.0 {
-                    *g += a;
-                }
-            }
+            self.add_acting(weight_grad, &acting);
             add_column_sums(bias_grad, dy);
         } else {
             let (dst, a, b) = (view_mut(weight_grad, o, i), view(dy, rows, o).transpose(), view(x, rows, i));
@@ -271,6 +266,16 @@ impl<'a> Dense<'a> {
         self.backward_input(dy, rows)
     }
 
+    /// Adds a monotone layer's weight gradient where its raw weight acts: only the positive raw weights do,
+    /// so only they receive gradient (burn's ReLU backward).
+    fn add_acting(&self, weight_grad: &mut [f32], acting: &[f32]) {
+        for ((g, a), w) in weight_grad.iter_mut().zip(acting).zip(self.weight.iter()) {
+            if *w > 0.0 {
+                *g += a;
+            }
+        }
+    }
+
     /// [`Dense::backward_through_relu`] for output gradients that are zero but at `dy`'s entries.
     pub fn sparse_backward_through_relu(&self, x: &[f32], dy: &SparseColumns, grads: &mut [Vec<f32>]) -> Vec<f32> {
         let (o, i) = (self.d_out, self.d_in);
@@ -279,11 +284,7 @@ impl<'a> Dense<'a> {
         if self.non_negative {
             let mut acting = vec![0.0; o * i];
             dy.add_transposed_product(x, i, &mut acting);
-            for ((g, a), w) in weight_grad.iter_mut().zip(&acting).zip(self.weight.iter()) {
-                if *w > 0.0 {
-                    *g += a;
-                }
-            }
+            self.add_acting(weight_grad, &acting);
         } else {
             dy.add_transposed_product(x, i, weight_grad);
         }

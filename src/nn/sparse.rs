@@ -8,7 +8,7 @@
 
 use rayon::prelude::*;
 
-use crate::util::wide::widest_fn;
+use super::backprop::{relu_backward, zip_values};
 
 /// A rows × width matrix of which only the pushed entries are nonzero, kept by column.
 #[derive(Clone, Debug)]
@@ -72,7 +72,7 @@ impl SparseColumns {
         out.par_chunks_mut(d).zip(&self.columns).for_each(|(out, entries)| {
             for &(row, value) in entries {
                 let row = row as usize;
-                add_scaled(out, value, &x[row * d..(row + 1) * d]);
+                zip_values(out, &x[row * d..(row + 1) * d], |sum, x| *sum = value.mul_add(x, *sum));
             }
         });
     }
@@ -90,10 +90,10 @@ impl SparseColumns {
         out.par_chunks_mut(d).enumerate().with_min_len(64).for_each(|(row, out)| {
             for &(j, value) in &by_rows.entries[by_rows.starts[row]..by_rows.starts[row + 1]] {
                 let j = j as usize;
-                add_scaled(out, value, &w[j * d..(j + 1) * d]);
+                zip_values(out, &w[j * d..(j + 1) * d], |sum, w| *sum = value.mul_add(w, *sum));
             }
             if let Some(y) = relu_of {
-                out.iter_mut().zip(&y[row * d..(row + 1) * d]).for_each(|(g, y)| *g = if *y <= 0.0 { 0.0 } else { *g });
+                relu_backward(out, &y[row * d..(row + 1) * d]);
             }
         });
         out
@@ -127,13 +127,6 @@ struct ByRows {
     /// Row r's entries are entries[starts[r]..starts[r + 1]].
     starts: Vec<usize>,
     entries: Vec<(u32, f32)>,
-}
-
-widest_fn! {
-    /// dst += a · x element-wise, by fused multiply-adds.
-    fn add_scaled(dst: &mut [f32], a: f32, x: &[f32]) {
-        dst.iter_mut().zip(x).for_each(|(d, x)| *d = a.mul_add(*x, *d))
-    }
 }
 
 #[cfg(test)]
