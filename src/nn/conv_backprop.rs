@@ -28,7 +28,7 @@ use super::backprop::{
     add_column_sums, add_into, assume_written, fill_with_row, matmul, relu_backward, relu_in_place, slots,
     tensor_index, unwritten, view, view_mut,
 };
-use super::gemm::Kernel;
+use super::gemm::{packed_offset, Finish, Kernel, PackedRight, Start, PACKED_PANEL};
 use super::params::ParamSet;
 use crate::error::{Error, Result};
 use crate::util::wide::widest_fn;
@@ -119,6 +119,29 @@ impl Grids {
         })
     }
 
+    /// Whether a kernel row's values are whole panels of a packed right operand, so that windows can be
+    /// gathered straight into the kernel's packed layout.
+    fn windows_pack(&self) -> bool {
+        (self.kernel * self.big_channels).is_multiple_of(PACKED_PANEL)
+    }
+
+    /// im2col of `images` big-grid images, as [`Grids::gather`] lays it out but written where the GEMM kernel's
+    /// packing would put it ([`packed_offset`]), on this thread: the weight gradient then reads it without
+    /// copying it again. Only where [`Grids::windows_pack`].
+    fn gather_packed(&self, big: &[f32], packed: &mut [f32]) {
+        let (window, span) = (self.window(), self.kernel * self.big_channels);
+        let rows = packed.len() / window;
+        for (image, big) in big.chunks(self.big_len()).enumerate() {
+            for (col_at, big_at) in self.window_rows() {
+                let (row, first_col) = (image * self.positions() + col_at / window, col_at % window);
+                for piece in (0..span).step_by(PACKED_PANEL) {
+                    let to = packed_offset(rows, window, row, first_col + piece);
+                    packed[to..to + PACKED_PANEL].copy_from_slice(&big[big_at + piece..][..PACKED_PANEL]);
+                }
+            }
+        }
+    }
+
     /// The adjoint of [`Grids::gather_image`] for one image.
     fn scatter_add_image(&self, col: &[f32], big: &mut [f32]) {
         scatter_add_image_widest(self, col, big);
@@ -179,6 +202,8 @@ pub struct StridedConv {
     bias_index: usize,
     /// Images per im2col buffer.
     chunk: usize,
+    /// W̃ and W̃ᵀ packed once for the products that run chunk by chunk on one thread, where the kernel runs.
+    packed: Option<(PackedRight, PackedRight)>,
 }
 
 impl StridedConv {
@@ -194,10 +219,15 @@ impl StridedConv {
             Direction::Up => big,
         };
         let bias_index = tensor_index(params, &format!("{prefix}.bias"), &[out_channels])?;
+        let weight = channels_last(&params.tensors[weight_index].values, small, big, k * k);
+        let window = grids.window();
+        let packed = PackedRight::new(view(&weight, small, window))
+            .zip(PackedRight::new(view(&weight, small, window).transpose()));
         Ok(StridedConv {
             grids,
             direction,
-            weight: channels_last(&params.tensors[weight_index].values, small, big, k * k),
+            weight,
+            packed,
             bias: params.tensors[bias_index].values.clone(),
             weight_index,
             bias_index,
@@ -293,6 +323,17 @@ impl StridedConv {
     fn columns_times_weight(&self, col: &[f32], small: &mut [f32], accum: Accum, split: bool) {
         let (window, channels) = (self.grids.window(), self.grids.small_channels);
         let rows = small.len() / channels;
+        if let (false, Some((_, transposed))) = (split, &self.packed) {
+            let done = transposed.fused_product(
+                view_mut(small, rows, channels),
+                Start::of(accum),
+                view(col, rows, window),
+                Finish::Store,
+            );
+            if done.is_some() {
+                return;
+            }
+        }
         product(
             view_mut(small, rows, channels),
             accum,
@@ -308,13 +349,24 @@ impl StridedConv {
         let (window, channels) = (self.grids.window(), self.grids.small_channels);
         let rows = small.len() / channels;
         let col = &mut col[..rows * window];
-        product(
-            view_mut(col, rows, window),
-            Accum::Replace,
-            view(small, rows, channels),
-            view(&self.weight, channels, window),
-            split,
-        );
+        let packed = match (split, &self.packed) {
+            (false, Some((weight, _))) => weight.fused_product(
+                view_mut(col, rows, window),
+                Start::Zero,
+                view(small, rows, channels),
+                Finish::Store,
+            ),
+            _ => None,
+        };
+        if packed.is_none() {
+            product(
+                view_mut(col, rows, window),
+                Accum::Replace,
+                view(small, rows, channels),
+                view(&self.weight, channels, window),
+                split,
+            );
+        }
         self.grids.scatter_add(col, big, split);
     }
 
@@ -348,14 +400,27 @@ impl StridedConv {
                 let rows = small_part.len() / small;
                 let col = &mut col[..rows * window];
                 // The small grid's values times the big grid's windows: the weight gradient in both directions.
-                g.gather(big_part, col, split);
-                product(
-                    view_mut(&mut weight_grad, small, window),
-                    Accum::Add,
-                    view(small_part, rows, small).transpose(),
-                    view(col, rows, window),
-                    split,
-                );
+                // A convolution's windows serve only this product, so on one thread they are gathered straight
+                // into the kernel's packed layout; a transposed one's feed its input gradient too, by rows.
+                let mut packed_done = false;
+                if !split && self.direction == Direction::Down && self.packed.is_some() && g.windows_pack() {
+                    g.gather_packed(big_part, col);
+                    if let Some(windows) = PackedRight::from_packed(col, rows, window) {
+                        let dst = view_mut(&mut weight_grad, small, window);
+                        let a = view(small_part, rows, small).transpose();
+                        packed_done = windows.fused_product(dst, Start::Dst, a, Finish::Store).is_some();
+                    }
+                }
+                if !packed_done {
+                    g.gather(big_part, col, split);
+                    product(
+                        view_mut(&mut weight_grad, small, window),
+                        Accum::Add,
+                        view(small_part, rows, small).transpose(),
+                        view(col, rows, window),
+                        split,
+                    );
+                }
                 if dx.is_empty() {
                     continue;
                 }
@@ -708,6 +773,29 @@ pub(crate) mod tests {
                 })
             };
             assert!(on_threads(1) == on_threads(2), "{direction:?}: bytes depend on the threads");
+        }
+    }
+
+    /// Windows gathered straight into the kernel's packed layout hold each window's values where
+    /// `packed_offset` puts them: 588 rows (two whole blocks of the kernel's inner dimension and a partial
+    /// one), windows of four 128-value kernel rows.
+    #[test]
+    fn windows_gathered_packed_sit_where_the_kernel_packs_them() {
+        let grids = Grids::conv(30, 32, 64, 4, 2);
+        assert!(grids.windows_pack() && !Grids::conv(10, 3, 4, 4, 2).windows_pack());
+        let (images, window) = (3, grids.window());
+        let big: Vec<f32> = (0..images * grids.big_len()).map(|i| i as f32).collect();
+        let rows = images * grids.positions();
+        assert_eq!(rows, 588);
+        let mut col = vec![0.0; rows * window];
+        grids.gather(&big, &mut col, false);
+        let mut packed = vec![f32::NAN; rows * window];
+        grids.gather_packed(&big, &mut packed);
+        for row in 0..rows {
+            for first in (0..window).step_by(PACKED_PANEL) {
+                let at = packed_offset(rows, window, row, first);
+                assert_eq!(packed[at..at + PACKED_PANEL], col[row * window + first..][..PACKED_PANEL], "row {row}");
+            }
         }
     }
 

@@ -204,11 +204,13 @@ impl Kernel {
                     // SAFETY: `fits` checked that the CPU has AVX-512F and that the layouts are those the kernel
                     // reads; the start row and the ReLU output have the output's shape (asserted above), the
                     // ReLU output by rows.
-                    unsafe { avx512::product(dst, start, a, b, finish, row_sums) }
+                    unsafe { avx512::product(dst, start, a, avx512::Right::Matrix(b), finish, row_sums) }
                 } else {
                     // A ReLU output the tiles cannot read by rows: the mask as a pass of its own.
                     // SAFETY: as above, with no finish in the kernel.
-                    unsafe { avx512::product(dst.as_mut(), start, a, b, Finish::Store, row_sums) };
+                    unsafe {
+                        avx512::product(dst.as_mut(), start, a, avx512::Right::Matrix(b), Finish::Store, row_sums)
+                    };
                     finish_pass(dst, finish);
                 }
             }
@@ -223,6 +225,94 @@ impl Kernel {
 pub fn faer_product(dst: MatMut<'_, f32>, accum: Accum, a: MatRef<'_, f32>, b: MatRef<'_, f32>) {
     faer::linalg::matmul::matmul(dst, accum, a, b, 1.0f32, Par::Seq);
     clean_upper_state();
+}
+
+/// A right operand packed once for the AVX-512 kernel, for a product run many times over it (a convolution's
+/// weight, chunk after chunk of images): packing the weight for every chunk was a third of the kernel's
+/// packing in DLGPD's step.
+pub struct PackedRight<V = Vec<f32>> {
+    values: V,
+    k: usize,
+    n: usize,
+}
+
+/// Columns per panel of a packed right operand.
+pub const PACKED_PANEL: usize = 32;
+/// Rows per block of a packed right operand.
+const PACKED_ROWS: usize = 256;
+
+/// Where the values of row `row`, columns `col..col + PACKED_PANEL` (`col` a multiple of the panel), lie in a
+/// k × n right operand packed as [`PackedRight`] holds it: blocks of 256 rows, each block by panels.
+pub fn packed_offset(k: usize, n: usize, row: usize, col: usize) -> usize {
+    debug_assert!(row < k && col < n && col.is_multiple_of(PACKED_PANEL));
+    let (k0, panels) = (row - row % PACKED_ROWS, n.div_ceil(PACKED_PANEL));
+    let kc = (k - k0).min(PACKED_ROWS);
+    k0 * panels * PACKED_PANEL + (col / PACKED_PANEL) * kc * PACKED_PANEL + (row - k0) * PACKED_PANEL
+}
+
+impl PackedRight {
+    /// `b` packed, or `None` where the AVX-512 kernel does not run (that product then goes to faer with `b`).
+    pub fn new(b: MatRef<'_, f32>) -> Option<PackedRight> {
+        #[cfg(target_arch = "x86_64")]
+        if b.ncols() >= MIN_COLS && b.nrows() > 0 && b.row_stride() > 0 && b.col_stride() > 0 && avx512::has_avx512() {
+            // SAFETY: the CPU has AVX-512F (checked just above).
+            let values = unsafe { avx512::pack_whole(b) };
+            return Some(PackedRight { values, k: b.nrows(), n: b.ncols() });
+        }
+        let _ = b;
+        None
+    }
+}
+
+impl<'a> PackedRight<&'a [f32]> {
+    /// A k × n operand whose values the caller wrote where [`packed_offset`] puts them (n a whole number of
+    /// panels), or `None` where the AVX-512 kernel does not run.
+    pub fn from_packed(values: &'a [f32], k: usize, n: usize) -> Option<Self> {
+        assert!(n.is_multiple_of(PACKED_PANEL) && values.len() == k * n, "gemm: packed values of another shape");
+        #[cfg(target_arch = "x86_64")]
+        if n >= MIN_COLS && k > 0 && avx512::has_avx512() {
+            return Some(PackedRight { values, k, n });
+        }
+        None
+    }
+}
+
+impl<V: AsRef<[f32]>> PackedRight<V> {
+    /// dst = finish(start + a · self), sequentially on the AVX-512 kernel; `None` (nothing written) where the
+    /// kernel does not read this output or left operand.
+    pub fn fused_product(
+        &self,
+        dst: MatMut<'_, f32>,
+        start: Start<'_>,
+        a: MatRef<'_, f32>,
+        finish: Finish<'_>,
+    ) -> Option<()> {
+        assert!(
+            a.ncols() == self.k && dst.ncols() == self.n && dst.nrows() == a.nrows(),
+            "gemm: operand shapes do not fit"
+        );
+        if let Start::Row(row) = start {
+            assert_eq!(row.len(), self.n, "gemm: a start row needs one value per output column");
+        }
+        // The starts and finishes that need no matrix beside the output.
+        let plain = matches!((start, finish), (Start::Zero | Start::Dst | Start::Row(_), Finish::Store | Finish::Relu));
+        #[cfg(target_arch = "x86_64")]
+        if plain && avx512::fits_left(&dst, &a) {
+            let view = avx512::PackedView {
+                values: self.values.as_ref(),
+                panels: self.n.div_ceil(PACKED_PANEL),
+                first_panel: 0,
+                k: self.k,
+                n: self.n,
+            };
+            // SAFETY: the kernel runs here and reads these layouts (checked above); the packed operand has the
+            // product's shape and a start row n values (asserted).
+            unsafe { avx512::product(dst, start, a, avx512::Right::Packed(view), finish, None) };
+            return Some(());
+        }
+        let _ = (dst, start, a, finish);
+        None
+    }
 }
 
 /// sums[i] += Σ_k a[i, k], in order of k.
@@ -276,29 +366,97 @@ mod avx512 {
     use super::{Finish, Start};
 
     /// Output columns per kernel call: two 16-lane vectors.
-    const NR: usize = 32;
+    const NR: usize = super::PACKED_PANEL;
     /// Output rows per kernel call: 12 × 2 accumulators leave registers for the right operand's two vectors and
     /// the broadcast.
     const MR: usize = 12;
     /// Inner-dimension block: one block of the right operand, packed, stays in the core's L2.
-    const KC: usize = 256;
+    const KC: usize = super::PACKED_ROWS;
     /// Widest column block: a packed KC × NC block of the right operand (768 KiB) stays in L2 beside the
     /// rows of `a` it meets. Wider outputs (a transposed convolution's 3200 columns) are cut into equal
     /// blocks; streaming a 3 MiB block from L3 for every 12 rows cost those products a third of their speed.
     const NC: usize = 768;
 
-    fn has_avx512() -> bool {
+    pub(super) fn has_avx512() -> bool {
         static DETECTED: OnceLock<bool> = OnceLock::new();
         *DETECTED.get_or_init(|| is_x86_feature_detected!("avx512f"))
+    }
+
+    /// The right operand of a product: a matrix the kernel packs block by block, or one packed before.
+    #[derive(Clone, Copy)]
+    pub(super) enum Right<'a> {
+        Matrix(MatRef<'a, f32>),
+        Packed(PackedView<'a>),
+    }
+
+    /// Columns `first_panel · NR..` (`n` of them) of a [`super::PackedRight`].
+    #[derive(Clone, Copy)]
+    pub(super) struct PackedView<'a> {
+        pub values: &'a [f32],
+        /// Panels of the whole operand: a block of k rows spans all of them.
+        pub panels: usize,
+        pub first_panel: usize,
+        pub k: usize,
+        pub n: usize,
+    }
+
+    impl Right<'_> {
+        fn nrows(&self) -> usize {
+            match self {
+                Right::Matrix(b) => b.nrows(),
+                Right::Packed(view) => view.k,
+            }
+        }
+
+        fn ncols(&self) -> usize {
+            match self {
+                Right::Matrix(b) => b.ncols(),
+                Right::Packed(view) => view.n,
+            }
+        }
+
+        /// Columns j0..j0 + cols; a packed operand is cut at whole panels only.
+        fn subcols(self, j0: usize, cols: usize) -> Self {
+            match self {
+                Right::Matrix(b) => Right::Matrix(b.subcols(j0, cols)),
+                Right::Packed(view) => {
+                    assert!(j0.is_multiple_of(NR) && j0 + cols <= view.n, "gemm: a packed operand cut inside a panel");
+                    Right::Packed(PackedView { first_panel: view.first_panel + j0 / NR, n: cols, ..view })
+                }
+            }
+        }
+    }
+
+    /// `b` as the kernel reads its blocks: [k block][panel][kc][NR], every block of KC rows but the last.
+    #[target_feature(enable = "avx512f")]
+    pub(super) unsafe fn pack_whole(b: MatRef<'_, f32>) -> Vec<f32> {
+        let (k, panels) = (b.nrows(), b.ncols().div_ceil(NR));
+        let mut values = vec![0.0; k * panels * NR];
+        for k0 in (0..k).step_by(KC) {
+            let kc = (k - k0).min(KC);
+            // SAFETY: the caller guarantees AVX-512F; the block holds kc rows of every panel.
+            unsafe { pack(b, k0, kc, &mut values[k0 * panels * NR..][..kc * panels * NR]) };
+        }
+        values
+    }
+
+    /// Whether the kernel reads a product with this output and left operand (its right operand packed).
+    pub(super) fn fits_left(dst: &MatMut<'_, f32>, a: &MatRef<'_, f32>) -> bool {
+        let unit_a = a.row_stride() == 1 || a.col_stride() == 1;
+        let rows_of_dst = dst.col_stride() == 1 && dst.row_stride() >= dst.ncols() as isize;
+        has_avx512()
+            && unit_a
+            && rows_of_dst
+            && a.row_stride() > 0
+            && a.col_stride() > 0
+            && dst.ncols() > 0
+            && a.ncols() > 0
     }
 
     /// The layouts the kernel reads: `dst` written by rows (which its masked stores need), `a` with a unit
     /// stride along one axis (it reads `a` by rows in place and packs it by columns), positive strides.
     pub(super) fn fits(dst: &MatMut<'_, f32>, a: &MatRef<'_, f32>, b: &MatRef<'_, f32>) -> bool {
-        let unit_a = a.row_stride() == 1 || a.col_stride() == 1;
-        let rows_of_dst = dst.col_stride() == 1 && dst.row_stride() >= dst.ncols() as isize;
-        let strides_positive = a.row_stride() > 0 && a.col_stride() > 0 && b.row_stride() > 0 && b.col_stride() > 0;
-        has_avx512() && unit_a && rows_of_dst && strides_positive && dst.ncols() > 0 && a.ncols() > 0
+        fits_left(dst, a) && b.row_stride() > 0 && b.col_stride() > 0
     }
 
     /// # Safety
@@ -310,12 +468,15 @@ mod avx512 {
         dst: MatMut<'_, f32>,
         start: Start<'_>,
         a: MatRef<'_, f32>,
-        b: MatRef<'_, f32>,
+        b: Right<'_>,
         finish: Finish<'_>,
         mut row_sums: Option<&mut [f32]>,
     ) {
         let (m, n, k) = (dst.nrows(), dst.ncols(), a.ncols());
         assert!(a.nrows() == m && b.nrows() == k && b.ncols() == n, "gemm: operand shapes do not fit");
+        if let Right::Packed(packed) = b {
+            assert!(packed.values.len() >= k * packed.panels * NR, "gemm: a packed operand shorter than its shape");
+        }
         let column_blocks = n.div_ceil(NC);
         if column_blocks > 1 {
             // Every element still sums its start and then k in order, in the same KC blocks: cutting the
@@ -340,7 +501,9 @@ mod avx512 {
         // Lanes of the last panel past the output's last column hold zeros or values of an earlier block or
         // product: they feed only accumulator lanes that the masked stores leave out.
         let (mut packed, mut a_block) = PACKING_BUFFERS.take();
-        grow(&mut packed, panels * KC.min(k) * NR);
+        if let Right::Matrix(_) = b {
+            grow(&mut packed, panels * KC.min(k) * NR);
+        }
         // `a` stored by rows is read in place, its 12 rows' values consecutive along k. Stored by columns (a
         // weight gradient's dYᵀ), its row block is packed as [k][row]: read in place, each k's 12 values sit
         // on lines of their own, which crowd the right operand's panel out of L1 (8 % slower).
@@ -352,7 +515,15 @@ mod avx512 {
         for k0 in (0..k).step_by(KC) {
             let kc = (k - k0).min(KC);
             // SAFETY: the caller guarantees AVX-512F.
-            unsafe { pack(b, k0, kc, &mut packed) };
+            let b_block = match b {
+                Right::Matrix(b) => {
+                    // SAFETY: the caller guarantees AVX-512F.
+                    unsafe { pack(b, k0, kc, &mut packed) };
+                    packed.as_ptr()
+                }
+                // Blocks before k0 hold KC rows of every panel; this one kc rows of each.
+                Right::Packed(right) => right.values[k0 * right.panels * NR + right.first_panel * kc * NR..].as_ptr(),
+            };
             // The start applies to the first block of the inner dimension, the finish to the last.
             // A `Matrix` start is read as the output is on later blocks: from a tile of rows `lds` apart.
             let (begin, row, start_at, lds) = match start {
@@ -407,7 +578,7 @@ mod avx512 {
                     let call = Call {
                         a: a_rows,
                         lda,
-                        b: unsafe { packed.as_ptr().add(p * kc * NR) },
+                        b: unsafe { b_block.add(p * kc * NR) },
                         kc,
                         c: tile,
                         ldc,
@@ -879,6 +1050,50 @@ mod tests {
                 assert!(from_rows[7].is_nan(), "{kernel:?}: the start matrix's NaN is kept");
                 let same_bits = from_rows.iter().zip(&from_columns).all(|(r, c)| r.to_bits() == c.to_bits());
                 assert!(same_bits, "{kernel:?}: a start by columns gives the bytes of one by rows");
+            }
+        }
+    }
+
+    #[test]
+    fn packed_right_operands_give_the_bytes_of_the_kernels_own_packing() {
+        let kernel = *available_kernels().last().unwrap();
+        if kernel == Kernel::Faer {
+            eprintln!("skipped: no AVX-512 here; packed operands exist only for that kernel");
+            assert!(PackedRight::new(Mat::<f32>::zeros(4, 32).as_ref()).is_none());
+            return;
+        }
+        let mut rng = ChaCha8Rng::seed_from_u64(8);
+        // Ragged rows, two blocks of k (256 + 44) and, at 1600 columns, a cut into column blocks.
+        for (m, k, n) in [(37, 300, 64), (25, 40, 1600), (13, 256, 48)] {
+            for a_rows in [true, false] {
+                let (a, b) = (random(m, k, &mut rng), random(k, n, &mut rng));
+                let a_stored = stored(&a, a_rows);
+                let a_view = if a_rows { a_stored.transpose() } else { a_stored.as_ref() };
+                let start: Vec<f32> = (0..m * n).map(|_| rng.random_range(-1.0..1.0)).collect();
+                let mut expected = start.clone();
+                let dst = MatMut::from_row_major_slice_mut(&mut expected, m, n);
+                kernel.product(dst, Accum::Add, a_view, b.as_ref());
+                let packed = PackedRight::new(b.as_ref()).expect("AVX-512 is here");
+                let mut got = start.clone();
+                let dst = MatMut::from_row_major_slice_mut(&mut got, m, n);
+                packed.fused_product(dst, Start::Dst, a_view, Finish::Store).expect("the kernel reads these layouts");
+                let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&got), bits(&expected), "{m}×{k}×{n}, a rows {a_rows}: packed once");
+                if n.is_multiple_of(PACKED_PANEL) {
+                    // The same operand written value by value where packed_offset puts it.
+                    let mut values = vec![f32::NAN; k * n];
+                    for row in 0..k {
+                        for col in (0..n).step_by(PACKED_PANEL) {
+                            let at = packed_offset(k, n, row, col);
+                            (0..PACKED_PANEL).for_each(|t| values[at + t] = b[(row, col + t)]);
+                        }
+                    }
+                    let written = PackedRight::from_packed(&values, k, n).expect("AVX-512 is here");
+                    let mut got = start.clone();
+                    let dst = MatMut::from_row_major_slice_mut(&mut got, m, n);
+                    written.fused_product(dst, Start::Dst, a_view, Finish::Store).expect("the kernel reads these");
+                    assert_eq!(bits(&got), bits(&expected), "{m}×{k}×{n}, a rows {a_rows}: packed by the caller");
+                }
             }
         }
     }
