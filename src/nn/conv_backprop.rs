@@ -23,6 +23,7 @@ use faer::{Accum, MatMut, MatRef};
 use rayon::prelude::*;
 
 use std::mem::MaybeUninit;
+use std::sync::OnceLock;
 
 use super::backprop::{
     add_column_sums, add_into, assume_written, fill_with_row, matmul, relu_backward, relu_in_place, slots,
@@ -202,8 +203,11 @@ pub struct StridedConv {
     bias_index: usize,
     /// Images per im2col buffer.
     chunk: usize,
-    /// W̃ and W̃ᵀ packed once for the products that run chunk by chunk on one thread, where the kernel runs.
-    packed: Option<(PackedRight, PackedRight)>,
+    /// W̃ and W̃ᵀ packed for the products that run chunk by chunk on one thread (`None` inside where the
+    /// kernel does not run), each on first use: a layer whose chunks run in turn, split over the pool, never
+    /// reads them, and packing the decoder's first layer (3.3 M values each way) on one thread cost a step at
+    /// two threads 2 %.
+    packed: [OnceLock<Option<PackedRight>>; 2],
 }
 
 impl StridedConv {
@@ -219,20 +223,26 @@ impl StridedConv {
             Direction::Up => big,
         };
         let bias_index = tensor_index(params, &format!("{prefix}.bias"), &[out_channels])?;
-        let weight = channels_last(&params.tensors[weight_index].values, small, big, k * k);
-        let window = grids.window();
-        let packed = PackedRight::new(view(&weight, small, window))
-            .zip(PackedRight::new(view(&weight, small, window).transpose()));
         Ok(StridedConv {
             grids,
             direction,
-            weight,
-            packed,
+            weight: channels_last(&params.tensors[weight_index].values, small, big, k * k),
+            packed: [OnceLock::new(), OnceLock::new()],
             bias: params.tensors[bias_index].values.clone(),
             weight_index,
             bias_index,
             chunk: grids.chunk_images(),
         })
+    }
+
+    /// W̃ (`transposed` false) or W̃ᵀ, packed for the kernel, or `None` where it does not run.
+    fn packed_weight(&self, transposed: bool) -> Option<&PackedRight> {
+        let (small, window) = (self.grids.small_channels, self.grids.window());
+        let packed = self.packed[transposed as usize].get_or_init(|| {
+            let weight = view(&self.weight, small, window);
+            PackedRight::new(if transposed { weight.transpose() } else { weight })
+        });
+        packed.as_ref()
     }
 
     pub fn input_len(&self) -> usize {
@@ -323,14 +333,11 @@ impl StridedConv {
     fn columns_times_weight(&self, col: &[f32], small: &mut [f32], accum: Accum, split: bool) {
         let (window, channels) = (self.grids.window(), self.grids.small_channels);
         let rows = small.len() / channels;
-        if let (false, Some((_, transposed))) = (split, &self.packed) {
-            let done = transposed.fused_product(
-                view_mut(small, rows, channels),
-                Start::of(accum),
-                view(col, rows, window),
-                Finish::Store,
-            );
-            if done.is_some() {
+        // On one thread, the weight as packed once per step (split over the pool, each piece packs its own).
+        let packed = if split { None } else { self.packed_weight(true) };
+        if let Some(transposed) = packed {
+            let dst = view_mut(small, rows, channels);
+            if transposed.fused_product(dst, Start::of(accum), view(col, rows, window), Finish::Store).is_some() {
                 return;
             }
         }
@@ -349,15 +356,10 @@ impl StridedConv {
         let (window, channels) = (self.grids.window(), self.grids.small_channels);
         let rows = small.len() / channels;
         let col = &mut col[..rows * window];
-        let packed = match (split, &self.packed) {
-            (false, Some((weight, _))) => weight.fused_product(
-                view_mut(col, rows, window),
-                Start::Zero,
-                view(small, rows, channels),
-                Finish::Store,
-            ),
-            _ => None,
-        };
+        let packed = if split { None } else { self.packed_weight(false) };
+        let dst = view_mut(col, rows, window);
+        let packed = packed
+            .and_then(|weight| weight.fused_product(dst, Start::Zero, view(small, rows, channels), Finish::Store));
         if packed.is_none() {
             product(
                 view_mut(col, rows, window),
@@ -403,7 +405,7 @@ impl StridedConv {
                 // A convolution's windows serve only this product, so on one thread they are gathered straight
                 // into the kernel's packed layout; a transposed one's feed its input gradient too, by rows.
                 let mut packed_done = false;
-                if !split && self.direction == Direction::Down && self.packed.is_some() && g.windows_pack() {
+                if !split && self.direction == Direction::Down && g.windows_pack() {
                     g.gather_packed(big_part, col);
                     if let Some(windows) = PackedRight::from_packed(col, rows, window) {
                         let dst = view_mut(&mut weight_grad, small, window);
