@@ -183,12 +183,24 @@ widest_fn! {
     }
 }
 
-/// dst [+]= a · b: split over the pool (as [`matmul`] splits it) or on this thread.
-fn product(dst: MatMut<'_, f32>, accum: Accum, a: MatRef<'_, f32>, b: MatRef<'_, f32>, split: bool) {
+/// dst [+]= a · b: split over the pool (as [`matmul`] splits it) or on this thread, where on this thread
+/// `packed` (b packed once for the kernel) is read instead of packing b again.
+fn product(
+    dst: MatMut<'_, f32>,
+    accum: Accum,
+    a: MatRef<'_, f32>,
+    b: MatRef<'_, f32>,
+    packed: Option<&PackedRight>,
+    split: bool,
+) {
     if split {
         matmul(dst, accum, a, b);
     } else {
-        Kernel::for_product(&dst, &a, &b).product(dst, accum, a, b);
+        let mut dst = dst;
+        let done = packed.and_then(|packed| packed.fused_product(dst.as_mut(), Start::of(accum), a, Finish::Store));
+        if done.is_none() {
+            Kernel::for_product(&dst, &a, &b).product(dst, accum, a, b);
+        }
     }
 }
 
@@ -335,17 +347,12 @@ impl StridedConv {
         let rows = small.len() / channels;
         // On one thread, the weight as packed once per step (split over the pool, each piece packs its own).
         let packed = if split { None } else { self.packed_weight(true) };
-        if let Some(transposed) = packed {
-            let dst = view_mut(small, rows, channels);
-            if transposed.fused_product(dst, Start::of(accum), view(col, rows, window), Finish::Store).is_some() {
-                return;
-            }
-        }
         product(
             view_mut(small, rows, channels),
             accum,
             view(col, rows, window),
             view(&self.weight, channels, window).transpose(),
+            packed,
             split,
         );
     }
@@ -357,18 +364,8 @@ impl StridedConv {
         let rows = small.len() / channels;
         let col = &mut col[..rows * window];
         let packed = if split { None } else { self.packed_weight(false) };
-        let dst = view_mut(col, rows, window);
-        let packed = packed
-            .and_then(|weight| weight.fused_product(dst, Start::Zero, view(small, rows, channels), Finish::Store));
-        if packed.is_none() {
-            product(
-                view_mut(col, rows, window),
-                Accum::Replace,
-                view(small, rows, channels),
-                view(&self.weight, channels, window),
-                split,
-            );
-        }
+        let (a, b) = (view(small, rows, channels), view(&self.weight, channels, window));
+        product(view_mut(col, rows, window), Accum::Replace, a, b, packed, split);
         self.grids.scatter_add(col, big, split);
     }
 
@@ -420,6 +417,7 @@ impl StridedConv {
                         Accum::Add,
                         view(small_part, rows, small).transpose(),
                         view(col, rows, window),
+                        None,
                         split,
                     );
                 }

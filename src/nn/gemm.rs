@@ -514,7 +514,6 @@ mod avx512 {
         }
         for k0 in (0..k).step_by(KC) {
             let kc = (k - k0).min(KC);
-            // SAFETY: the caller guarantees AVX-512F.
             let b_block = match b {
                 Right::Matrix(b) => {
                     // SAFETY: the caller guarantees AVX-512F.
