@@ -34,6 +34,12 @@ pub struct Batch {
 
 impl Batch {
     pub fn new(chunks: &[&Chunk], with_launcher: bool, device: &Device) -> Result<Batch> {
+        Batch::part_of(chunks, chunks.len(), with_launcher, device)
+    }
+
+    /// `chunks` as one part of a batch of `batch_size` chunks: the weights divide by the whole batch's size, so
+    /// the parts' losses (and gradients) add up to the whole batch's.
+    pub fn part_of(chunks: &[&Chunk], batch_size: usize, with_launcher: bool, device: &Device) -> Result<Batch> {
         let b = chunks.len();
         let steps = chunks.first().map_or(0, |c| c.slots.len());
         if b == 0 || chunks.iter().any(|c| c.slots.len() != steps) {
@@ -45,7 +51,7 @@ impl Batch {
         let measurements = (0..steps).map(|t| rows(&|c: &Chunk| c.slots[t].unwrap_or([0.0; 3]))).collect();
         let mut weights = Vec::with_capacity(b * steps);
         for c in chunks {
-            let share = 1.0 / (c.measured().max(1) * b) as f64;
+            let share = 1.0 / (c.measured().max(1) * batch_size.max(b)) as f64;
             weights.extend(c.slots.iter().map(|s| if s.is_some() { share } else { 0.0 }));
         }
         let launcher = if with_launcher { Some(launcher_inputs(chunks, device)?) } else { None };

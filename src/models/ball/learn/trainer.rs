@@ -3,6 +3,7 @@
 
 use burn::tensor::Device;
 use rand::seq::SliceRandom;
+use rayon::prelude::*;
 
 use super::batch::Batch;
 use super::chunks::{cut_chunks, Chunk};
@@ -13,7 +14,7 @@ use super::spin_net::{SpinNet, SpinNetWeights};
 use super::train::TrainSettings;
 use crate::data::ball_io::Recording;
 use crate::error::{Error, Result};
-use crate::models::ball::BallModelParams;
+use crate::models::ball::{BallModelParams, BallPhysics};
 use crate::nn::params::ParamSet;
 use crate::nn::Adam;
 use crate::train::{state, StoredTensor, TrainingMethod};
@@ -87,16 +88,68 @@ impl BallEkfTrainer {
     }
 }
 
+/// One run of a batch's chunks: its share of the loss, and its gradients where that share is finite.
+struct PartLoss {
+    value: f64,
+    grads: Option<Vec<Vec<f64>>>,
+}
+
+fn part_loss(
+    module: &BallParamsModule,
+    chunks: &[&Chunk],
+    batch_size: usize,
+    launcher: bool,
+    physics: &BallPhysics,
+    device: &Device,
+) -> Result<PartLoss> {
+    let batch = Batch::part_of(chunks, batch_size, launcher, device)?;
+    let loss = chunk_loss(module, &batch, physics, device)?;
+    let value: f64 = loss.clone().into_scalar();
+    let grads = value.is_finite().then(|| ParamSet::<f64>::gradients(module, &loss.backward()));
+    Ok(PartLoss { value, grads })
+}
+
 impl TrainingMethod for BallEkfTrainer {
     fn step(&mut self, step: u64) -> Result<f64> {
         let picked: Vec<&Chunk> = self.batch(step).into_iter().map(|i| &self.chunks[i]).collect();
-        let batch = Batch::new(&picked, self.settings.launcher_prior, &self.device)?;
-        let loss = chunk_loss(self.module(), &batch, &self.settings.initial.physics, &self.device)?;
-        let value: f64 = loss.clone().into_scalar();
-        if !value.is_finite() {
-            return Ok(value);
+        let launcher = self.settings.launcher_prior;
+        let (physics, device) = (&self.settings.initial.physics, &self.device);
+        // burn's graph for a batch is a few thousand small tensor operations, about a third of whose time does
+        // not shrink with the batch; on more threads the batch is cut into one run of chunks per thread, each
+        // its own graph over its own copy of the parameters, and the runs' losses and gradients are added in
+        // run order. The sums' order depends on the thread count, so the bytes do too, as for every training.
+        let runs = rayon::current_num_threads().clamp(1, picked.len().max(1));
+        let parts: Vec<Result<PartLoss>> = if runs == 1 {
+            vec![part_loss(self.module(), &picked, picked.len(), launcher, physics, device)]
+        } else {
+            let (module, params) = (self.module(), &self.params);
+            (0..runs)
+                .into_par_iter()
+                .map(|run| {
+                    let chunks = &picked[picked.len() * run / runs..picked.len() * (run + 1) / runs];
+                    let own = params.load_into(module.clone(), device)?;
+                    part_loss(&own, chunks, picked.len(), launcher, physics, device)
+                })
+                .collect()
+        };
+        let mut value = 0.0;
+        let mut total: Option<Vec<Vec<f64>>> = None;
+        for part in parts {
+            let part = part?;
+            value += part.value;
+            let Some(grads) = part.grads else { continue };
+            match &mut total {
+                None => total = Some(grads),
+                Some(total) => {
+                    for (sum, add) in total.iter_mut().zip(&grads) {
+                        sum.iter_mut().zip(add).for_each(|(s, a)| *s += a);
+                    }
+                }
+            }
         }
-        let mut grads = ParamSet::<f64>::gradients(self.module(), &loss.backward());
+        let Some(mut grads) = total.filter(|_| value.is_finite()) else {
+            return Ok(value);
+        };
         self.adam.update(&mut self.params.values_mut(), &mut grads)?;
         self.load()?;
         Ok(value)

@@ -147,3 +147,30 @@ fn bad_input_is_a_clear_error() {
     assert!(msg(&[no_side], &launcher).contains("side information"));
     assert!(msg(&good, &TrainSettings { learning_rate: f64::NAN, ..settings }).contains("learning_rate"));
 }
+
+/// On more threads a batch runs as one graph per run of chunks (the trainer's `runs`): the runs' losses and
+/// gradients must add up to the whole batch's, and a given thread count must give the same bytes every time.
+#[test]
+fn runs_of_a_batch_on_more_threads_add_up_to_the_whole_batch() {
+    let recs = recordings(3, 2);
+    let settings = TrainSettings { steps: 4, batch_size: 5, seed: 3, ..TrainSettings::default() };
+    let on = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| train(&recs, &settings, &NullMonitor).unwrap())
+    };
+    let one = on(1);
+    for threads in [2, 3] {
+        let many = on(threads);
+        assert_eq!(many, on(threads), "{threads} threads, run twice");
+        for (a, b) in one.losses.iter().zip(&many.losses) {
+            assert!((a - b).abs() <= 1e-12 * a.abs().max(1.0), "{threads} threads: loss {b} against {a}");
+        }
+        let (a, b) = (one.params.a_d0, many.params.a_d0);
+        assert!((a - b).abs() <= 1e-10 * a.abs(), "{threads} threads: a_d0 {b} against {a}");
+        for (row_a, row_b) in one.params.c.iter().zip(&many.params.c) {
+            for (a, b) in row_a.iter().zip(row_b) {
+                assert!((a - b).abs() <= 1e-10 * a.abs().max(1e-3), "{threads} threads: C {b} against {a}");
+            }
+        }
+    }
+}
