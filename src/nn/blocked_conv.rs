@@ -428,7 +428,14 @@ mod tests {
             let dy: Vec<f32> = (0..y.len()).map(|_| rng.random_range(-1.0..1.0)).collect();
             let (mut ours, mut theirs) = (zero_gradients(&params), zero_gradients(&params));
             blocked.backward(&input, &dy, None, &mut ours);
-            im2col.backward(&x_last, &mut dy.clone(), None, images, &mut theirs, false);
+            im2col.backward(
+                &x_last,
+                &mut dy.clone(),
+                None,
+                images,
+                &mut theirs,
+                crate::nn::conv_backprop::InputGradient::Skip,
+            );
             for (ours, theirs) in ours.iter().zip(&theirs) {
                 close(ours, theirs, "parameter gradient");
             }

@@ -55,6 +55,19 @@ pub enum Direction {
     Up,
 }
 
+/// The input gradient a layer's backward pass returns.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum InputGradient {
+    /// None (an empty vector).
+    Skip,
+    /// The gradient at the layer's input.
+    AtInput,
+    /// The input being a ReLU's output, the gradient at that ReLU's input: zero where the input is not
+    /// positive. Masked chunk by chunk while the chunk and its input are in cache; the layer below would mask
+    /// it in a pass of its own, reading its output back from memory.
+    BelowRelu,
+}
+
 /// The two square grids a layer maps between.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Grids {
@@ -370,13 +383,15 @@ impl StridedConv {
     }
 
     /// The weight gradient (W̃'s layout) and the bias gradient of one run of chunks, with their input gradients
-    /// written to `dx` when it is not empty. Each chunk of `dy` is first masked by the ReLU where there is one.
+    /// written to `dx` when it is not empty (masked by the input where `below_relu`). Each chunk of `dy` is
+    /// first masked by the ReLU where there is one.
     fn backward_chunks(
         &self,
         x: &[f32],
         dy: &mut [f32],
         relu_output: Option<&[f32]>,
         dx: &mut [MaybeUninit<f32>],
+        below_relu: bool,
         split: bool,
     ) -> (Vec<f32>, Vec<f32>) {
         let g = &self.grids;
@@ -431,13 +446,16 @@ impl StridedConv {
                     // `col` holds this chunk's windows of dy already, gathered for the weight gradient.
                     Direction::Up => self.columns_times_weight(col, dx, Accum::Replace, split),
                 }
+                if below_relu {
+                    relu_backward(dx, x_part);
+                }
             }
         });
         (weight_grad, bias_grad)
     }
 
     /// Adds the weight and bias gradients for output gradients `dy` at inputs `x` to `grads` (torch's layout)
-    /// and returns the input gradients when asked for. With `relu_output` (this layer's output, through a
+    /// and returns the input gradients `dx` asks for. With `relu_output` (this layer's output, through a
     /// ReLU), `dy` is the gradient at the ReLU's output and is masked in place, chunk by chunk, first.
     pub fn backward(
         &self,
@@ -446,8 +464,9 @@ impl StridedConv {
         relu_output: Option<&[f32]>,
         images: usize,
         grads: &mut [Vec<f32>],
-        want_dx: bool,
+        dx: InputGradient,
     ) -> Vec<f32> {
+        let (want_dx, below_relu) = (dx != InputGradient::Skip, dx == InputGradient::BelowRelu);
         debug_assert_eq!(x.len(), images * self.input_len());
         debug_assert_eq!(dy.len(), images * self.output_len());
         debug_assert!(relu_output.is_none_or(|y| y.len() == dy.len()));
@@ -457,7 +476,7 @@ impl StridedConv {
         let mut dx = unwritten(dx_len);
         let dx_slots = slots(&mut dx, dx_len);
         let sums = match self.task_images(images) {
-            None => vec![self.backward_chunks(x, dy, relu_output, dx_slots, true)],
+            None => vec![self.backward_chunks(x, dy, relu_output, dx_slots, below_relu, true)],
             Some(task) => {
                 let tasks = images.div_ceil(task);
                 let dx_parts: Vec<&mut [MaybeUninit<f32>]> = match want_dx {
@@ -473,7 +492,7 @@ impl StridedConv {
                     .zip(x.par_chunks(task * input_len))
                     .zip(dy.par_chunks_mut(task * output_len))
                     .zip(relu_parts)
-                    .map(|(((dx, x), dy), relu)| self.backward_chunks(x, dy, relu, dx, false))
+                    .map(|(((dx, x), dy), relu)| self.backward_chunks(x, dy, relu, dx, below_relu, false))
                     .collect()
             }
         };
@@ -594,8 +613,14 @@ pub(crate) mod tests {
         let y_ours = ours.forward(&x_last, images, false);
         close(&to_channels_first(&y_ours, out_channels, out_side), &values(&y), "output");
         let mut grads = zero_gradients(&params);
-        let dx =
-            ours.backward(&x_last, &mut to_channels_last(&r, out_channels, out_side), None, images, &mut grads, true);
+        let dx = ours.backward(
+            &x_last,
+            &mut to_channels_last(&r, out_channels, out_side),
+            None,
+            images,
+            &mut grads,
+            InputGradient::AtInput,
+        );
         close(&to_channels_first(&dx, in_channels, in_side), &values(&xt.grad(&burn_grads).unwrap()), "dx");
         for ((t, g), theirs) in params.tensors.iter().zip(&grads).zip(ParamSet::<f32>::gradients(&layer, &burn_grads)) {
             close(g, &theirs, &t.name);
@@ -630,13 +655,13 @@ pub(crate) mod tests {
         reference: &StridedConv,
         params: &ParamSet,
         batch: (&[f32], &[f32], usize),
-        want_dx: bool,
+        want_dx: InputGradient,
     ) {
         let (x, dy, images) = batch;
         let (mut reference_grads, mut grads) = (zero_gradients(params), zero_gradients(params));
         let dx_reference = reference.backward(x, &mut dy.to_vec(), None, images, &mut reference_grads, want_dx);
         let dx = layer.backward(x, &mut dy.to_vec(), None, images, &mut grads, want_dx);
-        assert_eq!(dx.len(), if want_dx { x.len() } else { 0 });
+        assert_eq!(dx.len(), if want_dx == InputGradient::Skip { 0 } else { x.len() });
         close(&dx, &dx_reference, "dx");
         for (ours, theirs) in grads.iter().zip(&reference_grads) {
             close(ours, theirs, "parameter gradient");
@@ -673,21 +698,26 @@ pub(crate) mod tests {
             assert!(whole.chunk >= images && whole.task_images(images).is_none());
             let (x, dy) = random_batch(&whole, images, &mut rng);
             let (mut whole_grads, mut chunked_grads) = (zero_gradients(&params), zero_gradients(&params));
-            let dx_whole = whole.backward(&x, &mut dy.clone(), None, images, &mut whole_grads, true);
+            let dx_whole = whole.backward(&x, &mut dy.clone(), None, images, &mut whole_grads, InputGradient::AtInput);
             for (chunk, tasks) in [(2, false), (1, true)] {
                 let mut chunked = StridedConv::new(&params, "layer", grids, direction).unwrap();
                 chunked.chunk = chunk;
                 assert_eq!(chunked.task_images(images).is_some(), tasks);
                 close(&chunked.forward(&x, images, false), &whole.forward(&x, images, false), "output");
                 chunked_grads.iter_mut().for_each(|g| g.fill(0.0));
-                close(&chunked.backward(&x, &mut dy.clone(), None, images, &mut chunked_grads, true), &dx_whole, "dx");
+                close(
+                    &chunked.backward(&x, &mut dy.clone(), None, images, &mut chunked_grads, InputGradient::AtInput),
+                    &dx_whole,
+                    "dx",
+                );
                 for (ours, theirs) in chunked_grads.iter().zip(&whole_grads) {
                     close(ours, theirs, "parameter gradient");
                 }
                 let on_threads = |threads| {
                     on_pool(threads, || {
                         let mut grads = zero_gradients(&params);
-                        let dx = chunked.backward(&x, &mut dy.clone(), None, images, &mut grads, true);
+                        let dx =
+                            chunked.backward(&x, &mut dy.clone(), None, images, &mut grads, InputGradient::AtInput);
                         (chunked.forward(&x, images, false), dx, grads)
                     })
                 };
@@ -711,7 +741,7 @@ pub(crate) mod tests {
             assert_eq!(chunked.task_images(images), Some(4), "18 chunks in 16 tasks: 2 chunks per task");
             let (x, dy) = random_batch(&whole, images, &mut rng);
             close(&chunked.forward(&x, images, false), &whole.forward(&x, images, false), "output");
-            for want_dx in [true, false] {
+            for want_dx in [InputGradient::AtInput, InputGradient::Skip] {
                 assert_same_gradients(&chunked, &whole, &params, (&x, &dy, images), want_dx);
                 let on_threads = |threads| {
                     on_pool(threads, || {
@@ -764,11 +794,11 @@ pub(crate) mod tests {
             }
             let _ = (dst, a, b);
             let (x, dy) = random_batch(&whole, images, &mut rng);
-            assert_same_gradients(&tasks, &whole, &params, (&x, &dy, images), true);
+            assert_same_gradients(&tasks, &whole, &params, (&x, &dy, images), InputGradient::AtInput);
             let on_threads = |threads| {
                 on_pool(threads, || {
                     let mut grads = zero_gradients(&params);
-                    tasks.backward(&x, &mut dy.clone(), None, images, &mut grads, false);
+                    tasks.backward(&x, &mut dy.clone(), None, images, &mut grads, InputGradient::Skip);
                     grads
                 })
             };
@@ -819,11 +849,21 @@ pub(crate) mod tests {
                 let mut masked = dy.clone();
                 relu_backward(&mut masked, &y);
                 let (mut separate, mut fused_grads) = (zero_gradients(&params), zero_gradients(&params));
-                let dx = layer.backward(&x, &mut masked.clone(), None, images, &mut separate, true);
+                let dx = layer.backward(&x, &mut masked.clone(), None, images, &mut separate, InputGradient::AtInput);
                 let mut dy_fused = dy.clone();
-                let dx_fused = layer.backward(&x, &mut dy_fused, Some(&y), images, &mut fused_grads, true);
+                let dx_fused =
+                    layer.backward(&x, &mut dy_fused, Some(&y), images, &mut fused_grads, InputGradient::AtInput);
                 assert!(dy_fused == masked, "the gradient is masked in place");
                 close(&dx_fused, &dx, "dx");
+                // Taken on below the ReLU whose output x is, chunk by chunk: the bits of masking dx after.
+                let mut below = zero_gradients(&params);
+                let dx_below =
+                    layer.backward(&x, &mut masked.clone(), None, images, &mut below, InputGradient::BelowRelu);
+                let mut dx_masked = dx.clone();
+                relu_backward(&mut dx_masked, &x);
+                assert!(dx_below == dx_masked, "chunk {chunk}: the input gradient's mask changed its bits");
+                assert!(dx_below.contains(&0.0) && dx_below.iter().any(|&v| v != 0.0));
+                assert!(below == separate, "the mask of dx changed the parameter gradients");
                 for (ours, theirs) in fused_grads.iter().zip(&separate) {
                     close(ours, theirs, "parameter gradient");
                 }

@@ -13,9 +13,9 @@ use super::vae::{FRAME_CHANNELS, FRAME_SIDE, STD_FLOOR, STD_SHIFT};
 use crate::error::{Error, Result};
 use crate::models::gp::GpHypers;
 use crate::nn::activation::{fast_sigmoid, fast_softplus};
-use crate::nn::backprop::{add_into, relu_backward, zero_gradients, Dense};
+use crate::nn::backprop::{add_into, zero_gradients, Dense};
 use crate::nn::blocked_conv::{BlockedConv, BlockedInput};
-use crate::nn::conv_backprop::{to_channels_first, to_channels_last, Direction, Grids, StridedConv};
+use crate::nn::conv_backprop::{to_channels_first, to_channels_last, Direction, Grids, InputGradient, StridedConv};
 use crate::nn::ParamSet;
 use crate::util::wide::widest_fn;
 
@@ -121,10 +121,14 @@ impl<'a> ConvVaeGrad<'a> {
         add_into(&mut d_flat, &d_from_std);
         let (channels, side) = self.encoder_out;
         let mut d = to_channels_last(&d_flat, channels, side);
+        // Every layer's input is the ReLU output of the layer below, so each hands down the gradient below that
+        // ReLU, masked while in cache; only the top layer masks its own output's gradient.
+        let top = self.encoder.len() - 1;
         for (i, layer) in self.encoder.iter().enumerate().rev() {
-            d = layer.backward(&tape.grids[i], &mut d, Some(&tape.grids[i + 1]), images, grads, true);
+            let relu_output = (i == top).then(|| tape.grids[i + 1].as_slice());
+            d = layer.backward(&tape.grids[i], &mut d, relu_output, images, grads, InputGradient::BelowRelu);
         }
-        self.first.backward(frames, &d, Some(&tape.grids[0]), grads);
+        self.first.backward(frames, &d, None, grads);
     }
 
     /// Latents [rows, L] → pixel logits, channels-last [rows, 64, 64, 6], and the tape.
@@ -150,12 +154,12 @@ impl<'a> ConvVaeGrad<'a> {
         rows: usize,
         grads: &mut [Vec<f32>],
     ) -> Vec<f32> {
+        // The last layer has no ReLU, and every layer's input is a ReLU's output (the dense layer's for the
+        // first): each hands down the gradient below that ReLU, masked while in cache.
         let mut d = d_logits;
         for (i, layer) in self.decoder.iter().enumerate().rev() {
-            let relu_output = tape.grids.get(i + 1).map(Vec::as_slice);
-            d = layer.backward(&tape.grids[i], &mut d, relu_output, rows, grads, true);
+            d = layer.backward(&tape.grids[i], &mut d, None, rows, grads, InputGradient::BelowRelu);
         }
-        relu_backward(&mut d, &tape.grids[0]);
         self.fc.backward(latents, &d, rows, grads, true)
     }
 }
