@@ -4,6 +4,9 @@
 //!
 //!   cargo bench --bench training_steps -- [--quick] [--only NAME[,NAME…]] [--threads N]
 //!
+//! `REPEATS=N` in the environment times N steps of each workload instead of its own count: a profile of many
+//! steps then shows the steady state rather than the first step's page faults.
+//!
 //! Each workload's figure is the median of its timed steps after warm-up steps; the ceiling is the best of
 //! several 1024³ products. The step counts and sizes are those the issue names (PETS small and medium, the
 //! context model's paper net at batch 64 and 512, SAC at batch 128, DLGPD at 256 and 1024, the ball EKF at
@@ -149,6 +152,13 @@ fn time_workload(workload: &Workload, quick: bool, warm: &Warm) -> (f64, usize) 
         (workload.warmup.min(2), (workload.repeats / 5).max(2))
     } else {
         (workload.warmup, workload.repeats)
+    };
+    let repeats = match std::env::var("REPEATS") {
+        Ok(value) => value.parse().ok().filter(|&n: &usize| n > 0).unwrap_or_else(|| {
+            eprintln!("REPEATS={value}: expected a whole number of timed steps, at least 1");
+            std::process::exit(2)
+        }),
+        Err(_) => repeats,
     };
     for _ in 0..warmup {
         warm.rearm();

@@ -90,7 +90,7 @@ impl<'a> ConvVaeGrad<'a> {
     }
 
     /// Frames regrouped for the first convolution → encoder (mean, std) and the tape.
-    fn encode(&self, frames: &BlockedInput, images: usize) -> (Vec<f32>, Vec<f32>, EncoderTape) {
+    fn encode(&self, frames: &BlockedInput<'_>, images: usize) -> (Vec<f32>, Vec<f32>, EncoderTape) {
         let mut grids = vec![self.first.forward(frames, true)];
         for layer in &self.encoder {
             let y = layer.forward(grids.last().expect("the first convolution's output at least"), images, true);
@@ -106,7 +106,7 @@ impl<'a> ConvVaeGrad<'a> {
 
     fn encode_backward(
         &self,
-        frames: &BlockedInput,
+        frames: &BlockedInput<'_>,
         tape: &EncoderTape,
         d_mean: &[f32],
         mut d_std: Vec<f32>,
