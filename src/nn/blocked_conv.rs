@@ -155,7 +155,7 @@ impl BlockedConv {
 
     /// Channels-first `frames` ([images, channels, side, side], given as consecutive parts), checked to be whole
     /// images, for the passes to regroup as they go.
-    pub fn regroup<'a>(&self, parts: &[&'a [f32]]) -> Result<BlockedInput<'a>> {
+    pub fn input<'a>(&self, parts: &[&'a [f32]]) -> Result<BlockedInput<'a>> {
         if let Some(part) = parts.iter().find(|p| p.len() % self.input_len() != 0) {
             return Err(Error::data(format!(
                 "{} values are not whole {} × {} × {} images",
@@ -384,7 +384,7 @@ mod tests {
             let params = ParamSet::<f32>::from_module(&conv, |n: &str| format!("layer.{n}"));
             let ours = BlockedConv::new(&params, "layer", side, (cin, cout), k, s).unwrap();
             let split = (images / 2) * cin * side * side;
-            let input = ours.regroup(&[&x[..split], &x[split..]]).unwrap();
+            let input = ours.input(&[&x[..split], &x[split..]]).unwrap();
             let y_ours = ours.forward(&input, false);
             close(&to_channels_first(&y_ours, cout, out_side), &values(&y), "output");
             let mut grads = zero_gradients(&params);
@@ -427,7 +427,7 @@ mod tests {
         let run = |threads| {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             pool.install(|| {
-                let input = layer.regroup(&[&x]).unwrap();
+                let input = layer.input(&[&x]).unwrap();
                 let mut grads = zero_gradients(&params);
                 layer.backward(&input, &dy, None, &mut grads);
                 (layer.forward(&input, false), grads)
@@ -453,7 +453,7 @@ mod tests {
             let down = crate::nn::conv_backprop::Direction::Down;
             let im2col = crate::nn::conv_backprop::StridedConv::new(&params, "layer", grids, down).unwrap();
             let x: Vec<f32> = (0..images * blocked.input_len()).map(|_| rng.random_range(-1.0..1.0)).collect();
-            let input = blocked.regroup(&[&x]).unwrap();
+            let input = blocked.input(&[&x]).unwrap();
             let x_last = crate::nn::conv_backprop::to_channels_last(&x, cin, side);
             let y = blocked.forward(&input, false);
             close(&y, &im2col.forward(&x_last, images, false), "output");
@@ -481,7 +481,7 @@ mod tests {
         let (params, layer) = random_layer(&mut rng, 12, (3, 5));
         let images = 9;
         let x: Vec<f32> = (0..images * layer.input_len()).map(|_| rng.random_range(-1.0..1.0)).collect();
-        let input = layer.regroup(&[&x]).unwrap();
+        let input = layer.input(&[&x]).unwrap();
         let mut y = layer.forward(&input, false);
         crate::nn::backprop::relu_in_place(&mut y);
         assert!(layer.forward(&input, true) == y, "the fused ReLU changed the output's bits");
@@ -502,7 +502,7 @@ mod tests {
         let conv = Conv2dConfig::new(2, 3, 4, 2).init(&device, &mut ChaCha8Rng::seed_from_u64(5));
         let params = ParamSet::<f32>::from_module(&conv, |n: &str| format!("layer.{n}"));
         let layer = BlockedConv::new(&params, "layer", 8, (2, 3), 4, 2).unwrap();
-        let error = layer.regroup(&[&[0.0; 128], &[0.0; 127]]).err().expect("127 values are not an image");
+        let error = layer.input(&[&[0.0; 128], &[0.0; 127]]).err().expect("127 values are not an image");
         assert!(error.to_string().contains("not whole 2 × 8 × 8 images"), "{error}");
     }
 }

@@ -89,7 +89,7 @@ impl<'a> ConvVaeGrad<'a> {
         })
     }
 
-    /// Frames regrouped for the first convolution → encoder (mean, std) and the tape.
+    /// The frames, as the first convolution reads them → encoder (mean, std) and the tape.
     fn encode(&self, frames: &BlockedInput<'_>, images: usize) -> (Vec<f32>, Vec<f32>, EncoderTape) {
         let mut grids = vec![self.first.forward(frames, true)];
         for layer in &self.encoder {
@@ -209,7 +209,7 @@ pub fn images_loss_and_gradients(
     if batch.obs.len() != rows * width || batch.next_obs.len() != rows * width {
         return Err(Error::data(format!("DLGPD batch: {rows} rows of frames need {width} values each")));
     }
-    let frames = net.first.regroup(&[&batch.obs, &batch.next_obs])?;
+    let frames = net.first.input(&[&batch.obs, &batch.next_obs])?;
     let (mean, std, tape) = net.encode(&frames, 2 * rows);
     let eps = noise.0.iter().chain(noise.1);
     let samples: Vec<f32> = mean.iter().zip(&std).zip(eps).map(|((m, s), e)| m + s * e).collect();
