@@ -251,7 +251,9 @@ impl StridedConv {
         Ok(StridedConv {
             grids,
             direction,
-            weight: channels_last(&params.tensors[weight_index].values, big, k),
+            // torch's [small, big, k, k] → W̃ [small, k, k, big]: each row a channels-first k × k "image" of the
+            // big channels, permuted on the pool (one element at a time on one thread, this cost DLGPD's step 3 ms).
+            weight: to_channels_last(&params.tensors[weight_index].values, big, k),
             packed: [OnceLock::new(), OnceLock::new()],
             bias: params.tensors[bias_index].values.clone(),
             weight_index,
@@ -510,13 +512,6 @@ impl StridedConv {
         }
         dx
     }
-}
-
-/// torch's weight layout [rows, channels, k, k] → W̃ [rows, k, k, channels]: each row is one "image" of a
-/// `channels` × k × k grid, permuted on the pool (a loop of one element at a time cost DLGPD's step 3 ms on one
-/// thread, most of it the decoder's first layer's 3.3 M weights).
-fn channels_last(w: &[f32], channels: usize, kernel: usize) -> Vec<f32> {
-    to_channels_last(w, channels, kernel)
 }
 
 /// Values of the weight gradient above which [`add_torch_layout`] runs on the pool.
@@ -881,7 +876,7 @@ pub(crate) mod tests {
         for (rows, channels, kernel) in [(2, 3, 2), (48, 64, 5)] {
             let taps = kernel * kernel;
             let w: Vec<f32> = (0..rows * channels * taps).map(|i| i as f32).collect();
-            let last = channels_last(&w, channels, kernel);
+            let last = to_channels_last(&w, channels, kernel);
             for (r, c, t) in (0..rows).flat_map(|r| (0..channels).flat_map(move |c| (0..taps).map(move |t| (r, c, t))))
             {
                 assert_eq!(last[(r * taps + t) * channels + c], w[(r * channels + c) * taps + t]);
